@@ -1,0 +1,66 @@
+//! `lobe`: BRDF importance sampling on the command line.
+//!
+//! A thin dispatcher: one module per command. Every error ends as one line
+//! `lobe: error: <message>` on stderr and exit code 1 (clap's own usage
+//! errors exit 2).
+
+mod demo;
+mod eval;
+
+use clap::{Args, Parser, Subcommand};
+use std::process::ExitCode;
+
+#[derive(Parser, Debug)]
+#[command(
+    name = "lobe",
+    version,
+    about = "BRDFs and their importance samplers: evaluate, sample, compare",
+    after_help = "Examples:\n  \
+                  lobe demo\n  \
+                  echo '{\"wo\":[0.6,0,0.8],\"wi\":[0,0,1]}' | lobe eval --material '{\"type\":\"lambert\"}'\n\n\
+                  `lobe <COMMAND> --help` shows each command's input, output and examples."
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    Demo(DemoArgs),
+    Eval(eval::EvalArgs),
+}
+
+/// The arguments of `lobe demo`.
+#[derive(Args, Debug)]
+#[command(
+    about = "Compare uniform sampling with importance sampling",
+    after_help = "Example:\n  lobe demo --quiet"
+)]
+struct DemoArgs {
+    /// Print less
+    #[arg(long, short)]
+    quiet: bool,
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Demo(args) => demo::run(args.quiet),
+        Command::Eval(args) => eval::run(&args),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            // One line, whatever the message holds.
+            let message = format!("{e:#}");
+            let message: Vec<&str> = message
+                .lines()
+                .map(str::trim)
+                .filter(|l| !l.is_empty())
+                .collect();
+            eprintln!("lobe: error: {}", message.join("; "));
+            ExitCode::FAILURE
+        }
+    }
+}

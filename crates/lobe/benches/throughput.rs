@@ -1,0 +1,135 @@
+//! Per-core throughput of the work a path tracer does for one BSDF sample:
+//! `Material::sample`, then `Material::eval` and `Material::pdf` for the
+//! returned direction (as for multiple importance sampling), on a batch of
+//! precomputed random `(wo, uc, u)` triples.
+//!
+//! ```text
+//! cargo bench -p lobe --bench throughput
+//! cargo bench -p lobe --bench throughput -- ggx-alpha0.2/vndf   # one benchmark
+//! ```
+//!
+//! Criterion reports elements/s; one element is one *attempted* sample
+//! (a failed sample, `None`, costs its `sample` call and counts too).
+//! The `sample-only` groups time `Material::sample` alone, for comparison.
+
+use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
+use glam::{DVec2, DVec3};
+use lobe::{Material, MaterialDesc, Rgb, Strategy};
+use rand::RngExt;
+use std::f64::consts::PI;
+use std::hint::black_box;
+use std::time::Duration;
+
+/// Samples per timed iteration.
+const BATCH: usize = 4096;
+
+/// The benchmarked materials: a short name for the group, and the JSON.
+const MATERIALS: &[(&str, &str)] = &[
+    ("lambert", r#"{"type":"lambert"}"#),
+    ("phong-n100", r#"{"type":"phong","exponent":100,"normalized":true}"#),
+    ("blinn-phong-n100", r#"{"type":"blinn-phong","exponent":100}"#),
+    ("ggx-alpha0.2", r#"{"type":"cook-torrance","distribution":"ggx","alpha":0.2}"#),
+    ("ggx-aniso-0.1x0.4", r#"{"type":"cook-torrance","distribution":"ggx","alpha_u":0.1,"alpha_v":0.4}"#),
+    ("beckmann-alpha0.2", r#"{"type":"cook-torrance","distribution":"beckmann","alpha":0.2}"#),
+    ("bp-ndf-alpha0.2", r#"{"type":"cook-torrance","distribution":"blinn-phong","alpha":0.2}"#),
+    ("kd0.3-ggx-alpha0.2", r#"{"type":"cook-torrance","distribution":"ggx","alpha":0.2,"kd":0.3}"#),
+];
+
+/// One precomputed input: view direction, lobe-choice number, direction numbers.
+#[derive(Clone, Copy)]
+struct Input {
+    wo: DVec3,
+    uc: f64,
+    u: DVec2,
+}
+
+/// `BATCH` inputs with `wo` uniform over the upper hemisphere (random
+/// azimuth, which matters for the anisotropic material), fixed seed.
+fn inputs() -> Vec<Input> {
+    let mut rng = rand_pcg::Pcg64::new(0x6c6f_6265, 0x7468_726f_7567_6870);
+    (0..BATCH)
+        .map(|_| {
+            // cos θo uniform in (0, 1]: never exactly at the horizon.
+            let cos_t: f64 = 1.0 - rng.random::<f64>();
+            let sin_t = (1.0 - cos_t * cos_t).max(0.0).sqrt();
+            let phi = 2.0 * PI * rng.random::<f64>();
+            let wo = DVec3::new(sin_t * phi.cos(), sin_t * phi.sin(), cos_t);
+            Input { wo, uc: rng.random(), u: DVec2::new(rng.random(), rng.random()) }
+        })
+        .collect()
+}
+
+fn material(json: &str) -> Material {
+    MaterialDesc::from_json(json).and_then(|d| d.build()).unwrap_or_else(|e| panic!("{json}: {e}"))
+}
+
+/// The timed loop: sample, then eval and pdf for the sampled direction.
+/// `wi` goes through `black_box` so that the compiler cannot reuse the `f`
+/// and `pdf` that `sample` computed internally: a renderer calls `eval` and
+/// `pdf` from elsewhere (light sampling, MIS), not on the same values inline.
+#[inline(never)]
+fn sample_eval_pdf(m: &Material, strategy: Strategy, inputs: &[Input]) -> (Rgb, Rgb, f64) {
+    let (mut weights, mut fs, mut pdfs) = (Rgb::ZERO, Rgb::ZERO, 0.0);
+    for x in inputs {
+        if let Some(s) = m.sample(strategy, x.wo, x.uc, x.u) {
+            weights += s.weight;
+            let wi = black_box(s.wi);
+            fs += m.eval(x.wo, wi);
+            pdfs += m.pdf(strategy, x.wo, wi);
+        }
+    }
+    (weights, fs, pdfs)
+}
+
+/// `sample` alone (its result already carries `f` and `pdf`).
+#[inline(never)]
+fn sample_only(m: &Material, strategy: Strategy, inputs: &[Input]) -> Rgb {
+    let mut weights = Rgb::ZERO;
+    for x in inputs {
+        if let Some(s) = m.sample(strategy, x.wo, x.uc, x.u) {
+            weights += s.weight;
+        }
+    }
+    weights
+}
+
+fn throughput(c: &mut Criterion) {
+    let inputs = inputs();
+    for &(name, json) in MATERIALS {
+        let m = material(json);
+        let mut group = c.benchmark_group(format!("throughput/{name}"));
+        group.throughput(Throughput::Elements(BATCH as u64));
+        for strategy in m.strategies() {
+            let ok = inputs.iter().filter(|x| m.sample(strategy, x.wo, x.uc, x.u).is_some()).count();
+            eprintln!("throughput/{name}/{strategy}: {:.1}% of samples valid", 100.0 * ok as f64 / BATCH as f64);
+            group.bench_function(BenchmarkId::from_parameter(strategy), |b| {
+                // The material and strategy are runtime values, as in a renderer.
+                b.iter(|| sample_eval_pdf(black_box(&m), black_box(strategy), black_box(&inputs)));
+            });
+        }
+        group.finish();
+    }
+
+    // For comparison: the cost of `sample` alone, for the GGX material.
+    let (name, json) = MATERIALS[3];
+    let m = material(json);
+    let mut group = c.benchmark_group(format!("sample-only/{name}"));
+    group.throughput(Throughput::Elements(BATCH as u64));
+    for strategy in m.strategies() {
+        group.bench_function(BenchmarkId::from_parameter(strategy), |b| {
+            b.iter(|| sample_only(black_box(&m), black_box(strategy), black_box(&inputs)));
+        });
+    }
+    group.finish();
+}
+
+criterion_group! {
+    name = benches;
+    config = Criterion::default()
+        .warm_up_time(Duration::from_secs(1))
+        .measurement_time(Duration::from_secs(2))
+        .sample_size(20)
+        .without_plots();
+    targets = throughput
+}
+criterion_main!(benches);

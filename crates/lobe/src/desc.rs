@@ -1,0 +1,413 @@
+//! Material descriptions: what a user writes in JSON or TOML, with every
+//! default in one place ([`DEFAULTS`]) and errors that name the field.
+
+use crate::Error;
+use crate::fresnel::Fresnel;
+use crate::material::{Glossy, Material};
+use crate::math::Rgb;
+use crate::microfacet::{Microfacet, Ndf, Shadowing};
+use crate::models::{BlinnPhong, CookTorrance, Phong};
+use serde::de::{self, Deserializer, SeqAccess, Visitor};
+use serde::{Deserialize, Serialize};
+
+/// The material keys, their values and defaults, printed by `lobe eval --help`.
+pub const DEFAULTS: &str = "\
+Material keys (JSON or TOML); colours are a number or [r, g, b]:
+  type          lambert | phong | blinn-phong | cook-torrance      (required)
+  albedo        lambert colour in [0,1]                               default 0.8
+  ks            specular colour >= 0 (<= 1 when normalized)           default 1
+  kd            diffuse colour in [0,1], added as kd/pi (not lambert) default 0
+  exponent      phong, blinn-phong shininess in [0, 1e7]              default 32
+  normalized    phong, blinn-phong: energy-normalized form            default true
+  distribution  cook-torrance: ggx | beckmann | blinn-phong           default ggx
+  alpha         cook-torrance width in [1e-4, 2] ([1e-4, 1] for       default 0.3
+                blinn-phong); or alpha_u and alpha_v (anisotropic);
+                or roughness r, with alpha = r^2
+  shadowing     cook-torrance: smith-separable | smith-correlated |   default smith-correlated
+                v-cavity
+  fresnel       cook-torrance:                                        default {\"type\":\"none\"}
+                {\"type\":\"none\"}                 F = 1
+                {\"type\":\"schlick\",\"f0\":c}        default f0 0.04
+                {\"type\":\"dielectric\",\"eta\":c}    default eta 1.5
+                {\"type\":\"conductor\",\"eta\":c,\"k\":c} default gold, eta [0.143,0.374,1.442] k [3.983,2.385,1.603]";
+
+pub const DEFAULT_ALBEDO: f64 = 0.8;
+pub const DEFAULT_EXPONENT: f64 = 32.0;
+pub const DEFAULT_ALPHA: f64 = 0.3;
+pub const DEFAULT_F0: f64 = 0.04;
+pub const DEFAULT_DIELECTRIC_ETA: f64 = 1.5;
+pub const DEFAULT_CONDUCTOR_ETA: [f64; 3] = [0.143, 0.374, 1.442];
+pub const DEFAULT_CONDUCTOR_K: [f64; 3] = [3.983, 2.385, 1.603];
+
+/// A colour: one number for grey, or `[r, g, b]`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[serde(untagged)]
+pub enum Color {
+    Grey(f64),
+    Rgb([f64; 3]),
+}
+
+impl Color {
+    #[must_use]
+    pub fn rgb(self) -> Rgb {
+        match self {
+            Color::Grey(v) => Rgb::splat(v),
+            Color::Rgb(c) => Rgb::from_array(c),
+        }
+    }
+}
+
+impl<'de> Deserialize<'de> for Color {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct V;
+        impl<'de> Visitor<'de> for V {
+            type Value = Color;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("a number or an [r, g, b] array of three numbers")
+            }
+            fn visit_f64<E: de::Error>(self, v: f64) -> Result<Color, E> {
+                Ok(Color::Grey(v))
+            }
+            fn visit_i64<E: de::Error>(self, v: i64) -> Result<Color, E> {
+                Ok(Color::Grey(v as f64))
+            }
+            fn visit_u64<E: de::Error>(self, v: u64) -> Result<Color, E> {
+                Ok(Color::Grey(v as f64))
+            }
+            fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<Color, A::Error> {
+                let mut c = [0.0; 3];
+                for (i, slot) in c.iter_mut().enumerate() {
+                    *slot = seq
+                        .next_element()?
+                        .ok_or_else(|| de::Error::invalid_length(i, &self))?;
+                }
+                if seq.next_element::<f64>()?.is_some() {
+                    return Err(de::Error::invalid_length(4, &self));
+                }
+                Ok(Color::Rgb(c))
+            }
+        }
+        d.deserialize_any(V)
+    }
+}
+
+/// A Fresnel term as written by a user.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FresnelDesc {
+    #[serde(rename = "type")]
+    pub kind: String,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub f0: Option<Color>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub eta: Option<Color>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub k: Option<Color>,
+}
+
+/// A material as written by a user; [`MaterialDesc::build`] checks it and
+/// turns it into a [`Material`].
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MaterialDesc {
+    #[serde(rename = "type")]
+    pub kind: String,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub albedo: Option<Color>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub ks: Option<Color>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub kd: Option<Color>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub exponent: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub normalized: Option<bool>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub distribution: Option<String>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub alpha: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub alpha_u: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub alpha_v: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub roughness: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub shadowing: Option<String>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub fresnel: Option<FresnelDesc>,
+}
+
+pub const MODEL_NAMES: &str = "lambert, phong, blinn-phong, cook-torrance";
+
+impl MaterialDesc {
+    /// Parse a JSON object; the error names the line, column and field.
+    pub fn from_json(text: &str) -> Result<Self, Error> {
+        serde_json::from_str(text).map_err(|e| Error::Parse(format!("material: {e}")))
+    }
+
+    /// A description with only the `type` set (every other key at its default).
+    #[must_use]
+    pub fn of_type(kind: &str) -> Self {
+        MaterialDesc {
+            kind: kind.to_string(),
+            ..Default::default()
+        }
+    }
+
+    /// Check every field and build the material.
+    pub fn build(&self) -> Result<Material, Error> {
+        let kind = self.kind.as_str();
+        let used: &[&str] = match kind {
+            "lambert" => &["albedo"],
+            "phong" | "blinn-phong" => &["ks", "kd", "exponent", "normalized"],
+            "cook-torrance" => &[
+                "ks",
+                "kd",
+                "distribution",
+                "alpha",
+                "alpha_u",
+                "alpha_v",
+                "roughness",
+                "shadowing",
+                "fresnel",
+            ],
+            _ => {
+                return Err(Error::UnknownName {
+                    field: "type".into(),
+                    value: self.kind.clone(),
+                    expected: MODEL_NAMES.into(),
+                });
+            }
+        };
+        for (name, present) in self.present_fields() {
+            if present && !used.contains(&name) {
+                return Err(Error::param(
+                    name,
+                    format!(
+                        "does not apply to type {kind} (its keys: {})",
+                        used.join(", ")
+                    ),
+                ));
+            }
+        }
+        let ks = self.ks.map_or(Rgb::ONE, Color::rgb);
+        let kd = self.kd.map_or(Rgb::ZERO, Color::rgb);
+        let exponent = self.exponent.unwrap_or(DEFAULT_EXPONENT);
+        let normalized = self.normalized.unwrap_or(true);
+        let glossy = match kind {
+            "lambert" => {
+                return Material::lambert(
+                    self.albedo.map_or(Rgb::splat(DEFAULT_ALBEDO), Color::rgb),
+                );
+            }
+            "phong" => Glossy::Phong(Phong::new(ks, exponent, normalized)?),
+            "blinn-phong" => Glossy::BlinnPhong(BlinnPhong::new(ks, exponent, normalized)?),
+            _ => {
+                let ndf: Ndf = self.distribution.as_deref().unwrap_or("ggx").parse()?;
+                let (ax, ay) = self.alphas()?;
+                let mf = Microfacet::new(ndf, ax, ay)?;
+                let shadowing: Shadowing = self
+                    .shadowing
+                    .as_deref()
+                    .unwrap_or("smith-correlated")
+                    .parse()?;
+                let fresnel = self
+                    .fresnel
+                    .as_ref()
+                    .map_or(Ok(Fresnel::None), FresnelDesc::build)?;
+                Glossy::CookTorrance(CookTorrance::new(ks, mf, shadowing, fresnel)?)
+            }
+        };
+        Material::with_diffuse(kd, glossy)
+    }
+
+    fn present_fields(&self) -> [(&'static str, bool); 12] {
+        [
+            ("albedo", self.albedo.is_some()),
+            ("ks", self.ks.is_some()),
+            ("kd", self.kd.is_some()),
+            ("exponent", self.exponent.is_some()),
+            ("normalized", self.normalized.is_some()),
+            ("distribution", self.distribution.is_some()),
+            ("alpha", self.alpha.is_some()),
+            ("alpha_u", self.alpha_u.is_some()),
+            ("alpha_v", self.alpha_v.is_some()),
+            ("roughness", self.roughness.is_some()),
+            ("shadowing", self.shadowing.is_some()),
+            ("fresnel", self.fresnel.is_some()),
+        ]
+    }
+
+    /// `(alpha_u, alpha_v)` from `alpha`, `alpha_u`/`alpha_v` or `roughness`.
+    fn alphas(&self) -> Result<(f64, f64), Error> {
+        let given = [
+            self.alpha.is_some(),
+            self.alpha_u.is_some() || self.alpha_v.is_some(),
+            self.roughness.is_some(),
+        ];
+        if given.iter().filter(|&&g| g).count() > 1 {
+            return Err(Error::param(
+                "alpha",
+                "give only one of alpha, alpha_u/alpha_v, roughness",
+            ));
+        }
+        if let Some(r) = self.roughness {
+            if !r.is_finite() || r < 0.0 {
+                return Err(Error::param(
+                    "roughness",
+                    format!("{r} is out of range: roughness must be a number >= 0"),
+                ));
+            }
+            return Ok((r * r, r * r));
+        }
+        if let Some(a) = self.alpha {
+            return Ok((a, a));
+        }
+        match (self.alpha_u, self.alpha_v) {
+            (Some(u), Some(v)) => Ok((u, v)),
+            (None, None) => Ok((DEFAULT_ALPHA, DEFAULT_ALPHA)),
+            (None, _) => Err(Error::param("alpha_u", "missing: alpha_v needs alpha_u")),
+            (_, None) => Err(Error::param("alpha_v", "missing: alpha_u needs alpha_v")),
+        }
+    }
+}
+
+impl FresnelDesc {
+    pub fn build(&self) -> Result<Fresnel, Error> {
+        let allowed: &[&str] = match self.kind.as_str() {
+            "none" => &[],
+            "schlick" => &["f0"],
+            "dielectric" => &["eta"],
+            "conductor" => &["eta", "k"],
+            other => {
+                return Err(Error::UnknownName {
+                    field: "fresnel.type".into(),
+                    value: other.into(),
+                    expected: "none, schlick, dielectric, conductor".into(),
+                });
+            }
+        };
+        for (name, present) in [
+            ("f0", self.f0.is_some()),
+            ("eta", self.eta.is_some()),
+            ("k", self.k.is_some()),
+        ] {
+            if present && !allowed.contains(&name) {
+                return Err(Error::param(
+                    &format!("fresnel.{name}"),
+                    format!("does not apply to fresnel type {}", self.kind),
+                ));
+            }
+        }
+        let positive = |field: &str, c: Rgb| -> Result<Rgb, Error> {
+            if c.to_array().iter().all(|v| v.is_finite() && *v > 0.0) {
+                Ok(c)
+            } else {
+                Err(Error::param(
+                    field,
+                    format!("{c} is out of range: each channel must be a number > 0"),
+                ))
+            }
+        };
+        Ok(match self.kind.as_str() {
+            "none" => Fresnel::None,
+            "schlick" => Fresnel::Schlick {
+                f0: crate::models::check_rgb(
+                    "fresnel.f0",
+                    self.f0.map_or(Rgb::splat(DEFAULT_F0), Color::rgb),
+                    1.0,
+                )?,
+            },
+            "dielectric" => Fresnel::Dielectric {
+                eta: positive(
+                    "fresnel.eta",
+                    self.eta
+                        .map_or(Rgb::splat(DEFAULT_DIELECTRIC_ETA), Color::rgb),
+                )?,
+            },
+            _ => Fresnel::Conductor {
+                eta: positive(
+                    "fresnel.eta",
+                    self.eta
+                        .map_or(Rgb::from_array(DEFAULT_CONDUCTOR_ETA), Color::rgb),
+                )?,
+                k: crate::models::check_rgb(
+                    "fresnel.k",
+                    self.k
+                        .map_or(Rgb::from_array(DEFAULT_CONDUCTOR_K), Color::rgb),
+                    f64::MAX,
+                )?,
+            },
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn err(json: &str) -> String {
+        match MaterialDesc::from_json(json).and_then(|d| d.build()) {
+            Ok(m) => panic!("{json} was accepted: {m:?}"),
+            Err(e) => e.to_string(),
+        }
+    }
+
+    #[test]
+    fn defaults_and_colours() {
+        let m = MaterialDesc::from_json(r#"{"type":"lambert"}"#)
+            .unwrap()
+            .build()
+            .unwrap();
+        assert_eq!(m.diffuse.albedo, Rgb::splat(0.8));
+        let m = MaterialDesc::from_json(
+            r#"{"type":"phong","ks":[0.1,0.2,0.3],"kd":0.5,"exponent":10}"#,
+        )
+        .unwrap()
+        .build()
+        .unwrap();
+        assert_eq!(m.diffuse.albedo, Rgb::splat(0.5));
+        let Glossy::Phong(p) = m.glossy else { panic!() };
+        assert_eq!(p.ks, Rgb::new(0.1, 0.2, 0.3));
+        assert!(p.normalized);
+        let m = MaterialDesc::from_json(r#"{"type":"cook-torrance","roughness":0.5}"#)
+            .unwrap()
+            .build()
+            .unwrap();
+        let Glossy::CookTorrance(c) = m.glossy else {
+            panic!()
+        };
+        assert_eq!(c.microfacet.alpha(), (0.25, 0.25));
+        assert_eq!(c.shadowing, Shadowing::SmithCorrelated);
+        assert_eq!(c.fresnel, Fresnel::None);
+    }
+
+    #[test]
+    fn bad_input_names_the_field() {
+        assert!(err(r#"{"type":"phong","exponent":-1}"#).contains("`exponent`"));
+        assert!(err(r#"{"type":"cook-torrance","alpha":-0.1}"#).contains("alpha"));
+        assert!(
+            err(r#"{"type":"cook-torrance","distribution":"ggz"}"#)
+                .contains("`distribution`: unknown value `ggz`")
+        );
+        assert!(err(r#"{"type":"cook-torrance","shadowing":"x"}"#).contains("shadowing"));
+        assert!(
+            err(r#"{"type":"lambert","exponent":3}"#)
+                .contains("`exponent`: does not apply to type lambert")
+        );
+        assert!(err(r#"{"type":"glass"}"#).contains("`type`"));
+        assert!(err(r#"{"type":"phong","ks":[1,2]}"#).contains("ks"));
+        assert!(err(r#"{"type":"phong","exponnt":3}"#).contains("unknown field `exponnt`"));
+        assert!(
+            err(r#"{"type":"cook-torrance","fresnel":{"type":"conductor","f0":0.5}}"#)
+                .contains("fresnel.f0")
+        );
+        assert!(
+            err(r#"{"type":"cook-torrance","fresnel":{"type":"dielectric","eta":0}}"#)
+                .contains("fresnel.eta")
+        );
+        assert!(err(r#"{"type":"cook-torrance","alpha_u":0.1}"#).contains("alpha_v"));
+        assert!(err(r#"{"type":"lambert","albedo":1.5}"#).contains("albedo"));
+    }
+}

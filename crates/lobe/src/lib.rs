@@ -1,0 +1,62 @@
+//! # lobe: BRDFs and their importance samplers
+//!
+//! `lobe` evaluates, samples and gives the pdf of the reflection models of the
+//! classic lecture on importance sampling in BRDF evaluation (Phong,
+//! Blinn-Phong, Cook-Torrance with GGX and Beckmann) and of the samplers that
+//! renderers use today (visible normals, spherical caps, bounded VNDF). Every
+//! sampler is proven against its pdf by the statistical tests in [`stats`].
+//!
+//! ## Conventions
+//!
+//! * Local shading frame, `+z` is the surface normal ([`Frame`] goes to and
+//!   from the world).
+//! * `wo` points toward the viewer, `wi` toward the light; both are unit
+//!   vectors pointing away from the surface.
+//! * [`Material::eval`] is `f_r` **without** the cosine.
+//! * Pdfs are densities in **solid angle** over `wi`.
+//! * A sample whose direction falls below the horizon is a *failed* sample:
+//!   `sample` returns `None`, and an estimator still counts it in its `N`.
+//!   Hence the pdf integrates over the sphere to the probability that a
+//!   sample is not lost, which may be below one.
+//! * `alpha` is the microfacet width parameter. Where "roughness" is
+//!   accepted, `alpha = roughness²` (not pbrt-v4's square root).
+//!
+//! ```
+//! use lobe::{Material, MaterialDesc, Strategy};
+//! use glam::{DVec2, DVec3};
+//! let m = MaterialDesc::from_json(r#"{"type":"cook-torrance","alpha":0.2}"#)?.build()?;
+//! let wo = DVec3::new(0.6, 0.0, 0.8);
+//! if let Some(s) = m.sample(Strategy::Vndf, wo, 0.5, DVec2::new(0.3, 0.7)) {
+//!     // s.weight == f * cos / pdf
+//!     assert!((s.pdf - m.pdf(Strategy::Vndf, wo, s.wi)).abs() < 1e-9 * s.pdf);
+//! }
+//! # Ok::<(), lobe::Error>(())
+//! ```
+
+pub mod desc;
+pub mod error;
+pub mod estimator;
+pub mod frame;
+pub mod fresnel;
+pub mod light;
+pub mod material;
+pub mod math;
+pub mod microfacet;
+pub mod models;
+pub mod sample;
+pub mod sequence;
+pub mod stats;
+pub mod strategy;
+pub mod warp;
+
+pub use desc::MaterialDesc;
+pub use error::Error;
+pub use frame::Frame;
+pub use fresnel::Fresnel;
+pub use glam;
+pub use light::Light;
+pub use material::{Glossy, Material};
+pub use math::Rgb;
+pub use microfacet::{Microfacet, Ndf, Shadowing};
+pub use sample::{BsdfSample, LobeKind};
+pub use strategy::Strategy;

@@ -1,0 +1,193 @@
+//! A material: a Lambertian term plus at most one glossy lobe, with
+//! evaluation, sampling by any strategy, and the matching pdf.
+//!
+//! With two lobes, `sample` chooses the glossy lobe with probability
+//! `P = a_g / (a_g + a_d)` from the lobes' albedo estimates
+//! ([`crate::models::Lobe::albedo_hint`]) and the diffuse lobe otherwise,
+//! and `pdf` is the mixture `P p_g + (1 − P) p_d` (one-sample MIS with the
+//! balance heuristic), so `pdf` is always the density that `sample` draws from.
+
+use crate::math::{INV_TWO_PI, Rgb};
+use crate::models::{BlinnPhong, CookTorrance, Lambert, Lobe, Phong};
+use crate::sample::{BsdfSample, LobeKind};
+use crate::{Error, Strategy, warp};
+use glam::{DVec2, DVec3};
+
+/// The glossy lobe of a material (static dispatch).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Glossy {
+    None,
+    Phong(Phong),
+    BlinnPhong(BlinnPhong),
+    CookTorrance(CookTorrance),
+}
+
+macro_rules! dispatch {
+    ($self:expr, $l:ident => $e:expr, $none:expr) => {
+        match $self {
+            Glossy::None => $none,
+            Glossy::Phong($l) => $e,
+            Glossy::BlinnPhong($l) => $e,
+            Glossy::CookTorrance($l) => $e,
+        }
+    };
+}
+
+/// A material: `f = diffuse.albedo/π + glossy`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Material {
+    pub diffuse: Lambert,
+    pub glossy: Glossy,
+}
+
+impl Material {
+    /// A Lambertian material.
+    pub fn lambert(albedo: Rgb) -> crate::error::Result<Self> {
+        Ok(Material {
+            diffuse: Lambert::new(albedo)?,
+            glossy: Glossy::None,
+        })
+    }
+
+    /// A glossy lobe plus a diffuse term `kd/π`.
+    pub fn with_diffuse(kd: Rgb, glossy: Glossy) -> crate::error::Result<Self> {
+        let diffuse = Lambert::new(kd).map_err(|_| {
+            Error::param(
+                "kd",
+                format!("{kd} is out of range: each channel must be in [0, 1]"),
+            )
+        })?;
+        Ok(Material { diffuse, glossy })
+    }
+
+    /// A short name of the model, for tables.
+    #[must_use]
+    pub fn model_name(&self) -> &'static str {
+        match self.glossy {
+            Glossy::None => "lambert",
+            Glossy::Phong(_) => "phong",
+            Glossy::BlinnPhong(_) => "blinn-phong",
+            Glossy::CookTorrance(_) => "cook-torrance",
+        }
+    }
+
+    fn has_diffuse(&self) -> bool {
+        self.diffuse.albedo != Rgb::ZERO
+    }
+
+    /// `Ok` when `strategy` applies to this material, otherwise an error
+    /// that says why.
+    pub fn check(&self, strategy: Strategy) -> crate::error::Result<()> {
+        let r = dispatch!(&self.glossy, l => l.supports(strategy), self.diffuse.supports(strategy));
+        r.map_err(|reason| Error::Unsupported {
+            strategy: strategy.name().into(),
+            reason,
+        })
+    }
+
+    /// The strategies that apply to this material, in [`Strategy::ALL`] order.
+    #[must_use]
+    pub fn strategies(&self) -> Vec<Strategy> {
+        Strategy::ALL
+            .into_iter()
+            .filter(|&s| self.check(s).is_ok())
+            .collect()
+    }
+
+    /// Probability of choosing the glossy lobe for `wo`.
+    #[inline]
+    #[must_use]
+    pub fn glossy_probability(&self, wo: DVec3) -> f64 {
+        let g = dispatch!(&self.glossy, l => l.albedo_hint(wo), return 0.0);
+        if !self.has_diffuse() {
+            return 1.0;
+        }
+        let d = self.diffuse.albedo_hint(wo);
+        if g + d > 0.0 { g / (g + d) } else { 0.5 }
+    }
+
+    /// `f_r(wo, wi)` without the cosine; zero unless both directions are
+    /// above the horizon.
+    #[inline]
+    #[must_use]
+    pub fn eval(&self, wo: DVec3, wi: DVec3) -> Rgb {
+        debug_assert!(
+            crate::math::is_unit(wo) && crate::math::is_unit(wi),
+            "wo {wo} or wi {wi} not unit"
+        );
+        if wo.z <= 0.0 || wi.z <= 0.0 {
+            return Rgb::ZERO;
+        }
+        let g = dispatch!(&self.glossy, l => l.eval(wo, wi), Rgb::ZERO);
+        g + self.diffuse.eval(wo, wi)
+    }
+
+    /// Density in solid angle with which `sample(strategy, wo, ..)` returns
+    /// `wi`; zero below the horizon. For a strategy that does not apply
+    /// (see [`Material::check`]) the result is meaningless.
+    #[inline]
+    #[must_use]
+    pub fn pdf(&self, strategy: Strategy, wo: DVec3, wi: DVec3) -> f64 {
+        if wo.z <= 0.0 || wi.z <= 0.0 {
+            return 0.0;
+        }
+        match strategy {
+            Strategy::Uniform => INV_TWO_PI,
+            Strategy::Cosine => warp::square_to_cosine_hemisphere_pdf(wi),
+            _ => {
+                let p = self.glossy_probability(wo);
+                let pg = if p > 0.0 {
+                    dispatch!(&self.glossy, l => l.pdf(strategy, wo, wi), 0.0)
+                } else {
+                    0.0
+                };
+                let pd = if p < 1.0 {
+                    self.diffuse.pdf(strategy, wo, wi)
+                } else {
+                    0.0
+                };
+                p * pg + (1.0 - p) * pd
+            }
+        }
+    }
+
+    /// Draw `wi` for `wo` with `strategy`. `uc` chooses the lobe, `u` the
+    /// direction. `None` is a failed sample (below the horizon, or `wo`
+    /// below it), which an estimator counts with weight zero.
+    #[inline]
+    #[must_use]
+    pub fn sample(&self, strategy: Strategy, wo: DVec3, uc: f64, u: DVec2) -> Option<BsdfSample> {
+        if wo.z <= 0.0 {
+            return None;
+        }
+        let (wi, lobe) = match strategy {
+            Strategy::Uniform => (warp::square_to_uniform_hemisphere(u), LobeKind::Hemisphere),
+            Strategy::Cosine => (warp::square_to_cosine_hemisphere(u), LobeKind::Hemisphere),
+            _ => {
+                if uc < self.glossy_probability(wo) {
+                    (
+                        dispatch!(&self.glossy, l => l.sample(strategy, wo, u)?, return None),
+                        LobeKind::Glossy,
+                    )
+                } else {
+                    (self.diffuse.sample(strategy, wo, u)?, LobeKind::Diffuse)
+                }
+            }
+        };
+        if wi.z <= 0.0 {
+            return None;
+        }
+        let pdf = self.pdf(strategy, wo, wi);
+        if !(pdf > 0.0 && pdf.is_finite()) {
+            return None;
+        }
+        let f = self.eval(wo, wi);
+        Some(BsdfSample {
+            wi,
+            f,
+            pdf,
+            weight: f * (wi.z / pdf),
+            lobe,
+        })
+    }
+}

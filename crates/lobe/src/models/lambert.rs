@@ -1,0 +1,56 @@
+//! Lambertian (ideal diffuse) reflection.
+//!
+//! | parameter | range | default | meaning |
+//! |---|---|---|---|
+//! | `albedo` | RGB in [0, 1] | 0.8 | fraction of light reflected, from every direction |
+//!
+//! `f_r = albedo / π`. Its `brdf` sampler is the cosine-weighted hemisphere,
+//! density `cos θi / π`, so the weight `f cos/pdf = albedo` is constant: a
+//! zero-variance estimator under constant light (the furnace test).
+
+use super::Lobe;
+use crate::math::{INV_PI, Rgb};
+use crate::{Strategy, warp};
+use glam::{DVec2, DVec3};
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Lambert {
+    pub albedo: Rgb,
+}
+
+impl Lambert {
+    pub fn new(albedo: Rgb) -> crate::error::Result<Self> {
+        Ok(Lambert {
+            albedo: super::check_rgb("albedo", albedo, 1.0)?,
+        })
+    }
+}
+
+impl Lobe for Lambert {
+    #[inline]
+    fn eval(&self, _wo: DVec3, _wi: DVec3) -> Rgb {
+        self.albedo * INV_PI
+    }
+
+    #[inline]
+    fn sample(&self, _strategy: Strategy, _wo: DVec3, u: DVec2) -> Option<DVec3> {
+        let wi = warp::square_to_cosine_hemisphere(u);
+        (wi.z > 0.0).then_some(wi)
+    }
+
+    #[inline]
+    fn pdf(&self, _strategy: Strategy, _wo: DVec3, wi: DVec3) -> f64 {
+        warp::square_to_cosine_hemisphere_pdf(wi)
+    }
+
+    fn albedo_hint(&self, _wo: DVec3) -> f64 {
+        crate::math::luminance(self.albedo)
+    }
+
+    fn supports(&self, strategy: Strategy) -> Result<(), String> {
+        match strategy {
+            Strategy::Uniform | Strategy::Cosine | Strategy::Brdf => Ok(()),
+            _ => Err("a Lambertian term has no microfacets; use uniform, cosine or brdf".into()),
+        }
+    }
+}

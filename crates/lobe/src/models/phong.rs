@@ -1,0 +1,99 @@
+//! Phong reflection, the lecture's form and the energy-normalized one.
+//!
+//! | parameter | range | default | meaning |
+//! |---|---|---|---|
+//! | `ks` | RGB ≥ 0 (≤ 1 when normalized) | 1 | specular colour |
+//! | `exponent` `n` | [0, 10⁷] | 32 | shininess: larger is a tighter highlight |
+//! | `normalized` | bool | true | use the energy-normalized form |
+//!
+//! With `α` the angle between `wi` and the mirror direction of `wo` about the
+//! normal (equivalently between `wo` and the mirror of `wi`: the model is
+//! reciprocal):
+//!
+//! * lecture form (`normalized = false`): `f = ks · max(cos α, 0)ⁿ`. Its albedo
+//!   at normal incidence is `ks · 2π/(n+2)`, above 1 for `n < 4.3` with
+//!   `ks = 1`: this form does not conserve energy.
+//! * modified Phong of Lafortune and Willems 1994 (`normalized = true`):
+//!   `f = ks · (n+2)/(2π) · max(cos α, 0)ⁿ`, whose albedo at normal incidence
+//!   is exactly `ks`, and lower at other angles (the lobe is cut by the
+//!   horizon).
+//!
+//! A diffuse term `kd/π` is added by the material.
+//!
+//! `brdf` sampling draws `α` around the mirror direction with density
+//! `(n+1)/(2π) cosⁿα` (`cos α = u₁^(1/(n+1))`, `φ = 2πu₂`), in a frame built
+//! around the mirror direction. Directions below the horizon are failed
+//! samples; the pdf is that density on the upper hemisphere and 0 below.
+
+use super::Lobe;
+use crate::math::{INV_TWO_PI, Rgb, luminance, mirror_z};
+use crate::{Frame, Strategy, warp};
+use glam::{DVec2, DVec3};
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Phong {
+    pub ks: Rgb,
+    pub exponent: f64,
+    pub normalized: bool,
+}
+
+impl Phong {
+    pub fn new(ks: Rgb, exponent: f64, normalized: bool) -> crate::error::Result<Self> {
+        let ks = super::check_rgb("ks", ks, if normalized { 1.0 } else { f64::MAX })?;
+        Ok(Phong {
+            ks,
+            exponent: super::check_exponent(exponent)?,
+            normalized,
+        })
+    }
+
+    /// The factor in front of `cosⁿα`.
+    #[inline]
+    fn norm(&self) -> f64 {
+        if self.normalized {
+            (self.exponent + 2.0) * INV_TWO_PI
+        } else {
+            1.0
+        }
+    }
+
+    #[inline]
+    fn cos_alpha(wo: DVec3, wi: DVec3) -> f64 {
+        mirror_z(wo).dot(wi).max(0.0)
+    }
+}
+
+impl Lobe for Phong {
+    #[inline]
+    fn eval(&self, wo: DVec3, wi: DVec3) -> Rgb {
+        self.ks * (self.norm() * Self::cos_alpha(wo, wi).powf(self.exponent))
+    }
+
+    #[inline]
+    fn sample(&self, _strategy: Strategy, wo: DVec3, u: DVec2) -> Option<DVec3> {
+        let local = warp::square_to_cos_power(u, self.exponent);
+        let wi = Frame::from_normal(mirror_z(wo)).to_world(local);
+        (wi.z > 0.0).then_some(wi)
+    }
+
+    #[inline]
+    fn pdf(&self, _strategy: Strategy, wo: DVec3, wi: DVec3) -> f64 {
+        (self.exponent + 1.0) * INV_TWO_PI * Self::cos_alpha(wo, wi).powf(self.exponent)
+    }
+
+    fn albedo_hint(&self, _wo: DVec3) -> f64 {
+        let a = luminance(self.ks);
+        if self.normalized {
+            a
+        } else {
+            a * 2.0 / (self.exponent + 2.0) * std::f64::consts::PI
+        }
+    }
+
+    fn supports(&self, strategy: Strategy) -> Result<(), String> {
+        match strategy {
+            Strategy::Uniform | Strategy::Cosine | Strategy::Brdf => Ok(()),
+            _ => Err("Phong has no microfacet distribution; use uniform, cosine or brdf".into()),
+        }
+    }
+}

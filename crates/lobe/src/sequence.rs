@@ -1,0 +1,316 @@
+//! Sample sequences for the estimators: independent PCG streams, stratified
+//! (jittered) points and Owen-scrambled Sobol points, each deterministic per
+//! seed and each a function of the sample index alone (chunks of samples
+//! can run on any thread in any order).
+//!
+//! Each sample takes three numbers: `uc` (lobe choice) and `u = (u₁, u₂)`.
+//!
+//! Sobol is written here rather than taken from `sobol_burley`, whose
+//! sequences stop at 2¹⁶ points: `lobe converge` goes to 2²⁰. The
+//! generator matrices are Joe and Kuo's for the first four dimensions and
+//! the scrambling is Burley's hash-based nested uniform (Owen) scramble
+//! (Burley 2020, "Practical Hash-based Owen Scrambling").
+
+use crate::estimator::chunk_rng;
+use rand::RngExt;
+
+/// How the samples of an estimate are placed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Sequence {
+    /// Independent uniform numbers from a PCG stream per chunk.
+    Independent,
+    /// Jittered: one point per cell of an `m × m` grid over `u` when `N = m²`,
+    /// otherwise Latin hypercube (every 1D projection stratified); `uc` is
+    /// stratified in 1D. Unbiased for every `N`.
+    Stratified,
+    /// Owen-scrambled Sobol points, up to 2³² of them.
+    Sobol,
+}
+
+impl Sequence {
+    pub const ALL: [Sequence; 3] = [Sequence::Independent, Sequence::Stratified, Sequence::Sobol];
+
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Sequence::Independent => "independent",
+            Sequence::Stratified => "stratified",
+            Sequence::Sobol => "sobol",
+        }
+    }
+}
+
+impl std::fmt::Display for Sequence {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::str::FromStr for Sequence {
+    type Err = crate::Error;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        Sequence::ALL
+            .into_iter()
+            .find(|x| x.name() == s)
+            .ok_or_else(|| crate::Error::UnknownName {
+                field: "sequence".into(),
+                value: s.into(),
+                expected: "independent, stratified, sobol".into(),
+            })
+    }
+}
+
+/// Fill `out` with the points `first .. first + out.len()` of an `n`-point
+/// sequence; `chunk` names the chunk (for the independent streams).
+pub fn fill(seq: Sequence, seed: u64, n: usize, chunk: usize, first: usize, out: &mut [[f64; 3]]) {
+    match seq {
+        Sequence::Independent => {
+            let mut rng = chunk_rng(seed, chunk);
+            for p in out.iter_mut() {
+                *p = [rng.random(), rng.random(), rng.random()];
+            }
+        }
+        Sequence::Stratified => {
+            let mut rng = chunk_rng(seed ^ 0x5354_5241_5449_4659, chunk);
+            let m = (n as f64).sqrt().round() as usize;
+            let square = m * m == n;
+            let s = hash64(seed);
+            for (k, p) in out.iter_mut().enumerate() {
+                let i = (first + k) as u64;
+                let (j1, j2, j3): (f64, f64, f64) = (rng.random(), rng.random(), rng.random());
+                let nn = n as u64;
+                let uc = (permute(i, nn, s as u32) as f64 + j3) / n as f64;
+                if square {
+                    let (x, y) = (i % m as u64, i / m as u64);
+                    p[1] = (x as f64 + j1) / m as f64;
+                    p[2] = (y as f64 + j2) / m as f64;
+                } else {
+                    p[1] = (permute(i, nn, (s >> 32) as u32) as f64 + j1) / n as f64;
+                    p[2] = (permute(i, nn, (s >> 16) as u32 ^ 0x9e37) as f64 + j2) / n as f64;
+                }
+                p[0] = uc.min(ONE_MINUS_EPS);
+                p[1] = p[1].min(ONE_MINUS_EPS);
+                p[2] = p[2].min(ONE_MINUS_EPS);
+            }
+        }
+        Sequence::Sobol => {
+            let s = hash64(seed);
+            let seeds = [s as u32, (s >> 32) as u32, hash64(s) as u32];
+            for (k, p) in out.iter_mut().enumerate() {
+                let i = (first + k) as u32;
+                // Shuffle the order of the points too (Burley, section 4).
+                let idx = nested_uniform_scramble(i, hash64(s ^ 0x1234) as u32);
+                for d in 0..3 {
+                    let x = nested_uniform_scramble(sobol(idx, d), seeds[d]);
+                    p[d] = (f64::from(x) + 0.5) / 4_294_967_296.0;
+                }
+            }
+        }
+    }
+}
+
+const ONE_MINUS_EPS: f64 = 1.0 - f64::EPSILON / 2.0;
+
+/// Joe–Kuo direction numbers: (degree, coefficients, initial m) for
+/// dimensions 2, 3, 4; dimension 1 is the van der Corput sequence.
+const JOE_KUO: [(u32, u32, [u32; 3]); 3] =
+    [(1, 0, [1, 0, 0]), (2, 1, [1, 3, 0]), (3, 1, [1, 3, 1])];
+
+const fn matrices() -> [[u32; 32]; 4] {
+    let mut v = [[0u32; 32]; 4];
+    let mut k = 0;
+    while k < 32 {
+        v[0][k] = 1u32 << (31 - k);
+        k += 1;
+    }
+    let mut d = 0;
+    while d < 3 {
+        let (s, a, m0) = JOE_KUO[d];
+        let s = s as usize;
+        let mut m = [0u32; 32];
+        let mut k = 0;
+        while k < 32 {
+            if k < s {
+                m[k] = m0[k];
+            } else {
+                let mut x = m[k - s] ^ (m[k - s] << s);
+                let mut j = 1;
+                while j < s {
+                    if (a >> (s - 1 - j)) & 1 == 1 {
+                        x ^= m[k - j] << j;
+                    }
+                    j += 1;
+                }
+                m[k] = x;
+            }
+            k += 1;
+        }
+        let mut k = 0;
+        while k < 32 {
+            v[d + 1][k] = m[k] << (31 - k);
+            k += 1;
+        }
+        d += 1;
+    }
+    v
+}
+
+static SOBOL_MATRICES: [[u32; 32]; 4] = matrices();
+
+/// Point `i` of the unscrambled Sobol sequence in dimension `d` (< 4), as a
+/// 32-bit fixed-point fraction.
+#[must_use]
+pub fn sobol(mut i: u32, d: usize) -> u32 {
+    let mut x = 0;
+    let mut k = 0;
+    while i != 0 {
+        if i & 1 == 1 {
+            x ^= SOBOL_MATRICES[d][k];
+        }
+        i >>= 1;
+        k += 1;
+    }
+    x
+}
+
+/// Burley's nested uniform scramble: a Laine–Karras-style hash on the
+/// reversed bits, so that each bit is flipped by a hash of the bits above it.
+#[must_use]
+pub fn nested_uniform_scramble(x: u32, seed: u32) -> u32 {
+    let mut v = x.reverse_bits();
+    v = v.wrapping_add(seed);
+    v ^= v.wrapping_mul(0x6c50_b47c);
+    v ^= v.wrapping_mul(0xb82f_1e52);
+    v ^= v.wrapping_mul(0xc7af_e638);
+    v ^= v.wrapping_mul(0x8d22_f6e6);
+    v.reverse_bits()
+}
+
+/// A 64-bit mixing hash (SplitMix64's finalizer).
+#[must_use]
+pub fn hash64(mut x: u64) -> u64 {
+    x = x.wrapping_add(0x9e37_79b9_7f4a_7c15);
+    x = (x ^ (x >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    x = (x ^ (x >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+    x ^ (x >> 31)
+}
+
+/// A pseudo-random permutation of `0..n` evaluated at `i`, without memory:
+/// a bijective hash on the next power of two, walked until it lands inside
+/// `0..n` (cycle walking; Kensler 2013).
+#[must_use]
+pub fn permute(i: u64, n: u64, seed: u32) -> u64 {
+    debug_assert!(i < n);
+    if n <= 1 {
+        return 0;
+    }
+    let bits = 64 - (n - 1).leading_zeros();
+    let mask = if bits == 64 {
+        u64::MAX
+    } else {
+        (1u64 << bits) - 1
+    };
+    let key = hash64(u64::from(seed));
+    let mut x = i;
+    loop {
+        // An invertible map on `bits`-bit integers: xor-shifts and odd multiplications.
+        x ^= key & mask;
+        x = x.wrapping_mul(0x9e37_79b9_7f4a_7c15 | 1) & mask;
+        x ^= (x >> (bits / 2 + 1)) & mask;
+        x = x.wrapping_mul(0xbf58_476d_1ce4_e5b9 | 1) & mask;
+        x ^= (x >> (bits / 3 + 1)) & mask;
+        x = (x ^ (key >> 32)) & mask;
+        if x < n {
+            return x;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sobol_first_points_are_the_known_ones() {
+        // Dimension 2 (Joe–Kuo d=2), natural order: 0, 1/2, 3/4, 1/4, 5/8, 1/8, 3/8, 7/8.
+        let expect = [0.0, 0.5, 0.75, 0.25, 0.625, 0.125, 0.375, 0.875];
+        for (i, e) in expect.iter().enumerate() {
+            assert_eq!(
+                f64::from(sobol(i as u32, 1)) / 4_294_967_296.0,
+                *e,
+                "point {i}"
+            );
+        }
+        // Dimension 3: 0, 1/2, 3/4, 1/4, 3/8, 7/8, 5/8, 1/8.
+        let expect = [0.0, 0.5, 0.75, 0.25, 0.375, 0.875, 0.625, 0.125];
+        for (i, e) in expect.iter().enumerate() {
+            assert_eq!(
+                f64::from(sobol(i as u32, 2)) / 4_294_967_296.0,
+                *e,
+                "point {i}"
+            );
+        }
+    }
+
+    #[test]
+    fn every_power_of_two_prefix_is_stratified_after_scrambling() {
+        // A (0, m, 2) net: 2^m points, one in each of 2^m elementary intervals per 1D projection.
+        let n = 1 << 10;
+        let mut out = vec![[0.0; 3]; n];
+        fill(Sequence::Sobol, 42, n, 0, 0, &mut out);
+        for d in 0..3 {
+            let mut seen = vec![false; n];
+            for p in &out {
+                let cell = (p[d] * n as f64) as usize;
+                assert!(!seen[cell], "dimension {d}: two points in cell {cell}");
+                seen[cell] = true;
+            }
+        }
+        // (u1, u2) form a (0, 2)-net: one point per 32 × 32 cell.
+        let mut seen = vec![false; n];
+        for p in &out {
+            let c = (p[1] * 32.0) as usize * 32 + (p[2] * 32.0) as usize;
+            assert!(!seen[c], "two points in 2D cell {c}");
+            seen[c] = true;
+        }
+    }
+
+    #[test]
+    fn permutations_are_bijections() {
+        for n in [1u64, 2, 3, 7, 100, 1000, 4097] {
+            let mut seen = vec![false; n as usize];
+            for i in 0..n {
+                let j = permute(i, n, 17) as usize;
+                assert!(!seen[j]);
+                seen[j] = true;
+            }
+        }
+    }
+
+    #[test]
+    fn stratified_points_are_stratified() {
+        for n in [1024usize, 1000] {
+            let mut out = vec![[0.0; 3]; n];
+            fill(Sequence::Stratified, 3, n, 0, 0, &mut out);
+            for d in 0..3 {
+                if n == 1024 && d > 0 {
+                    continue; // jittered grid: stratified per 32×32 cell, checked below
+                }
+                let mut seen = vec![false; n];
+                for p in &out {
+                    let c = (p[d] * n as f64) as usize;
+                    assert!(!seen[c], "n {n} dim {d}: cell {c} twice");
+                    seen[c] = true;
+                }
+            }
+        }
+        let mut out = vec![[0.0; 3]; 1024];
+        fill(Sequence::Stratified, 3, 1024, 0, 0, &mut out);
+        let mut seen = [false; 1024];
+        for p in &out {
+            let c = (p[1] * 32.0) as usize * 32 + (p[2] * 32.0) as usize;
+            assert!(!seen[c]);
+            seen[c] = true;
+        }
+    }
+}

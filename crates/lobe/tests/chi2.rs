@@ -1,0 +1,128 @@
+//! Chi-square goodness of fit of `sample()` against `pdf()` for every model ×
+//! strategy over the parameter grid, and the pdf's integral against the
+//! probability that a sample is not lost.
+//!
+//! Significance 0.01 over the whole grid (Šidák). A failure writes the
+//! observed and expected tables to `target/tmp/chi2-failures/<case>.csv`.
+
+mod common;
+
+use common::{Case, plan};
+use glam::DVec2;
+use lobe::Strategy;
+use lobe::stats::chi2::{Chi2Config, chi2_test, sidak, success_probability};
+
+fn run(cases: Vec<Case>) {
+    let alpha = sidak(0.01, common::grid_size());
+    let cfg = Chi2Config::default();
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("chi2-failures");
+    let mut failures = Vec::new();
+    let mut count = 0;
+    for c in &cases {
+        let m = c.material;
+        for (s, theta) in plan(&m) {
+            count += 1;
+            let wo = common::wo(theta);
+            let t0 = std::time::Instant::now();
+            let r = chi2_test(
+                &cfg,
+                |uc, u| m.sample(s, wo, uc, u).map(|x| x.wi),
+                |wi| m.pdf(s, wo, wi),
+            );
+            let label = format!("{}_{}_theta{}", c.name, s, theta);
+            if std::env::var_os("LOBE_CHI2_VERBOSE").is_some() {
+                eprintln!(
+                    "{label}: p = {:.3e}, dof {}, {:.2} s",
+                    r.p_value,
+                    r.dof,
+                    t0.elapsed().as_secs_f64()
+                );
+            }
+            if !r.passes(alpha) {
+                std::fs::create_dir_all(&dir).unwrap();
+                let path = dir.join(format!("{label}.csv"));
+                r.write_tables(&cfg, &path).unwrap();
+                failures.push(format!(
+                    "{} {s} θ={theta}: χ²={:.1} dof={} p={:.3e} < {alpha:.2e} {} (tables: {})",
+                    c.json,
+                    r.statistic,
+                    r.dof,
+                    r.p_value,
+                    r.message.clone().unwrap_or_default(),
+                    path.display()
+                ));
+            }
+            // ∫ pdf dω over the sphere = probability that a sample is not lost.
+            let p = m.glossy_probability(wo);
+            let lobes: Vec<(f64, f64)> = match s {
+                Strategy::Uniform | Strategy::Cosine => vec![(1.0, 0.5)],
+                _ => vec![(p, 0.5 * p), (1.0 - p, 0.5 * (1.0 + p))],
+            };
+            let kept = success_probability(
+                |uc, u: DVec2| m.sample(s, wo, uc, u).is_some(),
+                &lobes,
+                1024,
+            );
+            if (r.pdf_integral - kept).abs() > 1e-3 {
+                failures.push(format!(
+                    "{} {s} θ={theta}: ∫pdf = {:.6} but {:.6} of the samples are kept",
+                    c.json, r.pdf_integral, kept
+                ));
+            }
+        }
+    }
+    assert!(
+        failures.is_empty(),
+        "{} of {count} tests failed:\n{}",
+        failures.len(),
+        failures.join("\n")
+    );
+}
+
+#[test]
+fn chi2_lambert() {
+    run(common::lambert_family());
+}
+
+#[test]
+fn chi2_phong_and_blinn_phong() {
+    run(common::phong_family());
+}
+
+#[test]
+fn chi2_microfacet_ggx() {
+    run(common::microfacet_family()
+        .into_iter()
+        .filter(|c| c.json.contains("ggx"))
+        .collect());
+}
+
+#[test]
+fn chi2_microfacet_beckmann_and_blinn_ndf() {
+    run(common::microfacet_family()
+        .into_iter()
+        .filter(|c| !c.json.contains("ggx"))
+        .collect());
+}
+
+/// The harness can fail: a sampler checked against the wrong pdf is caught.
+#[test]
+fn chi2_catches_a_wrong_pdf() {
+    let c = common::case(r#"{"type":"blinn-phong","exponent":20}"#);
+    let m = c.material;
+    let wo = common::wo(30.0);
+    // The lecture's density over half vectors, used as if it were over wi.
+    let r = chi2_test(
+        &Chi2Config::default(),
+        |uc, u| m.sample(Strategy::Brdf, wo, uc, u).map(|x| x.wi),
+        |wi| {
+            let h = (wo + wi).normalize();
+            if wi.z > 0.0 {
+                21.0 / (2.0 * std::f64::consts::PI) * h.z.powf(20.0)
+            } else {
+                0.0
+            }
+        },
+    );
+    assert!(r.p_value < 1e-12, "p = {}", r.p_value);
+}

@@ -1,0 +1,112 @@
+//! The parameter grid shared by the statistical tests: every model and
+//! strategy over exponents 1 to 10⁴, alphas 0.02 to 1, anisotropy and view
+//! angles 0 to 89°.
+#![allow(dead_code)]
+
+use glam::DVec3;
+use lobe::{Material, MaterialDesc, Strategy};
+
+/// One material of the grid, with a name for messages and failure files.
+pub struct Case {
+    pub name: String,
+    pub json: String,
+    pub material: Material,
+}
+
+pub fn case(json: &str) -> Case {
+    let material = MaterialDesc::from_json(json)
+        .and_then(|d| d.build())
+        .unwrap_or_else(|e| panic!("{json}: {e}"));
+    let name = json
+        .trim_matches(|c| c == '{' || c == '}')
+        .replace(['"', ' '], "")
+        .replace([':', ','], "_")
+        .replace(['[', ']'], "");
+    Case {
+        name,
+        json: json.to_string(),
+        material,
+    }
+}
+
+/// View angles (degrees) of the grid.
+pub const VIEWS: [f64; 5] = [0.0, 30.0, 60.0, 80.0, 89.0];
+
+#[must_use]
+pub fn wo(theta_deg: f64) -> DVec3 {
+    let t = theta_deg.to_radians();
+    // A small azimuth so that anisotropic lobes are not seen along an axis.
+    let phi = 0.3f64;
+    DVec3::new(t.sin() * phi.cos(), t.sin() * phi.sin(), t.cos())
+}
+
+pub const EXPONENTS: [f64; 5] = [1.0, 10.0, 100.0, 1000.0, 10000.0];
+pub const ALPHAS: [f64; 4] = [0.02, 0.1, 0.3, 1.0];
+
+/// Lecture models (Phong, Blinn-Phong) over the exponents, both forms, and
+/// with a diffuse term.
+pub fn phong_family() -> Vec<Case> {
+    let mut v = Vec::new();
+    for model in ["phong", "blinn-phong"] {
+        for n in EXPONENTS {
+            v.push(case(&format!(r#"{{"type":"{model}","exponent":{n}}}"#)));
+        }
+        v.push(case(&format!(
+            r#"{{"type":"{model}","exponent":5,"normalized":false,"ks":0.5}}"#
+        )));
+        v.push(case(&format!(
+            r#"{{"type":"{model}","exponent":40,"ks":0.6,"kd":0.3}}"#
+        )));
+    }
+    v
+}
+
+/// Cook-Torrance over distributions, isotropic alphas and one anisotropic
+/// pair, with one two-lobe material per distribution.
+pub fn microfacet_family() -> Vec<Case> {
+    let mut v = Vec::new();
+    for d in ["ggx", "beckmann", "blinn-phong"] {
+        for a in ALPHAS {
+            v.push(case(&format!(
+                r#"{{"type":"cook-torrance","distribution":"{d}","alpha":{a}}}"#
+            )));
+        }
+        v.push(case(&format!(
+            r#"{{"type":"cook-torrance","distribution":"{d}","alpha_u":0.05,"alpha_v":0.5}}"#
+        )));
+        v.push(case(&format!(
+            r#"{{"type":"cook-torrance","distribution":"{d}","alpha":0.2,"kd":0.4,"fresnel":{{"type":"schlick","f0":0.3}}}}"#
+        )));
+    }
+    v
+}
+
+pub fn lambert_family() -> Vec<Case> {
+    vec![case(r#"{"type":"lambert","albedo":0.7}"#)]
+}
+
+/// Every case of the grid.
+pub fn all_cases() -> Vec<Case> {
+    let mut v = lambert_family();
+    v.extend(phong_family());
+    v.extend(microfacet_family());
+    v
+}
+
+/// The (strategy, view) pairs tested for a material: the material-blind
+/// strategies `uniform` and `cosine` at two views, the others at every view.
+pub fn plan(m: &Material) -> Vec<(Strategy, f64)> {
+    let mut v = Vec::new();
+    for s in m.strategies() {
+        match s {
+            Strategy::Uniform | Strategy::Cosine => v.extend([(s, 0.0), (s, 60.0)]),
+            _ => v.extend(VIEWS.iter().map(|&t| (s, t))),
+        }
+    }
+    v
+}
+
+/// Number of tests in the whole chi-square grid (for the Šidák correction).
+pub fn grid_size() -> usize {
+    all_cases().iter().map(|c| plan(&c.material).len()).sum()
+}
