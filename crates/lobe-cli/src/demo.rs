@@ -5,7 +5,7 @@
 //! prints how far each lands from the quadrature reference.
 
 use glam::DVec3;
-use lobe::estimator::{estimate, reference};
+use lobe::estimator::{estimate, reference, Plan};
 use lobe::math::luminance;
 use lobe::{Light, MaterialDesc, Rgb, Strategy};
 
@@ -51,7 +51,7 @@ pub fn run(quiet: bool) -> anyhow::Result<()> {
             let mut var = 0.0;
             let mut first = 0.0;
             for run in 0..RUNS {
-                let acc = estimate(&m, s, wo, &light, SAMPLES, run);
+                let acc = estimate(&m, wo, &light, &Plan::independent(s, SAMPLES, run));
                 let e = luminance(acc.mean());
                 if run == 0 {
                     first = e;

@@ -4,8 +4,14 @@
 //! `lobe: error: <message>` on stderr and exit code 1 (clap's own usage
 //! errors exit 2).
 
+mod common;
+mod converge;
 mod demo;
+mod estimate;
 mod eval;
+mod figures;
+mod plot;
+mod report;
 
 use clap::{Args, Parser, Subcommand};
 use std::process::ExitCode;
@@ -29,6 +35,10 @@ struct Cli {
 enum Command {
     Demo(DemoArgs),
     Eval(eval::EvalArgs),
+    Estimate(estimate::EstimateArgs),
+    Converge(converge::ConvergeArgs),
+    Plot(plot::PlotArgs),
+    Report(report::ReportArgs),
 }
 
 /// The arguments of `lobe demo`.
@@ -48,6 +58,10 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Demo(args) => demo::run(args.quiet),
         Command::Eval(args) => eval::run(&args),
+        Command::Estimate(args) => estimate::run(&args),
+        Command::Converge(args) => converge::run(&args),
+        Command::Plot(args) => plot::run(&args),
+        Command::Report(args) => report::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

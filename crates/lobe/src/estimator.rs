@@ -11,9 +11,9 @@ use crate::light::Light;
 use crate::math::{Rgb, luminance};
 use crate::stats::quadrature::{Tolerance, integrate_hemisphere};
 use crate::stats::ttest::Moments;
+use crate::sequence::{self, Sequence};
 use crate::{Material, Strategy};
 use glam::{DVec2, DVec3};
-use rand::RngExt;
 use rand_pcg::Pcg64;
 
 /// Samples per chunk: the unit of work and of random streams.
@@ -87,41 +87,52 @@ pub fn sample_value(m: &Material, s: Strategy, wo: DVec3, light: &Light, uc: f64
     }
 }
 
-/// Estimate with `n` independent samples, chunk by chunk, in order.
+/// What one estimate is: a strategy, a sequence, a sample count and a seed.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Plan {
+    pub strategy: Strategy,
+    pub sequence: Sequence,
+    pub samples: usize,
+    pub seed: u64,
+}
+
+impl Plan {
+    /// `samples` independent samples with `seed`.
+    #[must_use]
+    pub fn independent(strategy: Strategy, samples: usize, seed: u64) -> Self {
+        Plan { strategy, sequence: Sequence::Independent, samples, seed }
+    }
+
+    /// Number of chunks of [`CHUNK`] samples.
+    #[must_use]
+    pub fn chunks(&self) -> usize {
+        self.samples.div_ceil(CHUNK)
+    }
+}
+
+/// Estimate chunk by chunk, in order, on this thread. A caller with threads
+/// runs [`estimate_chunk`] for every chunk and merges them in chunk order,
+/// which gives the same numbers.
 #[must_use]
-pub fn estimate(
-    m: &Material,
-    s: Strategy,
-    wo: DVec3,
-    light: &Light,
-    n: usize,
-    seed: u64,
-) -> Accumulator {
+pub fn estimate(m: &Material, wo: DVec3, light: &Light, plan: &Plan) -> Accumulator {
     let mut acc = Accumulator::default();
-    for chunk in 0..n.div_ceil(CHUNK) {
-        acc.merge(&estimate_chunk(m, s, wo, light, n, seed, chunk));
+    for chunk in 0..plan.chunks() {
+        acc.merge(&estimate_chunk(m, wo, light, plan, chunk));
     }
     acc
 }
 
-/// The samples of chunk `chunk` of an `n`-sample estimate.
+/// The samples of chunk `chunk` of an estimate.
 #[must_use]
-pub fn estimate_chunk(
-    m: &Material,
-    s: Strategy,
-    wo: DVec3,
-    light: &Light,
-    n: usize,
-    seed: u64,
-    chunk: usize,
-) -> Accumulator {
-    let mut rng = chunk_rng(seed, chunk);
+pub fn estimate_chunk(m: &Material, wo: DVec3, light: &Light, plan: &Plan, chunk: usize) -> Accumulator {
+    let first = chunk * CHUNK;
+    let len = CHUNK.min(plan.samples.saturating_sub(first));
+    let mut points = [[0.0; 3]; CHUNK];
+    let points = &mut points[..len];
+    sequence::fill(plan.sequence, plan.seed, plan.samples, chunk, first, points);
     let mut acc = Accumulator::default();
-    let len = CHUNK.min(n.saturating_sub(chunk * CHUNK));
-    for _ in 0..len {
-        let uc: f64 = rng.random();
-        let u = DVec2::new(rng.random(), rng.random());
-        acc.push(sample_value(m, s, wo, light, uc, u));
+    for p in points.iter() {
+        acc.push(sample_value(m, plan.strategy, wo, light, p[0], DVec2::new(p[1], p[2])));
     }
     acc
 }

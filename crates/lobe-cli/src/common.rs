@@ -1,0 +1,161 @@
+//! Pieces shared by the commands: view and light arguments, progress bars,
+//! and the multi-threaded estimate that gives the same numbers whatever the
+//! thread count.
+
+use anyhow::{Result, anyhow, bail};
+use clap::Args;
+use glam::DVec3;
+use indicatif::{ProgressBar, ProgressStyle};
+use lobe::estimator::{Accumulator, Plan, estimate_chunk};
+use lobe::{Frame, Light, Material, Rgb};
+use rayon::prelude::*;
+
+/// `--theta DEG` or `--wo x,y,z`: the view direction in the local frame.
+#[derive(Args, Debug, Clone)]
+pub struct ViewArgs {
+    /// View angle from the normal in degrees, in [0, 90): wo = (sin θ, 0, cos θ)
+    #[arg(long, conflicts_with = "wo", allow_hyphen_values = true)]
+    pub theta: Option<f64>,
+    /// View direction x,y,z in the local frame (+z is the normal); normalized
+    #[arg(long, allow_hyphen_values = true)]
+    pub wo: Option<String>,
+}
+
+impl ViewArgs {
+    /// The unit view direction; 30° when neither flag is given.
+    pub fn wo(&self) -> Result<DVec3> {
+        if let Some(w) = &self.wo {
+            let v = parse_vec3("--wo", w)?;
+            if v.z <= 0.0 {
+                bail!("--wo {w}: the view direction is below the horizon (z must be > 0 in the local frame)");
+            }
+            return Ok(v.normalize());
+        }
+        let t = self.theta.unwrap_or(30.0);
+        theta_to_wo(t)
+    }
+}
+
+/// `wo = (sin θ, 0, cos θ)` for θ in degrees, refusing θ outside [0, 90).
+pub fn theta_to_wo(theta: f64) -> Result<DVec3> {
+    if !theta.is_finite() || !(0.0..90.0).contains(&theta) {
+        bail!("--theta {theta}: the view angle must be in [0, 90) degrees");
+    }
+    let t = theta.to_radians();
+    Ok(DVec3::new(t.sin(), 0.0, t.cos()))
+}
+
+/// Parse `x,y,z` into a non-zero finite vector.
+pub fn parse_vec3(flag: &str, s: &str) -> Result<DVec3> {
+    let parts: Vec<&str> = s.split(',').map(str::trim).collect();
+    if parts.len() != 3 {
+        bail!("{flag} {s}: expected three numbers x,y,z");
+    }
+    let mut v = [0.0; 3];
+    for (slot, p) in v.iter_mut().zip(&parts) {
+        *slot = p.parse::<f64>().map_err(|_| anyhow!("{flag} {s}: `{p}` is not a number"))?;
+        if !slot.is_finite() {
+            bail!("{flag} {s}: `{p}` is not a finite number");
+        }
+    }
+    let v = DVec3::from_array(v);
+    if v.length_squared() == 0.0 {
+        bail!("{flag} {s}: the zero vector has no direction");
+    }
+    Ok(v)
+}
+
+/// `--light`, `--normal`, `--tangent`: incident light at the shading point.
+#[derive(Args, Debug, Clone)]
+pub struct LightArgs {
+    /// Lighting: `constant[:VALUE]` (the furnace, default 1), or
+    /// `lobe[:K[:X,Y,Z[:VALUE]]]`, radiance VALUE·max(0, ω·d)^K toward the
+    /// world direction d (default K = 8, d = 0,1,0.5 normalized, VALUE = 1)
+    #[arg(long, default_value = "constant", allow_hyphen_values = true)]
+    pub light: String,
+    /// World-space normal: local z
+    #[arg(long, default_value = "0,1,0", allow_hyphen_values = true)]
+    pub normal: String,
+    /// World-space tangent: local x (local y = normal × tangent)
+    #[arg(long, default_value = "1,0,0", allow_hyphen_values = true)]
+    pub tangent: String,
+}
+
+impl LightArgs {
+    pub fn frame(&self) -> Result<Frame> {
+        let n = parse_vec3("--normal", &self.normal)?;
+        let t = parse_vec3("--tangent", &self.tangent)?;
+        Frame::from_normal_tangent(n, t).ok_or_else(|| anyhow!("--tangent {} is parallel to --normal {}", self.tangent, self.normal))
+    }
+
+    /// The light in the local frame.
+    pub fn light(&self) -> Result<Light> {
+        parse_light(&self.light, &self.frame()?)
+    }
+}
+
+/// Parse a light description (see [`LightArgs`]) into the local `frame`.
+pub fn parse_light(spec: &str, frame: &Frame) -> Result<Light> {
+    let mut parts = spec.split(':');
+    let kind = parts.next().unwrap_or_default();
+    let number = |what: &str, s: &str| -> Result<f64> {
+        let v: f64 = s.parse().map_err(|_| anyhow!("--light {spec}: {what} `{s}` is not a number"))?;
+        if !v.is_finite() || v < 0.0 {
+            bail!("--light {spec}: {what} must be a finite number >= 0");
+        }
+        Ok(v)
+    };
+    match kind {
+        "constant" => {
+            let v = parts.next().map_or(Ok(1.0), |s| number("value", s))?;
+            if parts.next().is_some() {
+                bail!("--light {spec}: expected constant[:VALUE]");
+            }
+            Ok(Light::Constant(Rgb::splat(v)))
+        }
+        "lobe" => {
+            let k = parts.next().map_or(Ok(8.0), |s| number("exponent K", s))?;
+            let d = parts.next().map_or(Ok(DVec3::new(0.0, 1.0, 0.5)), |s| parse_vec3("--light direction", s))?;
+            let v = parts.next().map_or(Ok(1.0), |s| number("value", s))?;
+            if parts.next().is_some() {
+                bail!("--light {spec}: expected lobe[:K[:X,Y,Z[:VALUE]]]");
+            }
+            Ok(Light::Lobe { dir: frame.to_local(d.normalize()), exponent: k, radiance: Rgb::splat(v) })
+        }
+        _ => bail!("--light {spec}: unknown light `{kind}`, expected constant[:VALUE] or lobe[:K[:X,Y,Z[:VALUE]]]"),
+    }
+}
+
+/// A progress bar on stderr, hidden with `--quiet` (indicatif hides it by
+/// itself when stderr is not a terminal).
+pub fn progress(len: u64, message: &str, quiet: bool) -> ProgressBar {
+    if quiet {
+        return ProgressBar::hidden();
+    }
+    let pb = ProgressBar::new(len);
+    pb.set_style(
+        ProgressStyle::with_template("{msg:>24} [{bar:40}] {pos}/{len} {elapsed}<{eta}")
+            .expect("progress template is valid")
+            .progress_chars("=> "),
+    );
+    pb.set_message(message.to_string());
+    pb
+}
+
+/// Run an estimate on every thread of rayon's pool, chunk by chunk, and merge
+/// the chunks in order: the same numbers for any thread count.
+pub fn estimate_par(m: &Material, wo: DVec3, light: &Light, plan: &Plan, pb: &ProgressBar) -> Accumulator {
+    let parts: Vec<Accumulator> = (0..plan.chunks())
+        .into_par_iter()
+        .map(|c| {
+            let a = estimate_chunk(m, wo, light, plan, c);
+            pb.inc(a.count() as u64);
+            a
+        })
+        .collect();
+    let mut acc = Accumulator::default();
+    for p in &parts {
+        acc.merge(p);
+    }
+    acc
+}

@@ -1,0 +1,1 @@
+//! Figures: plots rendered with plotters (being written).
