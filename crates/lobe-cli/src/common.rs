@@ -27,7 +27,9 @@ impl ViewArgs {
         if let Some(w) = &self.wo {
             let v = parse_vec3("--wo", w)?;
             if v.z <= 0.0 {
-                bail!("--wo {w}: the view direction is below the horizon (z must be > 0 in the local frame)");
+                bail!(
+                    "--wo {w}: the view direction is below the horizon (z must be > 0 in the local frame)"
+                );
             }
             return Ok(v.normalize());
         }
@@ -53,7 +55,9 @@ pub fn parse_vec3(flag: &str, s: &str) -> Result<DVec3> {
     }
     let mut v = [0.0; 3];
     for (slot, p) in v.iter_mut().zip(&parts) {
-        *slot = p.parse::<f64>().map_err(|_| anyhow!("{flag} {s}: `{p}` is not a number"))?;
+        *slot = p
+            .parse::<f64>()
+            .map_err(|_| anyhow!("{flag} {s}: `{p}` is not a number"))?;
         if !slot.is_finite() {
             bail!("{flag} {s}: `{p}` is not a finite number");
         }
@@ -85,7 +89,13 @@ impl LightArgs {
     pub fn frame(&self) -> Result<Frame> {
         let n = parse_vec3("--normal", &self.normal)?;
         let t = parse_vec3("--tangent", &self.tangent)?;
-        Frame::from_normal_tangent(n, t).ok_or_else(|| anyhow!("--tangent {} is parallel to --normal {}", self.tangent, self.normal))
+        Frame::from_normal_tangent(n, t).ok_or_else(|| {
+            anyhow!(
+                "--tangent {} is parallel to --normal {}",
+                self.tangent,
+                self.normal
+            )
+        })
     }
 
     /// The light in the local frame.
@@ -99,7 +109,9 @@ pub fn parse_light(spec: &str, frame: &Frame) -> Result<Light> {
     let mut parts = spec.split(':');
     let kind = parts.next().unwrap_or_default();
     let number = |what: &str, s: &str| -> Result<f64> {
-        let v: f64 = s.parse().map_err(|_| anyhow!("--light {spec}: {what} `{s}` is not a number"))?;
+        let v: f64 = s
+            .parse()
+            .map_err(|_| anyhow!("--light {spec}: {what} `{s}` is not a number"))?;
         if !v.is_finite() || v < 0.0 {
             bail!("--light {spec}: {what} must be a finite number >= 0");
         }
@@ -115,14 +127,22 @@ pub fn parse_light(spec: &str, frame: &Frame) -> Result<Light> {
         }
         "lobe" => {
             let k = parts.next().map_or(Ok(8.0), |s| number("exponent K", s))?;
-            let d = parts.next().map_or(Ok(DVec3::new(0.0, 1.0, 0.5)), |s| parse_vec3("--light direction", s))?;
+            let d = parts.next().map_or(Ok(DVec3::new(0.0, 1.0, 0.5)), |s| {
+                parse_vec3("--light direction", s)
+            })?;
             let v = parts.next().map_or(Ok(1.0), |s| number("value", s))?;
             if parts.next().is_some() {
                 bail!("--light {spec}: expected lobe[:K[:X,Y,Z[:VALUE]]]");
             }
-            Ok(Light::Lobe { dir: frame.to_local(d.normalize()), exponent: k, radiance: Rgb::splat(v) })
+            Ok(Light::Lobe {
+                dir: frame.to_local(d.normalize()),
+                exponent: k,
+                radiance: Rgb::splat(v),
+            })
         }
-        _ => bail!("--light {spec}: unknown light `{kind}`, expected constant[:VALUE] or lobe[:K[:X,Y,Z[:VALUE]]]"),
+        _ => bail!(
+            "--light {spec}: unknown light `{kind}`, expected constant[:VALUE] or lobe[:K[:X,Y,Z[:VALUE]]]"
+        ),
     }
 }
 
@@ -144,7 +164,13 @@ pub fn progress(len: u64, message: &str, quiet: bool) -> ProgressBar {
 
 /// Run an estimate on every thread of rayon's pool, chunk by chunk, and merge
 /// the chunks in order: the same numbers for any thread count.
-pub fn estimate_par(m: &Material, wo: DVec3, light: &Light, plan: &Plan, pb: &ProgressBar) -> Accumulator {
+pub fn estimate_par(
+    m: &Material,
+    wo: DVec3,
+    light: &Light,
+    plan: &Plan,
+    pb: &ProgressBar,
+) -> Accumulator {
     let parts: Vec<Accumulator> = (0..plan.chunks())
         .into_par_iter()
         .map(|c| {

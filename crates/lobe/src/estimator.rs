@@ -9,9 +9,9 @@
 
 use crate::light::Light;
 use crate::math::{Rgb, luminance};
+use crate::sequence::{self, Sequence};
 use crate::stats::quadrature::{Tolerance, integrate_hemisphere};
 use crate::stats::ttest::Moments;
-use crate::sequence::{self, Sequence};
 use crate::{Material, Strategy};
 use glam::{DVec2, DVec3};
 use rand_pcg::Pcg64;
@@ -100,7 +100,12 @@ impl Plan {
     /// `samples` independent samples with `seed`.
     #[must_use]
     pub fn independent(strategy: Strategy, samples: usize, seed: u64) -> Self {
-        Plan { strategy, sequence: Sequence::Independent, samples, seed }
+        Plan {
+            strategy,
+            sequence: Sequence::Independent,
+            samples,
+            seed,
+        }
     }
 
     /// Number of chunks of [`CHUNK`] samples.
@@ -124,7 +129,13 @@ pub fn estimate(m: &Material, wo: DVec3, light: &Light, plan: &Plan) -> Accumula
 
 /// The samples of chunk `chunk` of an estimate.
 #[must_use]
-pub fn estimate_chunk(m: &Material, wo: DVec3, light: &Light, plan: &Plan, chunk: usize) -> Accumulator {
+pub fn estimate_chunk(
+    m: &Material,
+    wo: DVec3,
+    light: &Light,
+    plan: &Plan,
+    chunk: usize,
+) -> Accumulator {
     let first = chunk * CHUNK;
     let len = CHUNK.min(plan.samples.saturating_sub(first));
     let mut points = [[0.0; 3]; CHUNK];
@@ -132,7 +143,14 @@ pub fn estimate_chunk(m: &Material, wo: DVec3, light: &Light, plan: &Plan, chunk
     sequence::fill(plan.sequence, plan.seed, plan.samples, chunk, first, points);
     let mut acc = Accumulator::default();
     for p in points.iter() {
-        acc.push(sample_value(m, plan.strategy, wo, light, p[0], DVec2::new(p[1], p[2])));
+        acc.push(sample_value(
+            m,
+            plan.strategy,
+            wo,
+            light,
+            p[0],
+            DVec2::new(p[1], p[2]),
+        ));
     }
     acc
 }

@@ -1,0 +1,155 @@
+//! `lobe estimate` end to end: the table and JSON, the same numbers for any
+//! thread count, and one-line errors for bad input.
+
+use std::process::{Command, Output};
+
+fn lobe(args: &[&str], threads: Option<&str>) -> Output {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_lobe"));
+    c.args(args);
+    if let Some(t) = threads {
+        c.env("RAYON_NUM_THREADS", t);
+    }
+    c.output().expect("run lobe")
+}
+
+const GGX: &str = r#"{"type":"cook-torrance","distribution":"ggx","alpha":0.2,"kd":0.1}"#;
+
+fn json(threads: &str, sequence: &str) -> serde_json::Value {
+    let o = lobe(
+        &[
+            "estimate",
+            "--material",
+            GGX,
+            "--theta",
+            "60",
+            "--light",
+            "lobe:8:0.3,1,0.2",
+            "--samples",
+            "100000",
+            "--seed",
+            "7",
+            "--sequence",
+            sequence,
+            "--json",
+            "--quiet",
+        ],
+        Some(threads),
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let mut v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    // Wall time and efficiency are measurements of this run, not results.
+    for row in v["strategies"].as_array_mut().unwrap() {
+        row.as_object_mut().unwrap().remove("time_s");
+        row.as_object_mut().unwrap().remove("efficiency");
+    }
+    v
+}
+
+#[test]
+fn same_seed_same_json_whatever_the_thread_count() {
+    for seq in ["independent", "stratified", "sobol"] {
+        assert_eq!(json("1", seq), json("2", seq), "{seq}");
+    }
+}
+
+#[test]
+fn json_has_every_field_and_estimates_agree_with_the_reference() {
+    let v = json("2", "independent");
+    let r = v["reference"].as_array().unwrap();
+    assert_eq!(r.len(), 3);
+    let names: Vec<&str> = v["strategies"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|s| s["name"].as_str().unwrap())
+        .collect();
+    assert_eq!(
+        names,
+        [
+            "uniform",
+            "cosine",
+            "brdf",
+            "vndf",
+            "spherical-caps",
+            "bounded-vndf"
+        ]
+    );
+    for s in v["strategies"].as_array().unwrap() {
+        for k in [
+            "samples",
+            "mean",
+            "stderr",
+            "variance",
+            "variance_reduction",
+        ] {
+            assert!(s.get(k).is_some(), "missing {k}");
+        }
+        for c in 0..3 {
+            let (m, e, r) = (
+                s["mean"][c].as_f64().unwrap(),
+                s["stderr"][c].as_f64().unwrap(),
+                r[c].as_f64().unwrap(),
+            );
+            assert!((m - r).abs() <= 5.0 * e, "{}: {m} ± {e} vs {r}", s["name"]);
+        }
+    }
+    assert_eq!(
+        v["strategies"][0]["variance_reduction"].as_f64().unwrap(),
+        1.0
+    );
+}
+
+#[test]
+fn the_table_names_the_reference_method() {
+    let o = lobe(
+        &[
+            "estimate",
+            "--material",
+            r#"{"type":"phong","exponent":100}"#,
+            "--theta",
+            "30",
+            "--samples",
+            "4096",
+            "--quiet",
+        ],
+        None,
+    );
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success());
+    assert!(
+        out.contains("quadrature") && out.contains("brdf") && out.contains("uniform"),
+        "{out}"
+    );
+}
+
+#[test]
+fn bad_input_is_one_line_and_non_zero() {
+    let cases: [(&[&str], &str); 8] = [
+        (&["--strategy", "importance"], "unknown strategy"),
+        (&["--strategy", "vndf"], "vndf"),
+        (&["--sequence", "halton"], "sequence"),
+        (&["--samples", "0"], "--samples"),
+        (&["--theta", "90"], "--theta"),
+        (&["--wo", "0,0,-1"], "below the horizon"),
+        (&["--light", "sun"], "--light"),
+        (
+            &["--material", r#"{"type":"phong","exponent":-3}"#],
+            "exponent",
+        ),
+    ];
+    for (extra, expect) in cases {
+        let mut args = vec!["estimate", "--quiet"];
+        if extra[0] != "--material" {
+            args.extend(["--material", r#"{"type":"phong"}"#]);
+        }
+        args.extend_from_slice(extra);
+        let o = lobe(&args, None);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(!o.status.success(), "{args:?} succeeded");
+        assert_eq!(err.trim().lines().count(), 1, "{args:?}: {err}");
+        assert!(
+            err.contains(expect) && !err.contains("panicked"),
+            "{args:?}: {err}"
+        );
+    }
+}
