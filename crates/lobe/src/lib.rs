@@ -34,6 +34,7 @@
 //! ```
 
 pub mod desc;
+pub mod envmap;
 pub mod error;
 pub mod estimator;
 pub mod frame;

@@ -98,10 +98,13 @@ impl Material {
     #[inline]
     #[must_use]
     pub fn glossy_probability(&self, wo: DVec3) -> f64 {
-        let g = dispatch!(&self.glossy, l => l.albedo_hint(wo), return 0.0);
+        if matches!(self.glossy, Glossy::None) {
+            return 0.0;
+        }
         if !self.has_diffuse() {
             return 1.0;
         }
+        let g = dispatch!(&self.glossy, l => l.albedo_hint(wo), return 0.0);
         let d = self.diffuse.albedo_hint(wo);
         if g + d > 0.0 { g / (g + d) } else { 0.5 }
     }
@@ -164,7 +167,14 @@ impl Material {
             Strategy::Uniform => (warp::square_to_uniform_hemisphere(u), LobeKind::Hemisphere),
             Strategy::Cosine => (warp::square_to_cosine_hemisphere(u), LobeKind::Hemisphere),
             _ => {
-                if uc < self.glossy_probability(wo) {
+                let p = self.glossy_probability(wo);
+                if p >= 1.0 {
+                    // One lobe: its own f and pdf, computed with the sample.
+                    let (wi, f, pdf) =
+                        dispatch!(&self.glossy, l => l.sample_eval(strategy, wo, u)?, return None);
+                    return Self::finish(wi, f, pdf, LobeKind::Glossy);
+                }
+                if uc < p {
                     (
                         dispatch!(&self.glossy, l => l.sample(strategy, wo, u)?, return None),
                         LobeKind::Glossy,
@@ -177,11 +187,14 @@ impl Material {
         if wi.z <= 0.0 {
             return None;
         }
-        let pdf = self.pdf(strategy, wo, wi);
-        if !(pdf > 0.0 && pdf.is_finite()) {
+        Self::finish(wi, self.eval(wo, wi), self.pdf(strategy, wo, wi), lobe)
+    }
+
+    #[inline]
+    fn finish(wi: DVec3, f: Rgb, pdf: f64, lobe: LobeKind) -> Option<BsdfSample> {
+        if !(pdf > 0.0 && pdf.is_finite() && wi.z > 0.0) {
             return None;
         }
-        let f = self.eval(wo, wi);
         Some(BsdfSample {
             wi,
             f,

@@ -122,6 +122,10 @@ pub struct Microfacet {
     ndf: Ndf,
     alpha_x: f64,
     alpha_y: f64,
+    /// `1/αx`, `1/αy` and `1/(π αx αy)`, kept for the hot path.
+    inv_ax: f64,
+    inv_ay: f64,
+    inv_pi_axay: f64,
 }
 
 /// Smallest accepted alpha: below it the lobe is a delta that f64 cannot hold.
@@ -153,6 +157,9 @@ impl Microfacet {
             ndf,
             alpha_x,
             alpha_y,
+            inv_ax: 1.0 / alpha_x,
+            inv_ay: 1.0 / alpha_y,
+            inv_pi_axay: INV_PI / (alpha_x * alpha_y),
         })
     }
 
@@ -187,20 +194,20 @@ impl Microfacet {
         if wm.z <= 0.0 {
             return 0.0;
         }
-        let (ax, ay) = (self.alpha_x, self.alpha_y);
         let z2 = wm.z * wm.z;
+        let x = wm.x * self.inv_ax;
+        let y = wm.y * self.inv_ay;
         match self.ndf {
             Ndf::Ggx => {
-                let x = wm.x / ax;
-                let y = wm.y / ay;
                 let s = x * x + y * y + z2;
-                1.0 / (PI * ax * ay * s * s)
+                self.inv_pi_axay / (s * s)
             }
             Ndf::Beckmann => {
-                let x = wm.x / ax;
-                let y = wm.y / ay;
                 let e = (x * x + y * y) / z2;
-                (-e).exp() / (PI * ax * ay * z2 * z2)
+                if e > 700.0 {
+                    return 0.0;
+                }
+                (-e).exp() * self.inv_pi_axay / (z2 * z2)
             }
             Ndf::BlinnPhong => {
                 let (ex, ey) = self.blinn_exponents();
@@ -210,7 +217,7 @@ impl Microfacet {
                 } else {
                     0.5 * (ex + ey)
                 };
-                INV_PI / (ax * ay) * wm.z.powf(e)
+                self.inv_pi_axay * wm.z.powf(e)
             }
         }
     }
@@ -219,16 +226,18 @@ impl Microfacet {
     #[inline]
     #[must_use]
     pub fn lambda(&self, w: DVec3) -> f64 {
+        let (ax, ay) = (w.x * self.alpha_x, w.y * self.alpha_y);
+        let r2 = ax * ax + ay * ay;
         let z2 = w.z * w.z;
-        let a2t2 = (w.x * w.x * self.alpha_x * self.alpha_x
-            + w.y * w.y * self.alpha_y * self.alpha_y)
-            / z2;
-        if !a2t2.is_finite() {
-            return f64::INFINITY;
-        }
         match self.ndf {
-            Ndf::Ggx => 0.5 * ((1.0 + a2t2).sqrt() - 1.0),
+            // Λ = (√(1 + α²tan²θ) − 1)/2 = (‖(αx wx, αy wy, wz)‖/|wz| − 1)/2:
+            // one square root and one division (infinite at the horizon).
+            Ndf::Ggx => 0.5 * ((r2 + z2).sqrt() / w.z.abs() - 1.0),
             Ndf::Beckmann | Ndf::BlinnPhong => {
+                let a2t2 = r2 / z2;
+                if !a2t2.is_finite() {
+                    return f64::INFINITY;
+                }
                 if a2t2 == 0.0 {
                     return 0.0;
                 }
@@ -344,7 +353,7 @@ impl Microfacet {
         // Orthonormal basis around the stretched view direction.
         let len2 = wh.x * wh.x + wh.y * wh.y;
         let t1 = if len2 > 0.0 {
-            DVec3::new(-wh.y, wh.x, 0.0) / len2.sqrt()
+            DVec3::new(-wh.y, wh.x, 0.0) * (1.0 / len2.sqrt())
         } else {
             DVec3::X
         };

@@ -53,6 +53,26 @@ impl CookTorrance {
     }
 }
 
+impl CookTorrance {
+    /// Draw the microfacet normal by `strategy` and reflect: `(wi, wm)`.
+    #[inline]
+    fn sample_wm(&self, strategy: Strategy, wo: DVec3, u: DVec2) -> Option<(DVec3, DVec3)> {
+        let mf = &self.microfacet;
+        let wm = match strategy {
+            Strategy::Vndf => mf.sample_visible(wo, u)?,
+            Strategy::SphericalCaps => mf.sample_visible_caps(wo, u),
+            Strategy::BoundedVndf => mf.sample_visible_bounded(wo, u),
+            _ => mf.sample_wm(u),
+        };
+        if wo.dot(wm) <= 0.0 {
+            return None;
+        }
+        // Reflecting a unit vector about a unit vector keeps it unit to an ulp or two.
+        let wi = reflect(wo, wm);
+        (wi.z > 0.0).then_some((wi, wm))
+    }
+}
+
 impl Lobe for CookTorrance {
     #[inline]
     fn eval(&self, wo: DVec3, wi: DVec3) -> Rgb {
@@ -73,18 +93,34 @@ impl Lobe for CookTorrance {
 
     #[inline]
     fn sample(&self, strategy: Strategy, wo: DVec3, u: DVec2) -> Option<DVec3> {
+        self.sample_wm(strategy, wo, u).map(|(wi, _)| wi)
+    }
+
+    /// The sampled `wm` is the half vector of `wo` and the reflected `wi`,
+    /// so `D(wm)` and `Λ(wo)` serve `f` and the pdf at once.
+    #[inline]
+    fn sample_eval(&self, strategy: Strategy, wo: DVec3, u: DVec2) -> Option<(DVec3, Rgb, f64)> {
+        let (wi, wm) = self.sample_wm(strategy, wo, u)?;
         let mf = &self.microfacet;
-        let wm = match strategy {
-            Strategy::Vndf => mf.sample_visible(wo, u)?,
-            Strategy::SphericalCaps => mf.sample_visible_caps(wo, u),
-            Strategy::BoundedVndf => mf.sample_visible_bounded(wo, u),
-            _ => mf.sample_wm(u),
+        let cos_oh = wo.dot(wm);
+        let d = mf.d(wm);
+        let lo = mf.lambda(wo);
+        let g = match self.shadowing {
+            Shadowing::SmithCorrelated => 1.0 / (1.0 + lo + mf.lambda(wi)),
+            Shadowing::SmithSeparable => mf.g1(wi) / (1.0 + lo),
+            Shadowing::VCavity => mf.g(Shadowing::VCavity, wo, wi, wm),
         };
-        if wo.dot(wm) <= 0.0 {
+        let inv4o = 0.25 / wo.z;
+        let dg = d * g * inv4o / wi.z;
+        let pdf = match strategy {
+            Strategy::Vndf | Strategy::SphericalCaps => d * inv4o / (1.0 + lo),
+            Strategy::BoundedVndf => mf.pdf_reflect_bounded(wo, wi),
+            _ => mf.pdf_wm(wm) * 0.25 / cos_oh,
+        };
+        if !(dg.is_finite() && pdf.is_finite()) {
             return None;
         }
-        let wi = reflect(wo, wm);
-        (wi.z > 0.0).then(|| wi.normalize())
+        Some((wi, self.ks * self.fresnel.eval(cos_oh) * dg, pdf))
     }
 
     #[inline]

@@ -28,6 +28,13 @@ pub trait Lobe {
     fn sample(&self, strategy: Strategy, wo: DVec3, u: DVec2) -> Option<DVec3>;
     /// Density in solid angle of what `sample` returns.
     fn pdf(&self, strategy: Strategy, wo: DVec3, wi: DVec3) -> f64;
+    /// `sample`, and `eval` and `pdf` at the sampled direction, sharing what
+    /// they have in common (a model may override it for speed).
+    #[inline]
+    fn sample_eval(&self, strategy: Strategy, wo: DVec3, u: DVec2) -> Option<(DVec3, Rgb, f64)> {
+        let wi = self.sample(strategy, wo, u)?;
+        Some((wi, self.eval(wo, wi), self.pdf(strategy, wo, wi)))
+    }
     /// An estimate of the lobe's directional albedo (luminance), used to
     /// choose between lobes.
     fn albedo_hint(&self, wo: DVec3) -> f64;

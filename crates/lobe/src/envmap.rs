@@ -1,0 +1,440 @@
+//! Equirectangular environment maps in Mitsuba 3's convention, and their
+//! importance sampling.
+//!
+//! | parameter | meaning |
+//! |---|---|
+//! | texels | `width × height` linear RGB, row 0 at the top (+Y) |
+//! | `scale` | multiplies the radiance |
+//! | `rotation_y` | degrees, a rotation of the map about world +Y |
+//!
+//! World +Y is up. A world direction `d` (after undoing the rotation) maps to
+//! `u = atan2(d.x, −d.z) / (2π)` wrapped into [0, 1) and `v = acos(d.y) / π`;
+//! texel `(i, j)` covers `u ∈ [i, i+1)/width`, `v ∈ [j, j+1)/height`, and the
+//! radiance is constant over it (nearest texel), so that light sampling can be
+//! exactly proportional to it.
+//!
+//! Light sampling picks a texel with probability proportional to its
+//! luminance times its solid angle `(2π/width)(cos θ₀ − cos θ₁)` (the sin θ
+//! weighting of a latitude-longitude map, integrated exactly over the texel),
+//! from a marginal distribution over rows and a conditional one within the
+//! row, then a uniform direction inside the texel. The density in solid angle
+//! is `lum(texel) / Σ lum·Ω`: proportional to the map's luminance.
+
+use crate::math::{Rgb, luminance};
+use glam::{DVec2, DVec3};
+use std::f64::consts::PI;
+
+/// A piecewise-constant 1D distribution over `n` bins.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Distribution1D {
+    /// `cdf[i]` = probability of bins `0..i`; `cdf[n] = 1`.
+    cdf: Vec<f64>,
+    total: f64,
+}
+
+impl Distribution1D {
+    /// From non-negative finite weights. `total()` is their sum; with a zero
+    /// sum every bin has probability 0 and `sample` returns `None`.
+    #[must_use]
+    pub fn new(weights: &[f64]) -> Self {
+        let mut cdf = Vec::with_capacity(weights.len() + 1);
+        let mut acc = 0.0;
+        cdf.push(0.0);
+        for &w in weights {
+            acc += w.max(0.0);
+            cdf.push(acc);
+        }
+        if acc > 0.0 {
+            for c in &mut cdf {
+                *c /= acc;
+            }
+            *cdf.last_mut().expect("non-empty") = 1.0;
+        }
+        Distribution1D { cdf, total: acc }
+    }
+
+    #[must_use]
+    pub fn total(&self) -> f64 {
+        self.total
+    }
+
+    #[must_use]
+    pub fn len(&self) -> usize {
+        self.cdf.len() - 1
+    }
+
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Probability of bin `i`.
+    #[must_use]
+    pub fn prob(&self, i: usize) -> f64 {
+        if self.total > 0.0 {
+            self.cdf[i + 1] - self.cdf[i]
+        } else {
+            0.0
+        }
+    }
+
+    /// A bin and the position of `u` inside it, rescaled to [0, 1).
+    #[must_use]
+    pub fn sample(&self, u: f64) -> Option<(usize, f64)> {
+        if self.total <= 0.0 {
+            return None;
+        }
+        // First bin whose upper edge exceeds u, skipping empty bins.
+        let i = self.cdf.partition_point(|&c| c <= u).clamp(1, self.len()) - 1;
+        let p = self.prob(i);
+        if p <= 0.0 {
+            return None;
+        }
+        let rest = ((u - self.cdf[i]) / p).clamp(0.0, 1.0 - f64::EPSILON / 2.0);
+        Some((i, rest))
+    }
+}
+
+/// An equirectangular environment map with its sampling distribution.
+#[derive(Debug, Clone, PartialEq)]
+pub struct EnvMap {
+    width: usize,
+    height: usize,
+    texels: Vec<Rgb>,
+    scale: f64,
+    /// cos and sin of the rotation about +Y.
+    rot: (f64, f64),
+    rows: Distribution1D,
+    cols: Vec<Distribution1D>,
+    /// Σ lum·Ω over the texels (unscaled).
+    norm: f64,
+}
+
+/// What went wrong building a map.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum EnvMapError {
+    #[error("the map is empty ({width}×{height})")]
+    Empty { width: usize, height: usize },
+    #[error("the map has {got} texels, expected {width}×{height} = {}", width * height)]
+    Size {
+        width: usize,
+        height: usize,
+        got: usize,
+    },
+    #[error("scale {0} must be a finite number >= 0")]
+    Scale(f64),
+    #[error("rotation_y {0} must be a finite number")]
+    Rotation(f64),
+}
+
+impl EnvMap {
+    /// A map from row-major texels, row 0 at the top. Negative or NaN
+    /// channels are clamped to 0; the count of clamped texels is returned
+    /// beside the map so that the caller can warn once.
+    pub fn new(
+        width: usize,
+        height: usize,
+        mut texels: Vec<Rgb>,
+        scale: f64,
+        rotation_y_deg: f64,
+    ) -> Result<(Self, usize), EnvMapError> {
+        if width == 0 || height == 0 {
+            return Err(EnvMapError::Empty { width, height });
+        }
+        if texels.len() != width * height {
+            return Err(EnvMapError::Size {
+                width,
+                height,
+                got: texels.len(),
+            });
+        }
+        if !scale.is_finite() || scale < 0.0 {
+            return Err(EnvMapError::Scale(scale));
+        }
+        if !rotation_y_deg.is_finite() {
+            return Err(EnvMapError::Rotation(rotation_y_deg));
+        }
+        let mut clamped = 0;
+        for t in &mut texels {
+            let ok = t.to_array().map(|c| c >= 0.0 && c.is_finite());
+            if ok.contains(&false) {
+                clamped += 1;
+                *t = Rgb::from_array(
+                    t.to_array()
+                        .map(|c| if c >= 0.0 && c.is_finite() { c } else { 0.0 }),
+                );
+            }
+        }
+        let dphi = 2.0 * PI / width as f64;
+        let mut row_weights = Vec::with_capacity(height);
+        let mut cols = Vec::with_capacity(height);
+        for j in 0..height {
+            let omega = dphi * Self::band(height, j);
+            let w: Vec<f64> = texels[j * width..(j + 1) * width]
+                .iter()
+                .map(|&t| luminance(t) * omega)
+                .collect();
+            let d = Distribution1D::new(&w);
+            row_weights.push(d.total());
+            cols.push(d);
+        }
+        let rows = Distribution1D::new(&row_weights);
+        let norm = rows.total();
+        let r = rotation_y_deg.to_radians();
+        Ok((
+            EnvMap {
+                width,
+                height,
+                texels,
+                scale,
+                rot: (r.cos(), r.sin()),
+                rows,
+                cols,
+                norm,
+            },
+            clamped,
+        ))
+    }
+
+    /// A map of one constant radiance (one texel).
+    #[must_use]
+    pub fn constant(c: Rgb) -> Self {
+        EnvMap::new(1, 1, vec![c], 1.0, 0.0)
+            .expect("a 1×1 map is valid")
+            .0
+    }
+
+    /// `cos θ₀ − cos θ₁` of row `j`.
+    fn band(height: usize, j: usize) -> f64 {
+        let t0 = PI * j as f64 / height as f64;
+        let t1 = PI * (j + 1) as f64 / height as f64;
+        t0.cos() - t1.cos()
+    }
+
+    #[must_use]
+    pub fn size(&self) -> (usize, usize) {
+        (self.width, self.height)
+    }
+
+    #[must_use]
+    pub fn texel(&self, i: usize, j: usize) -> Rgb {
+        self.texels[j * self.width + i] * self.scale
+    }
+
+    /// Map coordinates `(u, v)` of a world direction.
+    #[must_use]
+    pub fn direction_to_uv(&self, d: DVec3) -> DVec2 {
+        let d = self.unrotate(d);
+        let mut u = d.x.atan2(-d.z) / (2.0 * PI);
+        if u < 0.0 {
+            u += 1.0;
+        }
+        if u >= 1.0 {
+            u = 0.0;
+        }
+        DVec2::new(u, crate::math::safe_acos(d.y) / PI)
+    }
+
+    /// The world direction of map coordinates `(u, v)`.
+    #[must_use]
+    pub fn uv_to_direction(&self, uv: DVec2) -> DVec3 {
+        let (st, ct) = (PI * uv.y).sin_cos();
+        let (sp, cp) = (2.0 * PI * uv.x).sin_cos();
+        self.rotate(DVec3::new(st * sp, ct, -st * cp))
+    }
+
+    /// Apply the map's rotation about +Y (map frame → world).
+    fn rotate(&self, d: DVec3) -> DVec3 {
+        let (c, s) = self.rot;
+        DVec3::new(c * d.x + s * d.z, d.y, -s * d.x + c * d.z)
+    }
+
+    fn unrotate(&self, d: DVec3) -> DVec3 {
+        let (c, s) = self.rot;
+        DVec3::new(c * d.x - s * d.z, d.y, s * d.x + c * d.z)
+    }
+
+    fn texel_index(&self, d: DVec3) -> (usize, usize) {
+        let uv = self.direction_to_uv(d);
+        let i = ((uv.x * self.width as f64) as usize).min(self.width - 1);
+        let j = ((uv.y * self.height as f64) as usize).min(self.height - 1);
+        (i, j)
+    }
+
+    /// Radiance arriving from world direction `d` (unit).
+    #[inline]
+    #[must_use]
+    pub fn eval(&self, d: DVec3) -> Rgb {
+        let (i, j) = self.texel_index(d);
+        self.texel(i, j)
+    }
+
+    /// Draw a world direction with density ∝ luminance; `None` for a black map.
+    #[must_use]
+    pub fn sample(&self, u: DVec2) -> Option<(DVec3, f64)> {
+        let (j, ru) = self.rows.sample(u.x)?;
+        let (i, rv) = self.cols[j].sample(u.y)?;
+        // Uniform in solid angle inside the texel: uniform in cos θ and φ.
+        let t0 = PI * j as f64 / self.height as f64;
+        let t1 = PI * (j + 1) as f64 / self.height as f64;
+        let (c0, c1) = (t0.cos(), t1.cos());
+        let ct = c0 + (c1 - c0) * ru;
+        let v = crate::math::safe_acos(ct) / PI;
+        let uu = (i as f64 + rv) / self.width as f64;
+        let d = self.uv_to_direction(DVec2::new(uu, v.clamp(t0 / PI, t1 / PI)));
+        let pdf = self.pdf(d);
+        (pdf > 0.0).then_some((d, pdf))
+    }
+
+    /// Density in solid angle of [`EnvMap::sample`] at world direction `d`.
+    #[inline]
+    #[must_use]
+    pub fn pdf(&self, d: DVec3) -> f64 {
+        if self.norm <= 0.0 {
+            return 0.0;
+        }
+        let (i, j) = self.texel_index(d);
+        luminance(self.texels[j * self.width + i]) / self.norm
+    }
+
+    /// The solid-angle region of texel `(i, j)`: `(θ₀, θ₁)`, `(φ₀, φ₁)` in the
+    /// map's own frame, where `φ = 2πu`.
+    #[must_use]
+    pub fn texel_region(&self, i: usize, j: usize) -> ((f64, f64), (f64, f64)) {
+        let h = self.height as f64;
+        let w = self.width as f64;
+        (
+            (PI * j as f64 / h, PI * (j + 1) as f64 / h),
+            (2.0 * PI * i as f64 / w, 2.0 * PI * (i + 1) as f64 / w),
+        )
+    }
+
+    /// World direction of map-frame spherical coordinates `(θ, φ)`.
+    #[must_use]
+    pub fn spherical_to_direction(&self, theta: f64, phi: f64) -> DVec3 {
+        self.uv_to_direction(DVec2::new(phi / (2.0 * PI), theta / PI))
+    }
+
+    /// A procedural sky with a sun, the embedded default: a blue gradient
+    /// above the horizon, a dim ground, and a small bright sun at elevation
+    /// `sun_elevation_deg` toward azimuth `sun_azimuth_deg` (degrees; 0 is −Z).
+    #[must_use]
+    pub fn sky(width: usize, height: usize, sun_elevation_deg: f64, sun_azimuth_deg: f64) -> Self {
+        let (el, az) = (sun_elevation_deg.to_radians(), sun_azimuth_deg.to_radians());
+        let sun = DVec3::new(el.cos() * az.sin(), el.sin(), -el.cos() * az.cos());
+        let sun_cos = (0.5f64).to_radians().cos(); // a disc of 0.5° radius
+        let mut tex = Vec::with_capacity(width * height);
+        let probe = EnvMap::constant(Rgb::ONE);
+        for j in 0..height {
+            for i in 0..width {
+                let d = probe.uv_to_direction(DVec2::new(
+                    (i as f64 + 0.5) / width as f64,
+                    (j as f64 + 0.5) / height as f64,
+                ));
+                let c = if d.y > 0.0 {
+                    let t = d.y.powf(0.4);
+                    Rgb::new(0.9, 0.95, 1.0) * (1.0 - t) + Rgb::new(0.25, 0.45, 0.95) * t
+                } else {
+                    Rgb::new(0.25, 0.22, 0.2) * (1.0 + d.y).max(0.2)
+                };
+                let glow = (d.dot(sun).max(0.0)).powf(64.0) * Rgb::new(2.0, 1.6, 1.0);
+                let disc = if d.dot(sun) > sun_cos {
+                    Rgb::new(3000.0, 2700.0, 2300.0)
+                } else {
+                    Rgb::ZERO
+                };
+                tex.push(c + glow + disc);
+            }
+        }
+        EnvMap::new(width, height, tex, 1.0, 0.0)
+            .expect("the sky is a valid map")
+            .0
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn mitsuba_convention() {
+        let m = EnvMap::constant(Rgb::ONE);
+        // +Y is v = 0; -Z is u = 0; +X is u = 1/4.
+        assert!(m.direction_to_uv(DVec3::Y).y.abs() < 1e-12);
+        assert!((m.direction_to_uv(-DVec3::Y).y - 1.0).abs() < 1e-12);
+        let uv = m.direction_to_uv(-DVec3::Z);
+        assert!(uv.x.abs() < 1e-12 && (uv.y - 0.5).abs() < 1e-12);
+        assert!((m.direction_to_uv(DVec3::X).x - 0.25).abs() < 1e-12);
+        assert!((m.direction_to_uv(DVec3::Z).x - 0.5).abs() < 1e-12);
+        for &(u, v) in &[(0.1, 0.2), (0.7, 0.9), (0.5, 0.5)] {
+            let d = m.uv_to_direction(DVec2::new(u, v));
+            let back = m.direction_to_uv(d);
+            assert!((back - DVec2::new(u, v)).length() < 1e-12);
+        }
+    }
+
+    #[test]
+    fn rotation_turns_the_map_about_y() {
+        let (m, _) = EnvMap::new(
+            4,
+            2,
+            (0..8).map(|k| Rgb::splat(k as f64)).collect(),
+            1.0,
+            90.0,
+        )
+        .unwrap();
+        // Rotating by 90° moves what was at -Z (u = 0) to -X... (R_y(90°) maps -Z to -X).
+        let plain = EnvMap::new(
+            4,
+            2,
+            (0..8).map(|k| Rgb::splat(k as f64)).collect(),
+            1.0,
+            0.0,
+        )
+        .unwrap()
+        .0;
+        let d = DVec3::new(0.0, 0.3, -1.0).normalize();
+        let rd = DVec3::new(-d.z * 1.0, d.y, d.x).normalize(); // R_y(90°) d: (x,z) -> (z, -x)
+        assert_eq!(m.eval(DVec3::new(d.z, d.y, -d.x)), plain.eval(d), "{rd}");
+    }
+
+    #[test]
+    fn negative_and_nan_texels_are_clamped_and_counted() {
+        let (m, n) = EnvMap::new(
+            2,
+            1,
+            vec![Rgb::new(-1.0, 0.5, f64::NAN), Rgb::ONE],
+            1.0,
+            0.0,
+        )
+        .unwrap();
+        assert_eq!(n, 1);
+        assert_eq!(m.texel(0, 0), Rgb::new(0.0, 0.5, 0.0));
+    }
+
+    #[test]
+    fn bad_maps_are_refused() {
+        assert!(EnvMap::new(0, 1, vec![], 1.0, 0.0).is_err());
+        assert!(EnvMap::new(2, 2, vec![Rgb::ONE; 3], 1.0, 0.0).is_err());
+        assert!(EnvMap::new(1, 1, vec![Rgb::ONE], f64::NAN, 0.0).is_err());
+        assert!(EnvMap::new(1, 1, vec![Rgb::ONE], 1.0, f64::INFINITY).is_err());
+    }
+
+    #[test]
+    fn sampled_pdf_matches_pdf_and_black_maps_fail() {
+        let m = EnvMap::sky(64, 32, 30.0, 40.0);
+        for k in 0..1000 {
+            let u = DVec2::new(
+                (k as f64 * 0.618_033_988_7) % 1.0,
+                (k as f64 * 0.414_213_562) % 1.0,
+            );
+            let (d, p) = m.sample(u).unwrap();
+            assert!((p - m.pdf(d)).abs() <= 1e-9 * p);
+        }
+        assert!(
+            EnvMap::constant(Rgb::ZERO)
+                .sample(DVec2::splat(0.5))
+                .is_none()
+        );
+    }
+}
