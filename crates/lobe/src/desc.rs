@@ -143,7 +143,15 @@ pub const MODEL_NAMES: &str = "lambert, phong, blinn-phong, cook-torrance";
 impl MaterialDesc {
     /// Parse a JSON object; the error names the line, column and field.
     pub fn from_json(text: &str) -> Result<Self, Error> {
-        serde_json::from_str(text).map_err(|e| Error::Parse(format!("material: {e}")))
+        let de = &mut serde_json::Deserializer::from_str(text);
+        serde_path_to_error::deserialize(de).map_err(|e| {
+            let path = e.path().to_string();
+            if path == "." {
+                Error::Parse(format!("material: {}", e.inner()))
+            } else {
+                Error::Parse(format!("material: field `{path}`: {}", e.inner()))
+            }
+        })
     }
 
     /// A description with only the `type` set (every other key at its default).

@@ -138,8 +138,9 @@ mod tests {
     #[test]
     fn cos_power_keeps_precision_for_huge_exponents() {
         let w = square_to_cos_power(DVec2::new(0.5, 0.0), 1e7);
-        // cos θ = 0.5^(1e-7): sin²θ = 1 - 0.5^(2e-7) ≈ 2e-7 ln 2.
-        let expect = (2e-7 * std::f64::consts::LN_2).sqrt();
+        // cos θ = 0.5^(1/(n+1)) = e^l with l = −ln2/(n+1): sin²θ = 1 − e^{2l} = −2l − 2l² − …
+        let l = -std::f64::consts::LN_2 / (1e7 + 1.0);
+        let expect = (-2.0 * l - 2.0 * l * l).sqrt();
         assert!(
             (w.x - expect).abs() < 1e-9 * expect,
             "{} vs {}",
