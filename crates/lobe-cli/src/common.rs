@@ -72,9 +72,11 @@ pub fn parse_vec3(flag: &str, s: &str) -> Result<DVec3> {
 /// `--light`, `--normal`, `--tangent`: incident light at the shading point.
 #[derive(Args, Debug, Clone)]
 pub struct LightArgs {
-    /// Lighting: `constant[:VALUE]` (the furnace, default 1), or
+    /// Lighting: `constant[:VALUE]` (the furnace, default 1);
     /// `lobe[:K[:X,Y,Z[:VALUE]]]`, radiance VALUE·max(0, ω·d)^K toward the
-    /// world direction d (default K = 8, d = 0,1,0.5 normalized, VALUE = 1)
+    /// world direction d (default K = 8, d = 0,1,0.5 normalized, VALUE = 1);
+    /// `sky`, the built-in sky with a sun; or an equirectangular environment
+    /// map FILE.hdr / FILE.exr (Mitsuba's convention, world +Y up)
     #[arg(long, default_value = "constant", allow_hyphen_values = true)]
     pub light: String,
     /// World-space normal: local z
@@ -140,8 +142,20 @@ pub fn parse_light(spec: &str, frame: &Frame) -> Result<Light> {
                 radiance: Rgb::splat(v),
             })
         }
+        _ if spec == "sky" || spec.ends_with(".hdr") || spec.ends_with(".exr") => {
+            let (map, clamped) = lobe_render::load_envmap(std::path::Path::new(spec), 1.0, 0.0)?;
+            if clamped > 0 {
+                eprintln!(
+                    "lobe: warning: {spec}: {clamped} texels had negative or NaN values, clamped to 0"
+                );
+            }
+            Ok(Light::Env {
+                map: std::sync::Arc::new(map),
+                frame: *frame,
+            })
+        }
         _ => bail!(
-            "--light {spec}: unknown light `{kind}`, expected constant[:VALUE] or lobe[:K[:X,Y,Z[:VALUE]]]"
+            "--light {spec}: unknown light `{kind}`, expected constant[:VALUE], lobe[:K[:X,Y,Z[:VALUE]]], sky, or an environment map FILE.hdr / FILE.exr"
         ),
     }
 }

@@ -5,7 +5,7 @@ use crate::common::{LightArgs, ViewArgs, estimate_par, progress};
 use anyhow::{Result, bail};
 use clap::Args;
 use glam::DVec3;
-use lobe::estimator::{Plan, reference};
+use lobe::estimator::{Heuristic, Mis, MisForm, Plan, Technique, reference};
 use lobe::math::luminance;
 use lobe::sequence::Sequence;
 use lobe::{Light, Material, Strategy};
@@ -51,6 +51,14 @@ pub struct EstimateArgs {
     /// Sample sequence: independent, stratified or sobol
     #[arg(long, default_value = "independent")]
     pub sequence: String,
+    /// The BSDF strategy that MIS combines with light sampling (default: vndf
+    /// where the material has it, else brdf)
+    #[arg(long)]
+    pub mis_bsdf: Option<String>,
+    /// Samples per technique for MIS: BSDF,LIGHT (multi-sample: an estimate
+    /// uses both; one-sample: the chance of each)
+    #[arg(long, default_value = "1,1")]
+    pub mis_samples: String,
     /// Print JSON instead of a table
     #[arg(long)]
     pub json: bool,
@@ -86,25 +94,82 @@ pub struct Table {
     pub strategies: Vec<Row>,
 }
 
-/// Parse `all` or a list of strategy names, each checked against the material.
-pub fn parse_strategies(spec: &str, m: &Material) -> Result<Vec<Strategy>> {
+/// The BSDF strategy MIS uses by default: visible normals where the
+/// material has them, else the lecture's `brdf`.
+pub fn best_bsdf_strategy(m: &Material) -> Strategy {
+    if m.check(Strategy::Vndf).is_ok() {
+        Strategy::Vndf
+    } else {
+        Strategy::Brdf
+    }
+}
+
+/// Parse `all` or a list of technique names: the BSDF strategies
+/// (uniform, cosine, brdf, vndf, spherical-caps, bounded-vndf), `light`,
+/// and MIS: `mis` (balance) and `mis-power`, multi-sample, or `mis-one` and
+/// `mis-power-one`, one-sample. Each is checked against the material.
+pub fn parse_techniques(
+    spec: &str,
+    m: &Material,
+    mis_bsdf: Strategy,
+    n_bsdf: u32,
+    n_light: u32,
+) -> Result<Vec<Technique>> {
+    let mis = |h, form| {
+        Technique::Mis(Mis {
+            bsdf: mis_bsdf,
+            heuristic: h,
+            form,
+            n_bsdf,
+            n_light,
+        })
+    };
     if spec == "all" {
-        return Ok(m.strategies());
+        let mut v: Vec<Technique> = m.strategies().into_iter().map(Technique::from).collect();
+        v.extend([
+            Technique::Light,
+            mis(Heuristic::Balance, MisForm::MultiSample),
+            mis(Heuristic::Power, MisForm::MultiSample),
+        ]);
+        return Ok(v);
     }
     let mut v = Vec::new();
     for name in spec.split(',').map(str::trim) {
-        let s: Strategy = name.parse().map_err(|_| {
-            anyhow::anyhow!(
-                "--strategy: unknown strategy `{name}`, expected all or a list of: {}",
-                Strategy::names()
-            )
-        })?;
-        m.check(s).map_err(|e| anyhow::anyhow!("--strategy: {e}"))?;
-        if !v.contains(&s) {
-            v.push(s);
+        let t = match name {
+            "light" => Technique::Light,
+            "mis" => mis(Heuristic::Balance, MisForm::MultiSample),
+            "mis-power" => mis(Heuristic::Power, MisForm::MultiSample),
+            "mis-one" => mis(Heuristic::Balance, MisForm::OneSample),
+            "mis-power-one" => mis(Heuristic::Power, MisForm::OneSample),
+            _ => {
+                let s: Strategy = name.parse().map_err(|_| {
+                    anyhow::anyhow!(
+                        "--strategy: unknown strategy `{name}`, expected all or a list of: {}, light, mis, mis-power, mis-one, mis-power-one",
+                        Strategy::names()
+                    )
+                })?;
+                m.check(s).map_err(|e| anyhow::anyhow!("--strategy: {e}"))?;
+                Technique::Bsdf(s)
+            }
+        };
+        if !v.contains(&t) {
+            v.push(t);
         }
     }
     Ok(v)
+}
+
+/// `B,L`: samples of BSDF and light sampling per MIS estimate.
+pub fn parse_mis_samples(spec: &str) -> Result<(u32, u32)> {
+    let bad =
+        || anyhow::anyhow!("--mis-samples {spec}: expected two counts BSDF,LIGHT, each 1 to 64");
+    let (a, b) = spec.split_once(',').ok_or_else(bad)?;
+    let a: u32 = a.trim().parse().map_err(|_| bad())?;
+    let b: u32 = b.trim().parse().map_err(|_| bad())?;
+    if !(1..=64).contains(&a) || !(1..=64).contains(&b) {
+        return Err(bad());
+    }
+    Ok((a, b))
 }
 
 pub fn parse_sequence(spec: &str) -> Result<Sequence> {
@@ -121,7 +186,7 @@ pub fn run_table(
     m: &Material,
     wo: DVec3,
     light: &Light,
-    strategies: &[Strategy],
+    techniques: &[Technique],
     sequence: Sequence,
     samples: usize,
     seed: u64,
@@ -129,15 +194,16 @@ pub fn run_table(
 ) -> Table {
     let reference = reference(m, wo, light, REFERENCE_TOLERANCE);
     let r_lum = luminance(reference);
-    let mut todo: Vec<Strategy> = strategies.to_vec();
-    if !todo.contains(&Strategy::Uniform) {
-        todo.push(Strategy::Uniform);
+    let uniform = Technique::Bsdf(Strategy::Uniform);
+    let mut todo: Vec<Technique> = techniques.to_vec();
+    if !todo.contains(&uniform) {
+        todo.push(uniform);
     }
     let pb = progress((samples * todo.len()) as u64, "estimating", quiet);
-    let mut rows: Vec<(Strategy, Row)> = Vec::new();
+    let mut rows: Vec<(Technique, Row)> = Vec::new();
     for &s in &todo {
         let plan = Plan {
-            strategy: s,
+            technique: s,
             sequence,
             samples,
             seed,
@@ -155,7 +221,7 @@ pub fn run_table(
         rows.push((
             s,
             Row {
-                name: s.name().to_string(),
+                name: s.name(),
                 samples,
                 mean: mean.to_array(),
                 stderr: acc.std_error().to_array(),
@@ -170,12 +236,12 @@ pub fn run_table(
     pb.finish_and_clear();
     let uniform = rows
         .iter()
-        .find(|(s, _)| *s == Strategy::Uniform)
+        .find(|(s, _)| *s == uniform)
         .map(|(_, r)| r.variance)
         .unwrap_or(f64::NAN);
     let mut out = Vec::new();
     for (s, mut row) in rows {
-        if !strategies.contains(&s) {
+        if !techniques.contains(&s) {
             continue;
         }
         row.variance_reduction = (row.variance > 0.0).then(|| uniform / row.variance);
@@ -196,7 +262,21 @@ pub fn run(args: &EstimateArgs) -> Result<()> {
     if args.samples == 0 {
         bail!("--samples 0: an estimate needs at least one sample");
     }
-    let strategies = parse_strategies(&args.strategy, &m)?;
+    let mis_bsdf = match &args.mis_bsdf {
+        Some(name) => {
+            let s: Strategy = name.parse().map_err(|_| {
+                anyhow::anyhow!(
+                    "--mis-bsdf: unknown strategy `{name}`, expected one of: {}",
+                    Strategy::names()
+                )
+            })?;
+            m.check(s).map_err(|e| anyhow::anyhow!("--mis-bsdf: {e}"))?;
+            s
+        }
+        None => best_bsdf_strategy(&m),
+    };
+    let (n_bsdf, n_light) = parse_mis_samples(&args.mis_samples)?;
+    let strategies = parse_techniques(&args.strategy, &m, mis_bsdf, n_bsdf, n_light)?;
     let sequence = parse_sequence(&args.sequence)?;
     let table = run_table(
         &m,

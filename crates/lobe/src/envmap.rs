@@ -104,10 +104,47 @@ pub struct EnvMap {
     scale: f64,
     /// cos and sin of the rotation about +Y.
     rot: (f64, f64),
+    /// Density ∝ luminance.
+    plain: TexelSampler,
+    /// Density ∝ max(0, luminance − its mean): for MIS with BSDF sampling.
+    compensated: TexelSampler,
+}
+
+/// A piecewise-constant density over the texels: texel weights times their
+/// solid angles, a marginal over rows and a conditional within each row.
+#[derive(Debug, Clone, PartialEq)]
+struct TexelSampler {
+    weights: Vec<f64>,
     rows: Distribution1D,
     cols: Vec<Distribution1D>,
-    /// Σ lum·Ω over the texels (unscaled).
+    /// Σ weight·Ω over the texels.
     norm: f64,
+}
+
+impl TexelSampler {
+    fn new(width: usize, height: usize, weights: Vec<f64>) -> Self {
+        let dphi = 2.0 * PI / width as f64;
+        let mut row_weights = Vec::with_capacity(height);
+        let mut cols = Vec::with_capacity(height);
+        for j in 0..height {
+            let omega = dphi * EnvMap::band(height, j);
+            let w: Vec<f64> = weights[j * width..(j + 1) * width]
+                .iter()
+                .map(|&t| t * omega)
+                .collect();
+            let d = Distribution1D::new(&w);
+            row_weights.push(d.total());
+            cols.push(d);
+        }
+        let rows = Distribution1D::new(&row_weights);
+        let norm = rows.total();
+        TexelSampler {
+            weights,
+            rows,
+            cols,
+            norm,
+        }
+    }
 }
 
 /// What went wrong building a map.
@@ -165,21 +202,16 @@ impl EnvMap {
                 );
             }
         }
-        let dphi = 2.0 * PI / width as f64;
-        let mut row_weights = Vec::with_capacity(height);
-        let mut cols = Vec::with_capacity(height);
-        for j in 0..height {
-            let omega = dphi * Self::band(height, j);
-            let w: Vec<f64> = texels[j * width..(j + 1) * width]
-                .iter()
-                .map(|&t| luminance(t) * omega)
-                .collect();
-            let d = Distribution1D::new(&w);
-            row_weights.push(d.total());
-            cols.push(d);
-        }
-        let rows = Distribution1D::new(&row_weights);
-        let norm = rows.total();
+        let lum: Vec<f64> = texels.iter().map(|&t| luminance(t)).collect();
+        let plain = TexelSampler::new(width, height, lum.clone());
+        // Mean luminance over the sphere, then the part above it.
+        let mean = plain.norm / (4.0 * PI);
+        let above: Vec<f64> = lum.iter().map(|&l| (l - mean).max(0.0)).collect();
+        let compensated = if above.iter().any(|&w| w > 0.0) {
+            TexelSampler::new(width, height, above)
+        } else {
+            plain.clone()
+        };
         let r = rotation_y_deg.to_radians();
         Ok((
             EnvMap {
@@ -188,9 +220,8 @@ impl EnvMap {
                 texels,
                 scale,
                 rot: (r.cos(), r.sin()),
-                rows,
-                cols,
-                norm,
+                plain,
+                compensated,
             },
             clamped,
         ))
@@ -272,8 +303,35 @@ impl EnvMap {
     /// Draw a world direction with density ∝ luminance; `None` for a black map.
     #[must_use]
     pub fn sample(&self, u: DVec2) -> Option<(DVec3, f64)> {
-        let (j, ru) = self.rows.sample(u.x)?;
-        let (i, rv) = self.cols[j].sample(u.y)?;
+        self.sample_with(&self.plain, u)
+    }
+
+    /// Density in solid angle of [`EnvMap::sample`] at world direction `d`.
+    #[inline]
+    #[must_use]
+    pub fn pdf(&self, d: DVec3) -> f64 {
+        self.pdf_with(&self.plain, d)
+    }
+
+    /// Draw with density ∝ `max(0, lum − mean lum)` (MIS compensation,
+    /// Karlík et al. 2019): where the map is dimmer than its mean, BSDF
+    /// sampling takes over inside MIS. Only for MIS: alone it would miss
+    /// those directions. Falls back to [`EnvMap::sample`] for a uniform map.
+    #[must_use]
+    pub fn sample_compensated(&self, u: DVec2) -> Option<(DVec3, f64)> {
+        self.sample_with(&self.compensated, u)
+    }
+
+    /// Density of [`EnvMap::sample_compensated`].
+    #[inline]
+    #[must_use]
+    pub fn pdf_compensated(&self, d: DVec3) -> f64 {
+        self.pdf_with(&self.compensated, d)
+    }
+
+    fn sample_with(&self, t: &TexelSampler, u: DVec2) -> Option<(DVec3, f64)> {
+        let (j, ru) = t.rows.sample(u.x)?;
+        let (i, rv) = t.cols[j].sample(u.y)?;
         // Uniform in solid angle inside the texel: uniform in cos θ and φ.
         let t0 = PI * j as f64 / self.height as f64;
         let t1 = PI * (j + 1) as f64 / self.height as f64;
@@ -282,19 +340,17 @@ impl EnvMap {
         let v = crate::math::safe_acos(ct) / PI;
         let uu = (i as f64 + rv) / self.width as f64;
         let d = self.uv_to_direction(DVec2::new(uu, v.clamp(t0 / PI, t1 / PI)));
-        let pdf = self.pdf(d);
+        let pdf = self.pdf_with(t, d);
         (pdf > 0.0).then_some((d, pdf))
     }
 
-    /// Density in solid angle of [`EnvMap::sample`] at world direction `d`.
     #[inline]
-    #[must_use]
-    pub fn pdf(&self, d: DVec3) -> f64 {
-        if self.norm <= 0.0 {
+    fn pdf_with(&self, t: &TexelSampler, d: DVec3) -> f64 {
+        if t.norm <= 0.0 {
             return 0.0;
         }
         let (i, j) = self.texel_index(d);
-        luminance(self.texels[j * self.width + i]) / self.norm
+        t.weights[j * self.width + i] / t.norm
     }
 
     /// The solid-angle region of texel `(i, j)`: `(θ₀, θ₁)`, `(φ₀, φ₁)` in the
@@ -322,7 +378,7 @@ impl EnvMap {
     pub fn sky(width: usize, height: usize, sun_elevation_deg: f64, sun_azimuth_deg: f64) -> Self {
         let (el, az) = (sun_elevation_deg.to_radians(), sun_azimuth_deg.to_radians());
         let sun = DVec3::new(el.cos() * az.sin(), el.sin(), -el.cos() * az.cos());
-        let sun_cos = (0.5f64).to_radians().cos(); // a disc of 0.5° radius
+        let sun_cos = 1.0f64.to_radians().cos(); // a disc of 1° radius
         let mut tex = Vec::with_capacity(width * height);
         let probe = EnvMap::constant(Rgb::ONE);
         for j in 0..height {
@@ -339,7 +395,7 @@ impl EnvMap {
                 };
                 let glow = (d.dot(sun).max(0.0)).powf(64.0) * Rgb::new(2.0, 1.6, 1.0);
                 let disc = if d.dot(sun) > sun_cos {
-                    Rgb::new(3000.0, 2700.0, 2300.0)
+                    Rgb::new(9000.0, 8100.0, 6900.0)
                 } else {
                     Rgb::ZERO
                 };

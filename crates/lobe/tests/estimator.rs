@@ -56,7 +56,7 @@ fn every_estimate_is_within_four_standard_errors() {
                             wo,
                             &light,
                             &Plan {
-                                strategy: s,
+                                technique: s.into(),
                                 sequence: seq,
                                 samples: 1 << 16,
                                 seed: count,

@@ -13,7 +13,7 @@
 //! and the statistic `Σ (O − E)² / E` is compared with a chi-square
 //! distribution with `bins − 1` degrees of freedom.
 
-use super::quadrature::{Tolerance, integrate_sphere_region};
+use super::quadrature::{Estimate, Tolerance, integrate_sphere_region};
 use glam::{DVec2, DVec3};
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64;
@@ -31,9 +31,10 @@ const ZERO_PROBABILITY: f64 = 1e-12;
 /// Largest accepted `| |ω| − 1 |` of a sampled direction.
 const UNIT_TOLERANCE: f64 = 1e-6;
 
-/// Per-cell cubature tolerance: about 1e-10 absolute probability.
-fn cell_tolerance() -> Tolerance {
-    Tolerance::new(1e-10, 1e-8).with_max_evals(250_000)
+/// Per-cell cubature tolerance: about 1e-10 absolute probability, with at
+/// most `max_evals` pdf evaluations per cell.
+fn cell_tolerance(max_evals: usize) -> Tolerance {
+    Tolerance::new(1e-10, 1e-8).with_max_evals(max_evals)
 }
 
 /// Settings of [`chi2_test`].
@@ -49,6 +50,11 @@ pub struct Chi2Config {
     pub seed: u64,
     /// Bins expecting fewer counts than this are pooled together.
     pub min_expected: f64,
+    /// Pdf evaluations allowed per cell for its expected count. A pdf with
+    /// discontinuities inside cells (an environment map's texel edges) makes
+    /// the adaptive rule refine along them; a smaller budget keeps it fast at
+    /// a still negligible error.
+    pub max_evals_per_cell: usize,
 }
 
 impl Default for Chi2Config {
@@ -61,6 +67,7 @@ impl Default for Chi2Config {
             samples: 1_000_000,
             seed: 0x5eed_1ab0_c0ff_ee00,
             min_expected: 5.0,
+            max_evals_per_cell: 250_000,
         }
     }
 }
@@ -246,6 +253,46 @@ pub fn chi2_test(
     sample: impl Fn(f64, DVec2) -> Option<DVec3>,
     pdf: impl Fn(DVec3) -> f64,
 ) -> Chi2Result {
+    let bad_pdf: Cell<Option<(DVec3, f64)>> = Cell::new(None);
+    let checked_pdf = |w: DVec3| {
+        let p = pdf(w);
+        if p >= 0.0 && p.is_finite() {
+            p
+        } else {
+            if bad_pdf.get().is_none() {
+                bad_pdf.set(Some((w, p)));
+            }
+            0.0
+        }
+    };
+    let tol = cell_tolerance(cfg.max_evals_per_cell);
+    let mut result = chi2_test_cells(cfg, sample, |z0, z1, p0, p1| {
+        // theta decreases with z.
+        let theta = (z1.clamp(-1.0, 1.0).acos(), z0.clamp(-1.0, 1.0).acos());
+        integrate_sphere_region(checked_pdf, theta, (p0, p1), tol)
+    });
+    if let Some((w, p)) = bad_pdf.get() {
+        let msg = format!("pdf({w}) = {p} is not a finite non-negative number");
+        result.statistic = f64::INFINITY;
+        result.p_value = 0.0;
+        result.message = Some(match result.message.take() {
+            Some(m) => format!("{msg}; {m}"),
+            None => msg,
+        });
+    }
+    result
+}
+
+/// [`chi2_test`] with the probability of each cell given by `cell_probability(z0,
+/// z1, phi0, phi1)` instead of a cubature of a pdf: for samplers whose
+/// cell probabilities are known in closed form (a piecewise-constant
+/// environment map whose texels line up with the cells).
+#[must_use]
+pub fn chi2_test_cells(
+    cfg: &Chi2Config,
+    sample: impl Fn(f64, DVec2) -> Option<DVec3>,
+    mut cell_probability: impl FnMut(f64, f64, f64, f64) -> Estimate,
+) -> Chi2Result {
     let (nz, np) = (cfg.n_z, cfg.n_phi);
     let Some(ncells) = nz.checked_mul(np).filter(|&n| n > 0 && cfg.samples > 0) else {
         return Chi2Result {
@@ -296,31 +343,15 @@ pub fn chi2_test(
         ));
     }
 
-    // Expected counts by cubature of the pdf over each cell.
-    let bad_pdf: Cell<Option<(DVec3, f64)>> = Cell::new(None);
-    let checked_pdf = |w: DVec3| {
-        let p = pdf(w);
-        if p >= 0.0 && p.is_finite() {
-            p
-        } else {
-            if bad_pdf.get().is_none() {
-                bad_pdf.set(Some((w, p)));
-            }
-            0.0
-        }
-    };
-    let tol = cell_tolerance();
+    // Expected counts from each cell's probability.
     let mut expected = vec![0.0; ncells];
     let mut probs = vec![0.0; ncells];
     let mut unconverged = 0usize;
     let mut worst_error: f64 = 0.0;
     for iz in 0..nz {
-        let (z0, z1, _, _) = cfg.cell_bounds(iz, 0);
-        // theta decreases with z.
-        let theta = (z1.clamp(-1.0, 1.0).acos(), z0.clamp(-1.0, 1.0).acos());
         for ip in 0..np {
-            let (_, _, p0, p1) = cfg.cell_bounds(iz, ip);
-            let est = integrate_sphere_region(checked_pdf, theta, (p0, p1), tol);
+            let (z0, z1, p0, p1) = cfg.cell_bounds(iz, ip);
+            let est = cell_probability(z0, z1, p0, p1);
             if !est.converged {
                 unconverged += 1;
                 worst_error = worst_error.max(est.error);
@@ -329,11 +360,6 @@ pub fn chi2_test(
             probs[k] = est.value.max(0.0);
             expected[k] = n * probs[k];
         }
-    }
-    if let Some((w, p)) = bad_pdf.get() {
-        failures.push(format!(
-            "pdf({w}) = {p} is not a finite non-negative number"
-        ));
     }
     if unconverged > 0 {
         notes.push(format!(

@@ -1,0 +1,200 @@
+//! Reading environment maps: Radiance `.hdr` and OpenEXR (scanline or tiled;
+//! uncompressed, RLE, ZIPS, ZIP, PIZ, PXR24, B44, B44A through the `exr`
+//! crate). A compression the reader cannot decode (DWAA, DWAB) is named in
+//! the error. `sky` is the built-in procedural sky.
+
+use glam::DVec3;
+use lobe::envmap::EnvMap;
+use std::path::{Path, PathBuf};
+
+#[derive(Debug, thiserror::Error)]
+pub enum LoadError {
+    #[error("{path}: cannot read the file: {source}")]
+    Io {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("{path}: {message}")]
+    Format { path: PathBuf, message: String },
+    #[error("{path}: {source}")]
+    Map {
+        path: PathBuf,
+        source: lobe::envmap::EnvMapError,
+    },
+}
+
+/// The built-in sky's resolution and sun.
+pub const SKY: (usize, usize, f64, f64) = (512, 256, 35.0, 40.0);
+
+/// Load `path` (`.hdr`, `.exr`, or the word `sky`) as an environment map
+/// with `scale` and a rotation about +Y in degrees. Returns the map and the
+/// number of texels whose negative or NaN channels were clamped to 0.
+pub fn load_envmap(path: &Path, scale: f64, rotation_y: f64) -> Result<(EnvMap, usize), LoadError> {
+    let map_err = |source| LoadError::Map {
+        path: path.to_path_buf(),
+        source,
+    };
+    if path.as_os_str() == "sky" {
+        let sky = EnvMap::sky(SKY.0, SKY.1, SKY.2, SKY.3);
+        let (w, h) = sky.size();
+        let texels = (0..h)
+            .flat_map(|j| (0..w).map(move |i| (i, j)))
+            .map(|(i, j)| sky.texel(i, j))
+            .collect();
+        return EnvMap::new(w, h, texels, scale, rotation_y).map_err(map_err);
+    }
+    let bytes = std::fs::read(path).map_err(|source| LoadError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    let format_err = |message: String| LoadError::Format {
+        path: path.to_path_buf(),
+        message,
+    };
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    let format = match ext.as_deref() {
+        Some("hdr") | Some("pic") => image::ImageFormat::Hdr,
+        Some("exr") => {
+            if let Some(name) = exr_compression(&bytes).map_err(format_err)? {
+                if name == "DWAA" || name == "DWAB" {
+                    return Err(format_err(format!(
+                        "OpenEXR compression {name} is not supported; re-save the file with ZIP, PIZ, RLE or no compression"
+                    )));
+                }
+            }
+            image::ImageFormat::OpenExr
+        }
+        _ => {
+            return Err(format_err(
+                "unknown environment map format: expected a .hdr or .exr file, or `sky`".into(),
+            ));
+        }
+    };
+    let img = image::load_from_memory_with_format(&bytes, format)
+        .map_err(|e| format_err(format!("cannot decode: {e}")))?;
+    let rgb = img.into_rgb32f();
+    let (w, h) = (rgb.width() as usize, rgb.height() as usize);
+    let texels = rgb
+        .pixels()
+        .map(|p| DVec3::new(f64::from(p[0]), f64::from(p[1]), f64::from(p[2])))
+        .collect();
+    EnvMap::new(w, h, texels, scale, rotation_y).map_err(map_err)
+}
+
+/// The `compression` attribute of an OpenEXR header, by name.
+fn exr_compression(bytes: &[u8]) -> Result<Option<&'static str>, String> {
+    if bytes.len() < 8 || bytes[..4] != [0x76, 0x2f, 0x31, 0x01] {
+        return Err("not an OpenEXR file (bad magic number)".into());
+    }
+    let mut at = 8;
+    let read_str = |at: &mut usize| -> Result<String, String> {
+        let end = bytes[*at..]
+            .iter()
+            .position(|&b| b == 0)
+            .ok_or("truncated OpenEXR header")?;
+        let s = String::from_utf8_lossy(&bytes[*at..*at + end]).into_owned();
+        *at += end + 1;
+        Ok(s)
+    };
+    loop {
+        let name = read_str(&mut at)?;
+        if name.is_empty() {
+            return Ok(None);
+        }
+        let _type = read_str(&mut at)?;
+        let size_bytes = bytes.get(at..at + 4).ok_or("truncated OpenEXR header")?;
+        let size = u32::from_le_bytes(size_bytes.try_into().expect("4 bytes")) as usize;
+        at += 4;
+        let value = bytes.get(at..at + size).ok_or("truncated OpenEXR header")?;
+        if name == "compression" {
+            let names = [
+                "none", "RLE", "ZIPS", "ZIP", "PIZ", "PXR24", "B44", "B44A", "DWAA", "DWAB",
+                "HTJ2K",
+            ];
+            return Ok(value
+                .first()
+                .and_then(|&c| names.get(c as usize).copied())
+                .or(Some("unknown")));
+        }
+        at += size;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn tmp(name: &str) -> PathBuf {
+        let d = std::env::temp_dir().join(format!("lobe-render-test-{}", std::process::id()));
+        std::fs::create_dir_all(&d).unwrap();
+        d.join(name)
+    }
+
+    #[test]
+    fn hdr_and_exr_round_trip_and_truncated_files_are_errors() {
+        let (w, h) = (8u32, 4u32);
+        let img =
+            image::Rgb32FImage::from_fn(w, h, |x, y| image::Rgb([x as f32 * 0.5, y as f32, 0.25]));
+        for ext in ["hdr", "exr"] {
+            let p = tmp(&format!("map.{ext}"));
+            image::DynamicImage::ImageRgb32F(img.clone())
+                .save(&p)
+                .unwrap();
+            let (m, clamped) = load_envmap(&p, 2.0, 0.0).unwrap();
+            assert_eq!(clamped, 0);
+            assert_eq!(m.size(), (8, 4));
+            let t = m.texel(3, 2);
+            assert!(
+                (t.x - 3.0).abs() < 0.05 && (t.y - 4.0).abs() < 0.05,
+                "{ext}: {t}"
+            );
+            let bytes = std::fs::read(&p).unwrap();
+            let cut = tmp(&format!("cut.{ext}"));
+            std::fs::write(&cut, &bytes[..bytes.len() / 2]).unwrap();
+            let e = load_envmap(&cut, 1.0, 0.0).unwrap_err().to_string();
+            assert!(e.contains("cut."), "{e}");
+        }
+    }
+
+    #[test]
+    fn dwa_compression_is_named() {
+        // A minimal header with compression = DWAB (9).
+        let mut b = vec![0x76, 0x2f, 0x31, 0x01, 2, 0, 0, 0];
+        b.extend_from_slice(b"compression\0compression\0");
+        b.extend_from_slice(&1u32.to_le_bytes());
+        b.push(9);
+        b.push(0);
+        let p = tmp("dwab.exr");
+        std::fs::write(&p, &b).unwrap();
+        let e = load_envmap(&p, 1.0, 0.0).unwrap_err().to_string();
+        assert!(e.contains("DWAB") && e.contains("dwab.exr"), "{e}");
+    }
+
+    #[test]
+    fn missing_files_and_unknown_formats_name_the_path() {
+        let e = load_envmap(Path::new("/nonexistent/forest.hdr"), 1.0, 0.0)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("/nonexistent/forest.hdr"), "{e}");
+        let p = tmp("map.jpg");
+        std::fs::write(&p, b"x").unwrap();
+        assert!(
+            load_envmap(&p, 1.0, 0.0)
+                .unwrap_err()
+                .to_string()
+                .contains("map.jpg")
+        );
+    }
+
+    #[test]
+    fn the_shared_maps_load_when_present() {
+        let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/envmaps/forest.hdr");
+        if p.exists() {
+            let (m, _) = load_envmap(&p, 1.0, 0.0).unwrap();
+            assert_eq!(m.size(), (1024, 512));
+        }
+    }
+}
