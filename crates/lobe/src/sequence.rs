@@ -19,9 +19,11 @@ use rand::RngExt;
 pub enum Sequence {
     /// Independent uniform numbers from a PCG stream per chunk.
     Independent,
-    /// Jittered: one point per cell of an `m × m` grid over `u` when `N = m²`,
-    /// otherwise Latin hypercube (every 1D projection stratified); `uc` is
-    /// stratified in 1D. Unbiased for every `N`.
+    /// Jittered: one point per cell of an `nx × ny` grid over `u` when `N`
+    /// factors as `nx·ny` with an aspect of at most 4 (every power of two
+    /// does: `2^k × 2^k` or `2^k × 2^(k+1)`), otherwise Latin hypercube (every
+    /// 1D projection stratified); `uc` is stratified in 1D. Unbiased for
+    /// every `N`.
     Stratified,
     /// Owen-scrambled Sobol points, up to 2³² of them.
     Sobol,
@@ -72,18 +74,18 @@ pub fn fill(seq: Sequence, seed: u64, n: usize, chunk: usize, first: usize, out:
         }
         Sequence::Stratified => {
             let mut rng = chunk_rng(seed ^ 0x5354_5241_5449_4659, chunk);
-            let m = (n as f64).sqrt().round() as usize;
-            let square = m * m == n;
+            let (nx, ny) = grid_shape(n);
+            let grid = nx > 0;
             let s = hash64(seed);
             for (k, p) in out.iter_mut().enumerate() {
                 let i = (first + k) as u64;
                 let (j1, j2, j3): (f64, f64, f64) = (rng.random(), rng.random(), rng.random());
                 let nn = n as u64;
                 let uc = (permute(i, nn, s as u32) as f64 + j3) / n as f64;
-                if square {
-                    let (x, y) = (i % m as u64, i / m as u64);
-                    p[1] = (x as f64 + j1) / m as f64;
-                    p[2] = (y as f64 + j2) / m as f64;
+                if grid {
+                    let (x, y) = (i % nx as u64, i / nx as u64);
+                    p[1] = (x as f64 + j1) / nx as f64;
+                    p[2] = (y as f64 + j2) / ny as f64;
                 } else {
                     p[1] = (permute(i, nn, (s >> 32) as u32) as f64 + j1) / n as f64;
                     p[2] = (permute(i, nn, (s >> 16) as u32 ^ 0x9e37) as f64 + j2) / n as f64;
@@ -107,6 +109,21 @@ pub fn fill(seq: Sequence, seed: u64, n: usize, chunk: usize, first: usize, out:
             }
         }
     }
+}
+
+/// `(nx, ny)` with `nx·ny = n`, `nx ≤ ny ≤ 4 nx`, `nx` as large as possible;
+/// `(0, 0)` when `n` has no such factorization.
+#[must_use]
+pub fn grid_shape(n: usize) -> (usize, usize) {
+    let mut nx = (n as f64).sqrt().floor() as usize;
+    while nx > 0 {
+        if n % nx == 0 {
+            let ny = n / nx;
+            return if ny <= 4 * nx { (nx, ny) } else { (0, 0) };
+        }
+        nx -= 1;
+    }
+    (0, 0)
 }
 
 const ONE_MINUS_EPS: f64 = 1.0 - f64::EPSILON / 2.0;
@@ -289,7 +306,7 @@ mod tests {
 
     #[test]
     fn stratified_points_are_stratified() {
-        for n in [1024usize, 1000] {
+        for n in [1024usize, 997] {
             let mut out = vec![[0.0; 3]; n];
             fill(Sequence::Stratified, 3, n, 0, 0, &mut out);
             for d in 0..3 {
@@ -304,13 +321,18 @@ mod tests {
                 }
             }
         }
-        let mut out = vec![[0.0; 3]; 1024];
-        fill(Sequence::Stratified, 3, 1024, 0, 0, &mut out);
-        let mut seen = [false; 1024];
-        for p in &out {
-            let c = (p[1] * 32.0) as usize * 32 + (p[2] * 32.0) as usize;
-            assert!(!seen[c]);
-            seen[c] = true;
+        for (n, nx, ny) in [(1024, 32, 32), (2048, 32, 64)] {
+            assert_eq!(grid_shape(n), (nx, ny));
+            let mut out = vec![[0.0; 3]; n];
+            fill(Sequence::Stratified, 3, n, 0, 0, &mut out);
+            let mut seen = vec![false; n];
+            for p in &out {
+                let c = (p[1] * nx as f64) as usize * ny + (p[2] * ny as f64) as usize;
+                assert!(!seen[c]);
+                seen[c] = true;
+            }
         }
+        assert_eq!(grid_shape(1000), (25, 40));
+        assert_eq!(grid_shape(997), (0, 0));
     }
 }
