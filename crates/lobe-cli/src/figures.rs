@@ -1,1 +1,1739 @@
-//! Figures: plots rendered with plotters (being written).
+//! Figures drawn with plotters: convergence plots, polar plots of a BRDF,
+//! warp-test histograms and sample-weight heat maps.
+//!
+//! Every function writes one file and chooses the format from its extension:
+//! `.png` (a bitmap at a size meant to be read on screen) or `.svg`. The text
+//! is drawn with DejaVu Sans, embedded in the binary, so no font has to be
+//! installed where the figures are made.
+//!
+//! Heat maps are drawn over the *projected hemisphere*: the unit disk of the
+//! `(x, y)` coordinates of `wi` in the local frame (`+z` is the normal), `x`
+//! to the right and `y` up. With `wo = (sin θo, 0, cos θo)` the viewer is on
+//! the right and the mirror direction on the left.
+
+use anyhow::{Result, anyhow, bail};
+use glam::{DVec2, DVec3};
+use lobe::math::luminance;
+use lobe::{Material, Strategy};
+use plotters::coord::Shift;
+use plotters::coord::ranged1d::{DefaultFormatting, KeyPointHint, Ranged};
+use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
+use rand::{RngExt, SeedableRng};
+use rand_pcg::Pcg64;
+use rayon::prelude::*;
+use std::path::Path;
+use std::sync::OnceLock;
+
+/// Size in pixels of a line plot (convergence).
+pub const LINE_SIZE: (u32, u32) = (800, 500);
+/// Size in pixels of a polar plot.
+pub const POLAR_SIZE: (u32, u32) = (800, 500);
+/// Size in pixels of a warp-test histogram (two maps side by side).
+pub const HISTOGRAM_SIZE: (u32, u32) = (800, 400);
+/// Size in pixels of a sample-weight heat map.
+pub const WEIGHTS_SIZE: (u32, u32) = (640, 600);
+
+/// Significance level of the pass/fail word of [`warp_histogram`]: the test
+/// passes when `p_value > PASS_LEVEL` (Nori's warp test uses 1 %).
+pub const PASS_LEVEL: f64 = 0.01;
+
+/// The font family every figure uses; DejaVu Sans is registered under it.
+const FONT: &str = "sans-serif";
+static FONT_BYTES: &[u8] = include_bytes!("../assets/DejaVuSans.ttf");
+
+// ---------------------------------------------------------------------------
+// Public API
+// ---------------------------------------------------------------------------
+
+/// One curve of a convergence plot.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Series {
+    /// Legend text, e.g. the strategy name.
+    pub label: String,
+    /// `(N, RMSE)` pairs. Points with `N ≤ 0` or `RMSE ≤ 0` (or not finite)
+    /// cannot go on log axes and are left out.
+    pub points: Vec<(f64, f64)>,
+    /// Fitted slope of `log RMSE` against `log N` (−1/2 for a Monte Carlo
+    /// estimator with finite variance), shown in the legend when given.
+    pub slope: Option<f64>,
+}
+
+/// Draws RMSE against the number of samples on log-log axes (`log₂ N` on x,
+/// `log₁₀ RMSE` on y): one coloured line with markers per series, a legend
+/// with each label and its fitted slope, and a dashed reference line of
+/// slope −1/2 through the first point of the first series.
+///
+/// Writes an SVG if `path` ends in `.svg`, a PNG (800×500) if it ends in
+/// `.png`. Series without any plottable point (e.g. RMSE = 0 everywhere, as
+/// for a zero-variance estimator) are listed in the legend as not shown.
+///
+/// # Errors
+///
+/// An unknown extension, or the file cannot be written.
+pub fn convergence_plot(path: &Path, title: &str, series: &[Series]) -> Result<()> {
+    render(path, &Convergence { title, series })
+}
+
+/// Draws a polar plot of a BRDF in the plane of incidence: the upper half
+/// disk, the angle θi measured from the normal (straight up), negative angles
+/// on the viewer's side (left), positive on the mirror side (right). Each
+/// curve is `(label, [(θi in radians in [−π/2, π/2], value)])`; the radius is
+/// the value divided by the maximum over all curves, as a caption says.
+/// Negative or non-finite values are drawn as zero.
+///
+/// Writes an SVG if `path` ends in `.svg`, a PNG (800×500) if `.png`.
+///
+/// # Errors
+///
+/// An unknown extension, or the file cannot be written.
+#[allow(dead_code)] // the API the figures were specified with; callers use polar_plot_scaled
+pub fn polar_plot(path: &Path, title: &str, curves: &[(String, Vec<(f64, f64)>)]) -> Result<()> {
+    polar_plot_scaled(path, title, curves, PolarScale::Global)
+}
+
+/// How [`polar_plot_scaled`] turns values into radii.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PolarScale {
+    /// Every curve divided by the maximum over all curves: the curves
+    /// compare in size.
+    Global,
+    /// Every curve divided by its own maximum: every lobe's shape is
+    /// visible even when one curve is far larger (f_r at grazing angles).
+    PerCurve,
+}
+
+/// [`polar_plot`] with a choice of normalization. Either way the legend
+/// gives each curve's maximum and the caption says how radii were scaled.
+///
+/// # Errors
+///
+/// An unknown extension, or the file cannot be written.
+pub fn polar_plot_scaled(
+    path: &Path,
+    title: &str,
+    curves: &[(String, Vec<(f64, f64)>)],
+    scale: PolarScale,
+) -> Result<()> {
+    render(
+        path,
+        &Polar {
+            title,
+            curves,
+            scale,
+        },
+    )
+}
+
+/// Draws Nori's warp-test picture: the observed and the expected sample
+/// counts over the projected hemisphere as two square heat maps side by
+/// side, on the same linear colour scale (with a colour bar), and the
+/// chi-square `p_value` with the word PASS or FAIL (`p > PASS_LEVEL`)
+/// appended to `title`.
+///
+/// `observed` and `expected` are `res × res` grids laid out as
+/// [`projected_histograms`] returns them.
+///
+/// Writes an SVG if `path` ends in `.svg`, a PNG (800×400) if `.png`.
+///
+/// # Errors
+///
+/// `res == 0`, grids whose length is not `res²`, an unknown extension, or
+/// the file cannot be written.
+pub fn warp_histogram(
+    path: &Path,
+    title: &str,
+    observed: &[f64],
+    expected: &[f64],
+    res: usize,
+    p_value: f64,
+) -> Result<()> {
+    if res == 0 || observed.len() != res * res || expected.len() != res * res {
+        bail!(
+            "warp_histogram: the grids must hold res² = {}² values (got {} and {})",
+            res,
+            observed.len(),
+            expected.len()
+        );
+    }
+    render(
+        path,
+        &WarpHistogram {
+            title,
+            observed,
+            expected,
+            res,
+            p_value,
+        },
+    )
+}
+
+/// Observed and expected sample counts of `material.sample(strategy, wo, ..)`
+/// over a `res × res` grid on the projected hemisphere (the unit disk of
+/// `(wi.x, wi.y)`), as `(observed, expected)`.
+///
+/// Layout: row-major, pixel `(i, j)` at index `j * res + i` covers
+/// `x ∈ [−1 + 2i/res, −1 + 2(i+1)/res)` and likewise `y` with `j`, so row 0
+/// is the bottom (`y = −1`). Pixels outside the disk hold zero.
+///
+/// The observed counts come from `samples` draws with the uniforms `uc`,
+/// `u.x`, `u.y` taken in that order from `Pcg64::seed_from_u64(seed)`, the
+/// same stream as [`lobe::stats::chi2::chi2_test`]; failed samples are
+/// counted in `samples` but fall in no pixel. The expected count of a pixel
+/// is `samples × ∫ pdf dω` over its directions: the pixel is cut into a few
+/// × a few cells in disk coordinates, each weighing the pdf at its centre by
+/// its solid angle `∫∫ dx dy / z` (computed exactly, so the pixels on the
+/// rim, where `1/z` blows up, are as accurate as the others).
+///
+/// `res` must be at least 1; the strategy must apply to the material (see
+/// [`Material::check`]), otherwise the pdf is meaningless.
+#[must_use]
+pub fn projected_histograms(
+    material: &Material,
+    strategy: Strategy,
+    wo: DVec3,
+    samples: usize,
+    seed: u64,
+    res: usize,
+) -> (Vec<f64>, Vec<f64>) {
+    projected_histograms_with_progress(material, strategy, wo, samples, seed, res, &|_| {})
+}
+
+/// [`projected_histograms`], calling `progress(k)` after every further `k`
+/// samples drawn (for a progress bar of length `samples`).
+#[must_use]
+pub fn projected_histograms_with_progress(
+    material: &Material,
+    strategy: Strategy,
+    wo: DVec3,
+    samples: usize,
+    seed: u64,
+    res: usize,
+    progress: &(dyn Fn(u64) + Sync),
+) -> (Vec<f64>, Vec<f64>) {
+    let res = res.max(1);
+    let mut observed = vec![0.0; res * res];
+    let mut rng = Pcg64::seed_from_u64(seed);
+    const STEP: usize = 1 << 16;
+    for n in 0..samples {
+        let uc: f64 = rng.random();
+        let ux: f64 = rng.random();
+        let uy: f64 = rng.random();
+        if let Some(s) = material.sample(strategy, wo, uc, DVec2::new(ux, uy)) {
+            let (i, j) = (disk_cell(s.wi.x, res), disk_cell(s.wi.y, res));
+            observed[j * res + i] += 1.0;
+        }
+        if (n + 1) % STEP == 0 {
+            progress(STEP as u64);
+        }
+    }
+    progress((samples % STEP) as u64);
+
+    // Each pixel is cut into sub × sub cells; a cell contributes the pdf at
+    // its centre (pulled inside the disk at the rim) times its exact solid
+    // angle, so the 1/z singularity of dω = dx dy / z at the rim costs no
+    // accuracy.
+    let sub = (512 / res).clamp(3, 8);
+    let h = 2.0 / res as f64;
+    let hs = h / sub as f64;
+    let n = samples as f64;
+    let expected = (0..res * res)
+        .into_par_iter()
+        .map(|k| {
+            let (i, j) = (k % res, k / res);
+            let mut acc = 0.0;
+            for b in 0..sub {
+                let y0 = -1.0 + j as f64 * h + b as f64 * hs;
+                for a in 0..sub {
+                    let x0 = -1.0 + i as f64 * h + a as f64 * hs;
+                    let omega = rect_solid_angle(x0, x0 + hs, y0, y0 + hs);
+                    if omega <= 0.0 {
+                        continue;
+                    }
+                    let mut c = DVec2::new(x0 + 0.5 * hs, y0 + 0.5 * hs);
+                    let r = c.length();
+                    if r > 1.0 - 1e-7 {
+                        c *= (1.0 - 1e-7) / r;
+                    }
+                    let wi = DVec3::new(c.x, c.y, (1.0 - c.length_squared()).max(0.0).sqrt());
+                    let p = material.pdf(strategy, wo, wi);
+                    if p.is_finite() && p > 0.0 {
+                        acc += p * omega;
+                    }
+                }
+            }
+            n * acc
+        })
+        .collect();
+    (observed, expected)
+}
+
+/// Draws a heat map over the projected hemisphere of the sample weight
+/// `f·cos θi / pdf` (luminance of `f`) that `strategy` gives the direction at
+/// the centre of each of `res × res` pixels, on a log colour scale with a
+/// colour bar. This shows where a strategy's weights blow up (uniform
+/// sampling of a sharp lobe, `D cos θh` sampling at grazing views).
+///
+/// Pixels where `pdf = 0` but `f > 0` (directions the strategy never
+/// samples, a bias) are drawn red; pixels where `f = 0` grey; both are
+/// noted in the legend. A white `+` marks the mirror direction of `wo`.
+/// The scale spans at most 8 decades below the largest weight.
+///
+/// Writes an SVG if `path` ends in `.svg`, a PNG (640×600) if `.png`.
+///
+/// # Errors
+///
+/// `res == 0`, an unknown extension, or the file cannot be written.
+pub fn weight_heatmap(
+    path: &Path,
+    title: &str,
+    material: &Material,
+    strategy: Strategy,
+    wo: DVec3,
+    res: usize,
+) -> Result<()> {
+    if res == 0 {
+        bail!("weight_heatmap: res must be at least 1");
+    }
+    let pixels = weight_pixels(material, strategy, wo, res);
+    render(
+        path,
+        &WeightMap {
+            title,
+            pixels: &pixels,
+            res,
+            mirror: DVec2::new(-wo.x, -wo.y),
+        },
+    )
+}
+
+/// The viridis colour map (perceptually uniform, readable in grey and by
+/// colour-blind readers) at `t ∈ [0, 1]` (clamped; NaN gives the low end).
+/// Linear interpolation between ten anchors of the published map.
+#[must_use]
+pub fn viridis(t: f64) -> RGBColor {
+    const ANCHORS: [(u8, u8, u8); 10] = [
+        (0x44, 0x01, 0x54),
+        (0x48, 0x28, 0x78),
+        (0x3e, 0x4a, 0x89),
+        (0x31, 0x68, 0x8e),
+        (0x26, 0x82, 0x8e),
+        (0x1f, 0x9e, 0x89),
+        (0x35, 0xb7, 0x79),
+        (0x6d, 0xcd, 0x59),
+        (0xb4, 0xde, 0x2c),
+        (0xfd, 0xe7, 0x25),
+    ];
+    let t = if t.is_nan() { 0.0 } else { t.clamp(0.0, 1.0) };
+    let s = t * (ANCHORS.len() - 1) as f64;
+    let k = (s.floor() as usize).min(ANCHORS.len() - 2);
+    let f = s - k as f64;
+    let (a, b) = (ANCHORS[k], ANCHORS[k + 1]);
+    let mix = |x: u8, y: u8| (f64::from(x) + f * (f64::from(y) - f64::from(x))).round() as u8;
+    RGBColor(mix(a.0, b.0), mix(a.1, b.1), mix(a.2, b.2))
+}
+
+/// An antiderivative of `1/sqrt(1 − x² − y²)` in `x` and `y` over the unit
+/// disk (continuous up to its rim): `∂²F/∂x∂y = 1/z` and
+/// `∂F/∂y = asin(x / sqrt(1 − y²))`.
+fn solid_angle_antiderivative(x: f64, y: f64) -> f64 {
+    let half_asin = |num: f64, den2: f64| {
+        if den2 > 0.0 {
+            (num / den2.sqrt()).clamp(-1.0, 1.0).asin()
+        } else if num == 0.0 {
+            0.0
+        } else {
+            std::f64::consts::FRAC_PI_2.copysign(num)
+        }
+    };
+    let z = (1.0 - x * x - y * y).max(0.0).sqrt();
+    y * half_asin(x, 1.0 - y * y) + x * half_asin(y, 1.0 - x * x) - (x * y).atan2(z)
+}
+
+/// The solid angle of the directions whose `(x, y)` lie in the rectangle
+/// `[x0, x1] × [y0, y1]` and in the unit disk: `∫∫ dx dy / z`, exactly.
+fn rect_solid_angle(x0: f64, x1: f64, y0: f64, y1: f64) -> f64 {
+    use std::f64::consts::FRAC_PI_2;
+    let (ya, yb) = (y0.max(-1.0), y1.min(1.0));
+    if ya >= yb || x0 >= x1 {
+        return 0.0;
+    }
+    // Cut [ya, yb] where the rim crosses x = x0 and x = x1, so that in each
+    // piece each side of the rectangle is either inside the disk or not.
+    let mut cuts = vec![ya, yb];
+    for x in [x0, x1] {
+        if x.abs() < 1.0 {
+            let yc = (1.0 - x * x).sqrt();
+            cuts.extend([-yc, yc].into_iter().filter(|&v| v > ya && v < yb));
+        }
+    }
+    cuts.sort_by(f64::total_cmp);
+    let f = solid_angle_antiderivative;
+    let mut total = 0.0;
+    for w in cuts.windows(2) {
+        let (a, b) = (w[0], w[1]);
+        let c = (1.0 - (0.5 * (a + b)).powi(2)).max(0.0).sqrt();
+        if x1 <= -c || x0 >= c {
+            continue;
+        }
+        let upper = if x1 < c {
+            f(x1, b) - f(x1, a)
+        } else {
+            FRAC_PI_2 * (b - a)
+        };
+        let lower = if x0 > -c {
+            f(x0, b) - f(x0, a)
+        } else {
+            -FRAC_PI_2 * (b - a)
+        };
+        total += upper - lower;
+    }
+    total.max(0.0)
+}
+
+// ---------------------------------------------------------------------------
+// Rendering to a file
+// ---------------------------------------------------------------------------
+
+type DResult<DB, T = ()> =
+    std::result::Result<T, DrawingAreaErrorKind<<DB as DrawingBackend>::ErrorType>>;
+
+/// A figure that can draw itself on any plotters backend.
+trait Figure {
+    fn size(&self) -> (u32, u32);
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DResult<DB>;
+}
+
+/// Registers the embedded DejaVu Sans once; plotters' ab_glyph text needs it.
+fn register_fonts() -> Result<()> {
+    static DONE: OnceLock<bool> = OnceLock::new();
+    let ok = *DONE.get_or_init(|| {
+        ["sans-serif", "serif", "monospace"].iter().all(|family| {
+            plotters::style::register_font(family, FontStyle::Normal, FONT_BYTES).is_ok()
+        })
+    });
+    if ok {
+        Ok(())
+    } else {
+        Err(anyhow!("the embedded font could not be loaded"))
+    }
+}
+
+fn render(path: &Path, fig: &impl Figure) -> Result<()> {
+    register_fonts()?;
+    let shown = path.display();
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    match ext.as_deref() {
+        Some("png") => {
+            let root = BitMapBackend::new(path, fig.size()).into_drawing_area();
+            fig.draw(&root)
+                .map_err(|e| anyhow!("drawing {shown}: {e}"))?;
+            root.present()
+                .map_err(|e| anyhow!("cannot write {shown}: {e}"))?;
+        }
+        Some("svg") => {
+            let root = SVGBackend::new(path, fig.size()).into_drawing_area();
+            fig.draw(&root)
+                .map_err(|e| anyhow!("drawing {shown}: {e}"))?;
+            root.present()
+                .map_err(|e| anyhow!("cannot write {shown}: {e}"))?;
+        }
+        _ => bail!("{shown}: a figure file name must end in .png or .svg"),
+    }
+    Ok(())
+}
+
+// ---------------------------------------------------------------------------
+// Small helpers: colours, text, numbers
+// ---------------------------------------------------------------------------
+
+/// Okabe–Ito colours (distinguishable by colour-blind readers), yellow left out.
+const PALETTE: [RGBColor; 7] = [
+    RGBColor(0, 114, 178),
+    RGBColor(213, 94, 0),
+    RGBColor(0, 158, 115),
+    RGBColor(204, 121, 167),
+    RGBColor(230, 159, 0),
+    RGBColor(86, 180, 233),
+    RGBColor(0, 0, 0),
+];
+const GRID: RGBColor = RGBColor(215, 215, 215);
+const LIGHT_GRID: RGBColor = RGBColor(238, 238, 238);
+const TEXT: RGBColor = RGBColor(30, 30, 30);
+const DIM_TEXT: RGBColor = RGBColor(100, 100, 100);
+/// Pixels where `f > 0` but `pdf = 0`.
+const UNSAMPLED: RGBColor = RGBColor(228, 26, 28);
+/// Pixels where `f = 0`.
+const ZERO_F: RGBColor = RGBColor(190, 190, 190);
+
+fn font(size: f64) -> FontDesc<'static> {
+    (FONT, size).into_font()
+}
+
+fn text_style(size: f64, color: RGBColor, h: HPos, v: VPos) -> TextStyle<'static> {
+    font(size).color(&color).pos(Pos::new(h, v))
+}
+
+/// Draws `s` at pixel `pos` of `area`, anchored by `h` and `v`.
+fn put_text<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    s: &str,
+    pos: (i32, i32),
+    size: f64,
+    color: RGBColor,
+    (h, v): (HPos, VPos),
+) -> DResult<DB> {
+    area.draw_text(s, &text_style(size, color, h, v), pos)
+}
+
+/// The largest font size ≤ `size` at which `s` fits in `width` pixels.
+fn fit_size<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    s: &str,
+    size: f64,
+    width: u32,
+) -> DResult<DB, f64> {
+    let mut size = size;
+    while size > 9.0 {
+        let (w, _) = area.estimate_text_size(s, &font(size).into_text_style(area))?;
+        if w <= width {
+            break;
+        }
+        size -= 1.0;
+    }
+    Ok(size)
+}
+
+/// Draws a title centred at the top of `area` (shrunk to fit) and returns
+/// the height it took.
+fn draw_title<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    title: &str,
+    size: f64,
+) -> DResult<DB, i32> {
+    let (w, _) = area.dim_in_pixel();
+    let size = fit_size(area, title, size, w.saturating_sub(40))?;
+    put_text(
+        area,
+        title,
+        (w as i32 / 2, 8),
+        size,
+        TEXT,
+        (HPos::Center, VPos::Top),
+    )?;
+    Ok(size.round() as i32 + 16)
+}
+
+/// `n` as Unicode superscript digits, with a real minus sign.
+fn superscript(n: i64) -> String {
+    n.to_string()
+        .chars()
+        .map(|c| match c {
+            '-' => '⁻',
+            '0' => '⁰',
+            '1' => '¹',
+            '2' => '²',
+            '3' => '³',
+            '4' => '⁴',
+            '5' => '⁵',
+            '6' => '⁶',
+            '7' => '⁷',
+            '8' => '⁸',
+            _ => '⁹',
+        })
+        .collect()
+}
+
+/// `base^k` for an integer-valued `k`, e.g. `2¹⁰`, `10⁻³`.
+fn power_label(base: u32, k: f64) -> String {
+    format!("{base}{}", superscript(k.round() as i64))
+}
+
+/// A short human number: `0.0123`, `4.5`, `1200`, `3.2e-7`, with `−`.
+fn fmt_num(v: f64) -> String {
+    if v == 0.0 || !v.is_finite() {
+        return if v == 0.0 { "0".into() } else { format!("{v}") };
+    }
+    let a = v.abs();
+    let s = if (1e-3..1e6).contains(&a) {
+        let decimals = (2 - a.log10().floor() as i32).clamp(0, 5) as usize;
+        let s = format!("{v:.decimals$}");
+        if s.contains('.') {
+            s.trim_end_matches('0').trim_end_matches('.').to_string()
+        } else {
+            s
+        }
+    } else {
+        let e = a.log10().floor();
+        let m = v / 10f64.powf(e);
+        let m = format!("{m:.1}");
+        let m = m.trim_end_matches('0').trim_end_matches('.');
+        format!("{m}e{}", e as i64)
+    };
+    s.replace('-', "−")
+}
+
+/// The p-value as text: four decimals, or scientific below 1e-4.
+fn fmt_p(p: f64) -> String {
+    if p == 0.0 {
+        "0".into()
+    } else if p < 1e-4 {
+        format!("{p:.1e}").replace('-', "−")
+    } else {
+        format!("{p:.4}")
+    }
+}
+
+/// A "nice" step (1, 2 or 5 × 10^k) giving about `count` steps over `span`.
+fn nice_step(span: f64, count: f64) -> f64 {
+    let raw = (span / count).max(f64::MIN_POSITIVE);
+    let p = 10f64.powf(raw.log10().floor());
+    let m = raw / p;
+    let m = if m <= 1.0 {
+        1.0
+    } else if m <= 2.0 {
+        2.0
+    } else if m <= 5.0 {
+        5.0
+    } else {
+        10.0
+    };
+    m * p
+}
+
+/// Ticks (position in [0, 1] along a colour bar, label) for a log10 scale
+/// from `lo` to `hi` (in log10 units): decades over a wide range, else
+/// 1-2-5 (or finer) multiples.
+fn log_ticks(lo: f64, hi: f64) -> Vec<(f64, String)> {
+    let span = hi - lo;
+    let eps = 0.01 * span;
+    let mut ticks = Vec::new();
+    if span >= 3.0 {
+        let step = (span / 8.0).ceil().max(1.0);
+        let mut k = ((lo - eps) / step).ceil() * step;
+        while k <= hi + eps {
+            let v = 10f64.powf(k);
+            let label = if (1e-2..1e4).contains(&v) {
+                fmt_num(v)
+            } else {
+                power_label(10, k)
+            };
+            ticks.push((((k - lo) / span).clamp(0.0, 1.0), label));
+            k += step;
+        }
+    } else {
+        let mantissas: &[f64] = if span < 0.6 {
+            &[1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0]
+        } else if span < 1.5 {
+            &[1.0, 2.0, 3.0, 5.0]
+        } else {
+            &[1.0, 2.0, 5.0]
+        };
+        for d in (lo.floor() as i64)..=(hi.ceil() as i64) {
+            for &m in mantissas {
+                let t = (d as f64) + f64::log10(m);
+                if t >= lo - eps && t <= hi + eps {
+                    ticks.push((((t - lo) / span).clamp(0.0, 1.0), fmt_num(10f64.powf(t))));
+                }
+            }
+        }
+    }
+    ticks
+}
+
+/// Ticks for a linear scale from 0 to `hi`.
+fn linear_ticks(hi: f64) -> Vec<(f64, String)> {
+    let step = nice_step(hi, 5.0);
+    let mut ticks = Vec::new();
+    let mut k = 0.0;
+    while k <= hi * (1.0 + 1e-9) {
+        ticks.push((k / hi, fmt_num(k)));
+        k += step;
+    }
+    ticks
+}
+
+// ---------------------------------------------------------------------------
+// Convergence plot
+// ---------------------------------------------------------------------------
+
+/// A linear f64 axis whose tick marks (bold) and minor grid lines (light)
+/// are given, in the coordinates of the axis.
+struct TickedAxis {
+    range: std::ops::Range<f64>,
+    bold: Vec<f64>,
+    light: Vec<f64>,
+}
+
+impl Ranged for TickedAxis {
+    type FormatOption = DefaultFormatting;
+    type ValueType = f64;
+
+    fn map(&self, value: &f64, limit: (i32, i32)) -> i32 {
+        let t = (value - self.range.start) / (self.range.end - self.range.start);
+        limit.0 + (t * f64::from(limit.1 - limit.0)).round() as i32
+    }
+
+    fn key_points<H: KeyPointHint>(&self, hint: H) -> Vec<f64> {
+        if hint.weight().allow_light_points() {
+            self.light.clone()
+        } else {
+            self.bold.clone()
+        }
+    }
+
+    fn range(&self) -> std::ops::Range<f64> {
+        self.range.clone()
+    }
+}
+
+struct Convergence<'a> {
+    title: &'a str,
+    series: &'a [Series],
+}
+
+/// The outline, in pixel offsets, of marker shape `k % 4`: a disk (a
+/// 12-gon), a triangle, a square, a diamond.
+fn marker_shape(k: usize) -> Vec<(i32, i32)> {
+    match k % 4 {
+        0 => (0..12)
+            .map(|i| {
+                let a = std::f64::consts::TAU * f64::from(i) / 12.0;
+                (
+                    (4.5 * a.cos()).round() as i32,
+                    (4.5 * a.sin()).round() as i32,
+                )
+            })
+            .collect(),
+        1 => vec![(0, -6), (5, 3), (-5, 3)],
+        2 => vec![(-4, -4), (4, -4), (4, 4), (-4, 4)],
+        _ => vec![(0, -6), (5, 0), (0, 6), (-5, 0)],
+    }
+}
+
+impl Figure for Convergence<'_> {
+    fn size(&self) -> (u32, u32) {
+        LINE_SIZE
+    }
+
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DResult<DB> {
+        root.fill(&WHITE)?;
+        let logged: Vec<Vec<(f64, f64)>> = self
+            .series
+            .iter()
+            .map(|s| {
+                s.points
+                    .iter()
+                    .filter(|&&(n, e)| n.is_finite() && n > 0.0 && e.is_finite() && e > 0.0)
+                    .map(|&(n, e)| (n.log2(), e.log10()))
+                    .collect()
+            })
+            .collect();
+        let all: Vec<(f64, f64)> = logged.iter().flatten().copied().collect();
+        let (mut x0, mut x1, mut y0, mut y1) = (0.0f64, 20.0f64, -6.0f64, 0.0f64);
+        if !all.is_empty() {
+            x0 = all.iter().map(|p| p.0).fold(f64::INFINITY, f64::min);
+            x1 = all.iter().map(|p| p.0).fold(f64::NEG_INFINITY, f64::max);
+            y0 = all.iter().map(|p| p.1).fold(f64::INFINITY, f64::min);
+            y1 = all.iter().map(|p| p.1).fold(f64::NEG_INFINITY, f64::max);
+        }
+        let (xa, mut xb) = (x0.floor(), x1.ceil());
+        if xb < xa + 1.0 {
+            xb = xa + 1.0;
+        }
+        let (ya, mut yb) = (y0.floor(), y1.ceil());
+        if yb < ya + 1.0 {
+            yb = ya + 1.0;
+        }
+        let x_range = (xa - 0.3)..(xb + 0.3);
+        let y_pad = 0.04 * (yb - ya);
+        let y_range = (ya - y_pad)..(yb + y_pad);
+        let x_step = ((xb - xa) / 12.0).ceil().max(1.0);
+        let x_ticks: Vec<f64> = (0..)
+            .map(|k| (xa / x_step).ceil() * x_step + k as f64 * x_step)
+            .take_while(|&x| x <= xb + 1e-9)
+            .collect();
+        let y_step = ((yb - ya) / 10.0).ceil().max(1.0);
+        let y_ticks: Vec<f64> = (0..)
+            .map(|k| (ya / y_step).ceil() * y_step + k as f64 * y_step)
+            .take_while(|&y| y <= yb + 1e-9)
+            .collect();
+        let y_light: Vec<f64> = ((ya as i64)..(yb as i64))
+            .flat_map(|d| (1..10).map(move |m| d as f64 + f64::log10(f64::from(m))))
+            .collect();
+
+        let (w, _) = root.dim_in_pixel();
+        let size = fit_size(root, self.title, 22.0, w.saturating_sub(30))?;
+        let mut chart = ChartBuilder::on(root)
+            .caption(self.title, font(size).color(&TEXT))
+            .margin(12)
+            .margin_right(24)
+            .x_label_area_size(50)
+            .y_label_area_size(70)
+            .build_cartesian_2d(
+                TickedAxis {
+                    range: x_range,
+                    bold: x_ticks,
+                    light: Vec::new(),
+                },
+                TickedAxis {
+                    range: y_range,
+                    bold: y_ticks,
+                    light: y_light,
+                },
+            )?;
+        chart
+            .configure_mesh()
+            .x_desc("samples N (log₂ scale)")
+            .y_desc("RMSE (log₁₀ scale)")
+            .x_label_formatter(&|v| power_label(2, *v))
+            .y_label_formatter(&|v| power_label(10, *v))
+            .label_style(font(15.0).color(&TEXT))
+            .axis_desc_style(font(16.0).color(&TEXT))
+            .bold_line_style(GRID)
+            .light_line_style(LIGHT_GRID)
+            .draw()?;
+
+        // Reference slope −1/2: log10 RMSE = c − ½ log10(2) log2 N, through
+        // the first plotted point of the first series.
+        let mut lines: Vec<Vec<(f64, f64)>> = Vec::new();
+        let mut labels: Vec<String> = Vec::new();
+        if let Some(&(ax, ay)) = logged.iter().find_map(|s| s.first()) {
+            let slope = -0.5 * std::f64::consts::LOG10_2;
+            let (xr, yr) = (xa - 0.3..xb + 0.3, ya - y_pad..yb + y_pad);
+            // Clip the line to the plotting range.
+            let x_at = |y: f64| ax + (y - ay) / slope;
+            let lo = xr.start.max(x_at(yr.end));
+            let hi = xr.end.min(x_at(yr.start));
+            if lo < hi {
+                let pts = vec![(lo, ay + slope * (lo - ax)), (hi, ay + slope * (hi - ax))];
+                let label = "reference: slope −1/2 (RMSE ∝ 1/√N)".to_string();
+                chart
+                    .draw_series(DashedLineSeries::new(
+                        pts.clone(),
+                        8,
+                        6,
+                        RGBColor(110, 110, 110).stroke_width(2),
+                    ))?
+                    .label(label.clone())
+                    .legend(|(x, y)| {
+                        PathElement::new(
+                            vec![(x - 10, y), (x + 10, y)],
+                            RGBColor(110, 110, 110).stroke_width(2),
+                        )
+                    });
+                lines.push(pts);
+                labels.push(label);
+            }
+        }
+
+        for (k, (s, pts)) in self.series.iter().zip(&logged).enumerate() {
+            let color = PALETTE[k % PALETTE.len()];
+            let label = match (pts.is_empty(), s.slope) {
+                (true, _) => format!("{}: no point with RMSE > 0 (not shown)", s.label),
+                (false, Some(m)) if m.is_finite() => {
+                    format!(
+                        "{}  (slope {})",
+                        s.label,
+                        format!("{m:+.2}").replace('-', "−")
+                    )
+                }
+                (false, _) => s.label.clone(),
+            };
+            chart
+                .draw_series(LineSeries::new(pts.iter().copied(), color.stroke_width(2)))?
+                .label(label.clone())
+                .legend(move |at| {
+                    EmptyElement::at(at)
+                        + PathElement::new(vec![(-10, 0), (10, 0)], color.stroke_width(2))
+                        + Polygon::new(marker_shape(k), color.filled())
+                });
+            chart
+                .draw_series(pts.iter().map(|&p| {
+                    EmptyElement::at(p) + Polygon::new(marker_shape(k), color.filled())
+                }))?;
+            lines.push(pts.clone());
+            labels.push(label);
+        }
+
+        // The legend goes in the corner that hides the fewest points of the
+        // lines.
+        let legend_font = font(15.0).color(&TEXT);
+        let mut text_w = 0;
+        let mut text_h = 0;
+        for l in &labels {
+            let (tw, th) = root.estimate_text_size(l, &legend_font)?;
+            text_w = text_w.max(tw as i32);
+            text_h = text_h.max(th as i32);
+        }
+        let (box_w, box_h) = (
+            text_w + 30 + 24,
+            labels.len() as i32 * (text_h * 5 / 4 + 1) + 24,
+        );
+        let (pw, ph) = chart.plotting_area().dim_in_pixel();
+        let (pw, ph) = (pw as i32, ph as i32);
+        let base = chart.plotting_area().get_base_pixel();
+        let mut samples: Vec<(i32, i32)> = Vec::new();
+        for line in &lines {
+            let px: Vec<(i32, i32)> = line
+                .iter()
+                .map(|p| {
+                    let (x, y) = chart.backend_coord(p);
+                    (x - base.0, y - base.1)
+                })
+                .collect();
+            samples.extend(px.iter().copied());
+            for seg in px.windows(2) {
+                for t in 1..24 {
+                    let f = f64::from(t) / 24.0;
+                    let lerp = |a: i32, b: i32| a + (f * f64::from(b - a)).round() as i32;
+                    samples.push((lerp(seg[0].0, seg[1].0), lerp(seg[0].1, seg[1].1)));
+                }
+            }
+        }
+        let inset = 10;
+        let corners = [
+            (pw - box_w - inset, inset),
+            (inset, ph - box_h - inset),
+            (inset, inset),
+            (pw - box_w - inset, ph - box_h - inset),
+        ];
+        let hidden = |&(x, y): &(i32, i32)| {
+            samples
+                .iter()
+                .filter(|&&(sx, sy)| {
+                    sx >= x - 6 && sx <= x + box_w + 6 && sy >= y - 6 && sy <= y + box_h + 6
+                })
+                .count()
+        };
+        let (lx, ly) = corners
+            .iter()
+            .copied()
+            .min_by_key(|c| hidden(c))
+            .unwrap_or(corners[0]);
+
+        if labels.is_empty() {
+            let (cx, cy) = (base.0 + pw / 2, base.1 + ph / 2);
+            put_text(
+                root,
+                "no data",
+                (cx, cy),
+                18.0,
+                DIM_TEXT,
+                (HPos::Center, VPos::Center),
+            )?;
+        } else {
+            chart
+                .configure_series_labels()
+                .position(SeriesLabelPosition::Coordinate(lx, ly))
+                .margin(12)
+                .legend_area_size(30)
+                .label_font(legend_font)
+                .background_style(WHITE.mix(0.9))
+                .border_style(GRID)
+                .draw()?;
+        }
+        Ok(())
+    }
+}
+
+// ---------------------------------------------------------------------------
+// Polar plot
+// ---------------------------------------------------------------------------
+
+struct Polar<'a> {
+    title: &'a str,
+    curves: &'a [(String, Vec<(f64, f64)>)],
+    scale: PolarScale,
+}
+
+impl Figure for Polar<'_> {
+    fn size(&self) -> (u32, u32) {
+        POLAR_SIZE
+    }
+
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DResult<DB> {
+        use std::f64::consts::FRAC_PI_2;
+        root.fill(&WHITE)?;
+        let clean = |v: f64| if v.is_finite() && v > 0.0 { v } else { 0.0 };
+        let maxima: Vec<f64> = self
+            .curves
+            .iter()
+            .map(|(_, c)| c.iter().map(|&(_, v)| clean(v)).fold(0.0, f64::max))
+            .collect();
+        let max = maxima.iter().copied().fold(0.0, f64::max);
+        let inv = |m: f64| if m > 0.0 { 1.0 / m } else { 0.0 };
+
+        let title_h = draw_title(root, self.title, 20.0)?;
+        let (w, h) = root.dim_in_pixel();
+        let caption = match self.scale {
+            PolarScale::Global => format!(
+                "radius = value / maximum over all curves ({}); θi from the normal, negative on the viewer's side",
+                fmt_num(max)
+            ),
+            PolarScale::PerCurve => "radius = value / that curve's maximum (in the legend); \
+                 θi from the normal, negative on the viewer's side"
+                .to_string(),
+        };
+        let csize = fit_size(root, &caption, 14.0, w.saturating_sub(30))?;
+        put_text(
+            root,
+            &caption,
+            (w as i32 / 2, h as i32 - 8),
+            csize,
+            DIM_TEXT,
+            (HPos::Center, VPos::Bottom),
+        )?;
+
+        // Equal scale in x and y: fit [−1.25, 1.25] × [−0.12, 1.12].
+        let area = root.margin(title_h, 30, 10, 10);
+        let (aw, ah) = area.dim_in_pixel();
+        let s = (f64::from(aw) / 2.5).min(f64::from(ah) / 1.24);
+        let half_w = f64::from(aw) / (2.0 * s);
+        let y_lo = -0.12;
+        let y_hi = y_lo + f64::from(ah) / s;
+        let mut chart = ChartBuilder::on(&area).build_cartesian_2d(-half_w..half_w, y_lo..y_hi)?;
+
+        let polar = |t: f64, r: f64| (r * t.sin(), r * t.cos());
+        // Rings, rays and their labels.
+        for (i, r) in [0.25, 0.5, 0.75, 1.0].into_iter().enumerate() {
+            let ring: Vec<(f64, f64)> = (0..=180)
+                .map(|k| polar(-FRAC_PI_2 + std::f64::consts::PI * f64::from(k) / 180.0, r))
+                .collect();
+            let color = if i == 3 {
+                RGBColor(150, 150, 150)
+            } else {
+                GRID
+            };
+            chart.draw_series(LineSeries::new(ring, color.stroke_width(1)))?;
+            chart.draw_series(std::iter::once(Text::new(
+                fmt_num(r),
+                (-r + 0.012, 0.012),
+                text_style(12.0, DIM_TEXT, HPos::Left, VPos::Bottom),
+            )))?;
+        }
+        for deg in (-75..=75).step_by(15) {
+            let t = f64::from(deg).to_radians();
+            let color = if deg % 30 == 0 { GRID } else { LIGHT_GRID };
+            chart.draw_series(LineSeries::new(
+                [(0.0, 0.0), polar(t, 1.0)],
+                color.stroke_width(1),
+            ))?;
+        }
+        for deg in (-90i32..=90).step_by(30) {
+            let t = f64::from(deg).to_radians();
+            let label = format!("{deg}°").replace('-', "−");
+            let (pos, anchor) = match deg {
+                -90 => ((-1.03, 0.015), (HPos::Right, VPos::Bottom)),
+                90 => ((1.03, 0.015), (HPos::Left, VPos::Bottom)),
+                0 => (polar(t, 1.05), (HPos::Center, VPos::Bottom)),
+                d if d < 0 => (polar(t, 1.04), (HPos::Right, VPos::Bottom)),
+                _ => (polar(t, 1.04), (HPos::Left, VPos::Bottom)),
+            };
+            let (h, v) = anchor;
+            chart.draw_series(std::iter::once(Text::new(
+                label,
+                pos,
+                text_style(13.0, DIM_TEXT, h, v),
+            )))?;
+        }
+        // The surface, and which side is which.
+        chart.draw_series(LineSeries::new(
+            [(-1.2, 0.0), (1.2, 0.0)],
+            BLACK.stroke_width(2),
+        ))?;
+        chart.draw_series([
+            Text::new(
+                "viewer's side (θi < 0)",
+                (-0.55, -0.03),
+                text_style(13.0, DIM_TEXT, HPos::Center, VPos::Top),
+            ),
+            Text::new(
+                "mirror side (θi > 0)",
+                (0.55, -0.03),
+                text_style(13.0, DIM_TEXT, HPos::Center, VPos::Top),
+            ),
+        ])?;
+
+        for (k, (label, pts)) in self.curves.iter().enumerate() {
+            let color = PALETTE[k % PALETTE.len()];
+            let scale = match self.scale {
+                PolarScale::Global => inv(max),
+                PolarScale::PerCurve => inv(maxima[k]),
+            };
+            let xy: Vec<(f64, f64)> = pts
+                .iter()
+                .filter(|(t, _)| t.is_finite())
+                .map(|&(t, v)| polar(t.clamp(-FRAC_PI_2, FRAC_PI_2), clean(v) * scale))
+                .collect();
+            chart
+                .draw_series(LineSeries::new(xy, color.stroke_width(2)))?
+                .label(format!("{label} (max {})", fmt_num(maxima[k])))
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x - 10, y), (x + 10, y)], color.stroke_width(3))
+                });
+        }
+        if !self.curves.is_empty() {
+            chart
+                .configure_series_labels()
+                .position(SeriesLabelPosition::UpperLeft)
+                .margin(6)
+                .legend_area_size(28)
+                .label_font(font(14.0).color(&TEXT))
+                .background_style(WHITE.mix(0.9))
+                .border_style(GRID)
+                .draw()?;
+        }
+        Ok(())
+    }
+}
+
+// ---------------------------------------------------------------------------
+// Heat maps over the projected hemisphere
+// ---------------------------------------------------------------------------
+
+/// The pixel column (or row) holding coordinate `x ∈ [−1, 1]`.
+fn disk_cell(x: f64, res: usize) -> usize {
+    let i = ((x + 1.0) * 0.5 * res as f64).floor();
+    if i.is_nan() || i < 0.0 {
+        0
+    } else {
+        (i as usize).min(res - 1)
+    }
+}
+
+/// Where a disk map goes: a `size`-pixel square at `(x0, y0)` of the area.
+#[derive(Clone, Copy)]
+struct MapBox {
+    x0: i32,
+    y0: i32,
+    size: i32,
+}
+
+impl MapBox {
+    /// Pixel of disk coordinates `(x, y)` (y up).
+    fn to_px(self, x: f64, y: f64) -> (i32, i32) {
+        let s = f64::from(self.size);
+        (
+            self.x0 + ((x + 1.0) * 0.5 * s).round() as i32,
+            self.y0 + ((1.0 - y) * 0.5 * s).round() as i32,
+        )
+    }
+}
+
+/// Draws `colors` (a `res × res` grid, row 0 at the bottom, `None` left
+/// blank) in `b`, the unit circle, ticks at −1, 0, 1 and the axis names.
+fn draw_disk_map<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    b: MapBox,
+    res: usize,
+    colors: &[Option<RGBColor>],
+) -> DResult<DB> {
+    let edge = |k: usize| (k as i64 * i64::from(b.size) / res as i64) as i32;
+    for j in 0..res {
+        let top = b.y0 + b.size - edge(j + 1);
+        let bottom = (b.y0 + b.size - edge(j)).max(top + 1);
+        for i in 0..res {
+            if let Some(c) = colors[j * res + i] {
+                let left = b.x0 + edge(i);
+                let right = (b.x0 + edge(i + 1)).max(left + 1);
+                area.draw(&Rectangle::new([(left, top), (right, bottom)], c.filled()))?;
+            }
+        }
+    }
+    let outline = RGBColor(120, 120, 120);
+    area.draw(&Rectangle::new(
+        [(b.x0, b.y0), (b.x0 + b.size, b.y0 + b.size)],
+        outline.mix(0.5).stroke_width(1),
+    ))?;
+    let circle: Vec<(i32, i32)> = (0..=256)
+        .map(|k| {
+            let a = std::f64::consts::TAU * f64::from(k) / 256.0;
+            b.to_px(a.cos(), a.sin())
+        })
+        .collect();
+    area.draw(&PathElement::new(circle, outline.stroke_width(1)))?;
+    for v in [-1.0, 0.0, 1.0] {
+        let (x, _) = b.to_px(v, 0.0);
+        let (_, y) = b.to_px(0.0, v);
+        let bottom = b.y0 + b.size;
+        area.draw(&PathElement::new(
+            vec![(x, bottom), (x, bottom + 4)],
+            outline.stroke_width(1),
+        ))?;
+        area.draw(&PathElement::new(
+            vec![(b.x0 - 4, y), (b.x0, y)],
+            outline.stroke_width(1),
+        ))?;
+        let label = fmt_num(v);
+        put_text(
+            area,
+            &label,
+            (x, bottom + 6),
+            12.0,
+            DIM_TEXT,
+            (HPos::Center, VPos::Top),
+        )?;
+        put_text(
+            area,
+            &label,
+            (b.x0 - 6, y),
+            12.0,
+            DIM_TEXT,
+            (HPos::Right, VPos::Center),
+        )?;
+    }
+    let (xm, _) = b.to_px(0.5, 0.0);
+    put_text(
+        area,
+        "x",
+        (xm, b.y0 + b.size + 6),
+        13.0,
+        TEXT,
+        (HPos::Center, VPos::Top),
+    )?;
+    let (_, ym) = b.to_px(0.0, 0.5);
+    put_text(
+        area,
+        "y",
+        (b.x0 - 6, ym),
+        13.0,
+        TEXT,
+        (HPos::Right, VPos::Center),
+    )?;
+    Ok(())
+}
+
+/// Width in pixels that [`draw_colorbar`] takes with a bar `width` wide:
+/// the bar, its tick labels and its rotated label.
+fn colorbar_width<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    width: i32,
+    ticks: &[(f64, String)],
+) -> DResult<DB, i32> {
+    let mut widest = 0u32;
+    for (_, s) in ticks {
+        widest = widest.max(
+            area.estimate_text_size(s, &font(12.0).into_text_style(area))?
+                .0,
+        );
+    }
+    Ok(width + 12 + widest as i32 + 22)
+}
+
+/// Draws a vertical viridis colour bar `width` wide at `(x, top)` down to
+/// `bottom`, its `ticks` (position 0 at the bottom, 1 at the top, label) to
+/// the right, and `label` rotated along its right side.
+fn draw_colorbar<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    (x, top, bottom): (i32, i32, i32),
+    width: i32,
+    ticks: &[(f64, String)],
+    label: &str,
+) -> DResult<DB> {
+    let h = (bottom - top).max(1);
+    for k in 0..h {
+        let t = 1.0 - (f64::from(k) + 0.5) / f64::from(h);
+        area.draw(&Rectangle::new(
+            [(x, top + k), (x + width, top + k + 1)],
+            viridis(t).filled(),
+        ))?;
+    }
+    area.draw(&Rectangle::new(
+        [(x, top), (x + width, bottom)],
+        RGBColor(120, 120, 120).stroke_width(1),
+    ))?;
+    let mut widest = 0u32;
+    for (t, s) in ticks {
+        let y = bottom - (t * f64::from(h)).round() as i32;
+        area.draw(&PathElement::new(
+            vec![(x + width, y), (x + width + 4, y)],
+            BLACK.stroke_width(1),
+        ))?;
+        put_text(
+            area,
+            s,
+            (x + width + 6, y),
+            12.0,
+            TEXT,
+            (HPos::Left, VPos::Center),
+        )?;
+        widest = widest.max(
+            area.estimate_text_size(s, &font(12.0).into_text_style(area))?
+                .0,
+        );
+    }
+    // Rotated to read upwards; VPos::Top puts the text to the right of the
+    // anchor.
+    let style = font(13.0)
+        .transform(FontTransform::Rotate270)
+        .color(&TEXT)
+        .pos(Pos::new(HPos::Center, VPos::Top));
+    let lx = x + width + 12 + widest as i32;
+    area.draw_text(label, &style, (lx, (top + bottom) / 2))?;
+    Ok(())
+}
+
+struct WarpHistogram<'a> {
+    title: &'a str,
+    observed: &'a [f64],
+    expected: &'a [f64],
+    res: usize,
+    p_value: f64,
+}
+
+impl Figure for WarpHistogram<'_> {
+    fn size(&self) -> (u32, u32) {
+        HISTOGRAM_SIZE
+    }
+
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DResult<DB> {
+        root.fill(&WHITE)?;
+        let verdict = if self.p_value > PASS_LEVEL {
+            "PASS"
+        } else {
+            "FAIL"
+        };
+        let title = format!(
+            "{}: χ² p = {} → {verdict} (at {} %)",
+            self.title,
+            fmt_p(self.p_value),
+            PASS_LEVEL * 100.0
+        );
+        let title_h = draw_title(root, &title, 19.0)?;
+        let res = self.res;
+        let vmax = self
+            .observed
+            .iter()
+            .chain(self.expected)
+            .copied()
+            .filter(|v| v.is_finite())
+            .fold(0.0, f64::max);
+        let vmax = if vmax > 0.0 { vmax } else { 1.0 };
+        // Pixels whose centre is in the disk, or that hold any count.
+        let colors = |grid: &[f64], other: &[f64]| -> Vec<Option<RGBColor>> {
+            (0..res * res)
+                .map(|k| {
+                    let (i, j) = (k % res, k / res);
+                    let x = -1.0 + (i as f64 + 0.5) * 2.0 / res as f64;
+                    let y = -1.0 + (j as f64 + 0.5) * 2.0 / res as f64;
+                    (x * x + y * y < 1.0 || grid[k] > 0.0 || other[k] > 0.0)
+                        .then(|| viridis(grid[k] / vmax))
+                })
+                .collect()
+        };
+        let (_, h) = root.dim_in_pixel();
+        let label_h = 22;
+        let (w, _) = root.dim_in_pixel();
+        // Room for the tick labels at the left, the gap, and the colour bar.
+        let ticks = linear_ticks(vmax);
+        let bar_w = colorbar_width(root, 16, &ticks)?;
+        // Room for the tick labels at the left, the gap, and the colour bar.
+        let size =
+            (h as i32 - title_h - label_h - 34).min((w as i32 - 44 - 50 - 24 - bar_w - 8) / 2);
+        let top = title_h + label_h;
+        let left = MapBox {
+            x0: 44,
+            y0: top,
+            size,
+        };
+        let right = MapBox {
+            x0: left.x0 + size + 50,
+            y0: top,
+            size,
+        };
+        for (b, name, grid, other) in [
+            (left, "observed samples", self.observed, self.expected),
+            (
+                right,
+                "expected (samples × ∫ pdf dω)",
+                self.expected,
+                self.observed,
+            ),
+        ] {
+            put_text(
+                root,
+                name,
+                (b.x0 + size / 2, top - 4),
+                15.0,
+                TEXT,
+                (HPos::Center, VPos::Bottom),
+            )?;
+            draw_disk_map(root, b, res, &colors(grid, other))?;
+        }
+        draw_colorbar(
+            root,
+            (right.x0 + size + 24, top, top + size),
+            16,
+            &ticks,
+            &format!("samples per pixel ({res}×{res} pixels)"),
+        )?;
+        Ok(())
+    }
+}
+
+/// What a pixel of the weight map shows.
+#[derive(Clone, Copy, PartialEq)]
+enum WeightPixel {
+    Outside,
+    /// `f = 0`: the weight is zero.
+    ZeroF,
+    /// `f > 0` and `pdf = 0`: never sampled.
+    Unsampled,
+    Weight(f64),
+}
+
+fn weight_pixels(
+    material: &Material,
+    strategy: Strategy,
+    wo: DVec3,
+    res: usize,
+) -> Vec<WeightPixel> {
+    (0..res * res)
+        .into_par_iter()
+        .map(|k| {
+            let (i, j) = (k % res, k / res);
+            let x = -1.0 + (i as f64 + 0.5) * 2.0 / res as f64;
+            let y = -1.0 + (j as f64 + 0.5) * 2.0 / res as f64;
+            let r2 = x * x + y * y;
+            if r2 >= 1.0 {
+                return WeightPixel::Outside;
+            }
+            let wi = DVec3::new(x, y, (1.0 - r2).sqrt());
+            let f = luminance(material.eval(wo, wi));
+            let pdf = material.pdf(strategy, wo, wi);
+            if f.is_nan() || f <= 0.0 {
+                WeightPixel::ZeroF
+            } else if pdf.is_nan() || pdf <= 0.0 {
+                WeightPixel::Unsampled
+            } else {
+                WeightPixel::Weight(f * wi.z / pdf)
+            }
+        })
+        .collect()
+}
+
+struct WeightMap<'a> {
+    title: &'a str,
+    pixels: &'a [WeightPixel],
+    res: usize,
+    mirror: DVec2,
+}
+
+impl Figure for WeightMap<'_> {
+    fn size(&self) -> (u32, u32) {
+        WEIGHTS_SIZE
+    }
+
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DResult<DB> {
+        root.fill(&WHITE)?;
+        let title_h = draw_title(root, self.title, 18.0)?;
+        let weights = || {
+            self.pixels.iter().filter_map(|p| match p {
+                WeightPixel::Weight(w) if w.is_finite() => Some(*w),
+                _ => None,
+            })
+        };
+        let (wmin, wmax) = weights().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), w| {
+            (a.min(w), b.max(w))
+        });
+        let (mut lo, mut hi) = if wmin <= wmax {
+            (wmin.log10(), wmax.log10())
+        } else {
+            (-1.0, 1.0)
+        };
+        let clipped = hi - lo > 8.0;
+        if clipped {
+            lo = (hi - 8.0).ceil();
+        }
+        if hi - lo < 0.2 {
+            let c = 0.5 * (hi + lo);
+            (lo, hi) = (c - 0.5, c + 0.5);
+        }
+        let colors: Vec<Option<RGBColor>> = self
+            .pixels
+            .iter()
+            .map(|p| match *p {
+                WeightPixel::Outside => None,
+                WeightPixel::ZeroF => Some(ZERO_F),
+                WeightPixel::Unsampled => Some(UNSAMPLED),
+                WeightPixel::Weight(w) if w.is_finite() => {
+                    Some(viridis((w.log10() - lo) / (hi - lo)))
+                }
+                WeightPixel::Weight(_) => Some(UNSAMPLED),
+            })
+            .collect();
+        let mut ticks = log_ticks(lo, hi);
+        if clipped {
+            // The bottom colour also holds every smaller weight.
+            match ticks.first_mut() {
+                Some(first) if first.0 < 0.04 => first.1 = format!("≤ {}", first.1),
+                _ => ticks.insert(0, (0.0, format!("≤ {}", fmt_num(10f64.powf(lo))))),
+            }
+        }
+        let (w, h) = root.dim_in_pixel();
+        let legend_h = 44;
+        let bar_w = colorbar_width(root, 16, &ticks)?;
+        let size = (h as i32 - title_h - legend_h - 30).min(w as i32 - 44 - 24 - bar_w - 8);
+        let b = MapBox {
+            x0: 44,
+            y0: title_h + 4,
+            size,
+        };
+        draw_disk_map(root, b, self.res, &colors)?;
+
+        // The mirror direction of wo.
+        let (mx, my) = b.to_px(self.mirror.x, self.mirror.y);
+        for (c, wd) in [(BLACK, 4), (WHITE, 2)] {
+            root.draw(&PathElement::new(
+                vec![(mx - 7, my), (mx + 7, my)],
+                c.stroke_width(wd),
+            ))?;
+            root.draw(&PathElement::new(
+                vec![(mx, my - 7), (mx, my + 7)],
+                c.stroke_width(wd),
+            ))?;
+        }
+
+        draw_colorbar(
+            root,
+            (b.x0 + size + 24, b.y0, b.y0 + size),
+            16,
+            &ticks,
+            "weight f·cos θi / pdf (log scale)",
+        )?;
+
+        // Legend and range.
+        let unsampled = self
+            .pixels
+            .iter()
+            .filter(|p| **p == WeightPixel::Unsampled)
+            .count();
+        let zero_f = self
+            .pixels
+            .iter()
+            .filter(|p| **p == WeightPixel::ZeroF)
+            .count();
+        let y1 = b.y0 + size + 30;
+        let mut x = b.x0;
+        let swatch = |x: i32, y: i32, c: RGBColor| -> DResult<DB> {
+            root.draw(&Rectangle::new([(x, y - 6), (x + 12, y + 6)], c.filled()))?;
+            root.draw(&Rectangle::new(
+                [(x, y - 6), (x + 12, y + 6)],
+                RGBColor(120, 120, 120).stroke_width(1),
+            ))
+        };
+        swatch(x, y1, UNSAMPLED)?;
+        let s = if unsampled > 0 {
+            format!("f > 0 but pdf = 0 (never sampled): {unsampled} px")
+        } else {
+            "f > 0 but pdf = 0 (never sampled): none".to_string()
+        };
+        put_text(
+            root,
+            &s,
+            (x + 18, y1),
+            13.0,
+            TEXT,
+            (HPos::Left, VPos::Center),
+        )?;
+        x += 18
+            + root
+                .estimate_text_size(&s, &font(13.0).into_text_style(root))?
+                .0 as i32
+            + 18;
+        swatch(x, y1, ZERO_F)?;
+        let s = format!("f = 0: {zero_f} px");
+        put_text(
+            root,
+            &s,
+            (x + 18, y1),
+            13.0,
+            TEXT,
+            (HPos::Left, VPos::Center),
+        )?;
+        let y2 = y1 + 20;
+        let range = if wmin <= wmax {
+            format!(
+                "+ mirror direction of wo;  weights from {} to {} at pixel centres",
+                fmt_num(wmin),
+                fmt_num(wmax)
+            )
+        } else {
+            "+ mirror direction of wo;  no pixel with a finite weight".to_string()
+        };
+        put_text(
+            root,
+            &range,
+            (b.x0, y2),
+            13.0,
+            TEXT,
+            (HPos::Left, VPos::Center),
+        )?;
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn numbers_read_well() {
+        assert_eq!(fmt_num(0.0123), "0.0123");
+        assert_eq!(fmt_num(1200.0), "1200");
+        assert_eq!(fmt_num(-0.5), "−0.5");
+        assert_eq!(fmt_num(3.2e-7), "3.2e−7");
+        assert_eq!(superscript(-12), "⁻¹²");
+        assert_eq!(power_label(2, 10.0), "2¹⁰");
+    }
+
+    #[test]
+    fn viridis_ends() {
+        assert_eq!(viridis(0.0), RGBColor(0x44, 0x01, 0x54));
+        assert_eq!(viridis(1.0), RGBColor(0xfd, 0xe7, 0x25));
+        assert_eq!(viridis(f64::NAN), viridis(0.0));
+    }
+
+    /// Draws every figure as PNG and SVG (into `LOBE_FIGURES_DIR` when set,
+    /// to look at them).
+    #[test]
+    fn every_figure_renders() {
+        let dir = std::env::var_os("LOBE_FIGURES_DIR").map_or_else(
+            || std::env::temp_dir().join(format!("lobe-figures-{}", std::process::id())),
+            Into::into,
+        );
+        std::fs::create_dir_all(&dir).unwrap();
+        let curve = |c: f64, slope: f64| -> Vec<(f64, f64)> {
+            (4..=20)
+                .step_by(2)
+                .map(|k| {
+                    let n = f64::from(1u32 << k);
+                    (n, c * n.powf(slope) * (1.0 + 0.1 * f64::from(k).sin()))
+                })
+                .collect()
+        };
+        let series = vec![
+            Series {
+                label: "uniform".into(),
+                points: curve(3.0, -0.5),
+                slope: Some(-0.49),
+            },
+            Series {
+                label: "brdf".into(),
+                points: curve(0.4, -0.5),
+                slope: Some(-0.51),
+            },
+            Series {
+                label: "vndf".into(),
+                points: curve(0.2, -0.5),
+                slope: Some(-0.50),
+            },
+            Series {
+                label: "heavy tail".into(),
+                points: curve(1.0, -0.3),
+                slope: Some(-0.31),
+            },
+            Series {
+                label: "cosine".into(),
+                points: vec![(16.0, 0.0), (1024.0, 0.0)],
+                slope: None,
+            },
+        ];
+        let m = Material::lambert(lobe::Rgb::splat(0.8)).unwrap();
+        let wo = DVec3::new(0.5, 0.0, 0.75f64.sqrt());
+        let (o, e) = projected_histograms(&m, Strategy::Cosine, wo, 10_000, 3, 16);
+        let curves = vec![("a".to_string(), vec![(-1.0, 1.0), (0.0, 2.0), (1.0, 1.0)])];
+        for ext in ["png", "svg"] {
+            let p = |name: &str| dir.join(format!("{name}.{ext}"));
+            convergence_plot(
+                &p("convergence"),
+                "RMSE of the furnace estimate, GGX α = 0.3, θo = 60°",
+                &series,
+            )
+            .unwrap();
+            convergence_plot(&p("convergence-empty"), "no data", &[]).unwrap();
+            polar_plot(&p("polar"), "polar", &curves).unwrap();
+            warp_histogram(&p("histogram"), "cosine", &o, &e, 16, 0.5).unwrap();
+            weight_heatmap(&p("weights"), "weights", &m, Strategy::Uniform, wo, 16).unwrap();
+            for name in [
+                "convergence",
+                "convergence-empty",
+                "polar",
+                "histogram",
+                "weights",
+            ] {
+                assert!(
+                    std::fs::metadata(p(name)).unwrap().len() > 1000,
+                    "{name}.{ext}"
+                );
+            }
+        }
+        assert!(convergence_plot(&dir.join("x.jpg"), "t", &series).is_err());
+        assert!(warp_histogram(&dir.join("h.png"), "t", &o, &e, 15, 0.5).is_err());
+        if std::env::var_os("LOBE_FIGURES_DIR").is_none() {
+            let _ = std::fs::remove_dir_all(&dir);
+        }
+    }
+
+    #[test]
+    fn solid_angles_of_rectangles() {
+        use std::f64::consts::PI;
+        // Points on the rim lose about half the digits (z = sqrt of a rounding error).
+        let close = |a: f64, b: f64| (a - b).abs() < 1e-7 * b.abs().max(1.0);
+        assert!(close(rect_solid_angle(-1.0, 1.0, -1.0, 1.0), 2.0 * PI));
+        assert!(close(rect_solid_angle(0.0, 1.0, 0.0, 1.0), PI / 2.0));
+        assert!(close(rect_solid_angle(-2.0, 3.0, -1.5, 1.5), 2.0 * PI));
+        assert!(close(rect_solid_angle(0.3, 0.5, -1.0, 1.0), PI * 0.2));
+        assert!(close(rect_solid_angle(-1.0, 1.0, -0.7, -0.2), PI * 0.5));
+        assert_eq!(rect_solid_angle(0.8, 1.0, 0.8, 1.0), 0.0);
+        // Against a fine midpoint rule, on a rectangle that crosses the rim.
+        let (x0, x1, y0, y1) = (0.55, 0.8, 0.3, 0.9);
+        let m = 2000;
+        let mut num = 0.0;
+        for i in 0..m {
+            for j in 0..m {
+                let x = x0 + (x1 - x0) * (f64::from(i) + 0.5) / f64::from(m);
+                let y = y0 + (y1 - y0) * (f64::from(j) + 0.5) / f64::from(m);
+                let r2 = x * x + y * y;
+                if r2 < 1.0 {
+                    num += 1.0 / (1.0 - r2).sqrt();
+                }
+            }
+        }
+        num *= (x1 - x0) * (y1 - y0) / f64::from(m * m);
+        let exact = rect_solid_angle(x0, x1, y0, y1);
+        assert!((num / exact - 1.0).abs() < 2e-3, "{num} vs {exact}");
+    }
+
+    /// For a uniform pdf, the expected counts of a column of pixels are
+    /// `N × (x1 − x0) / 2` exactly, rim included.
+    #[test]
+    fn expected_counts_are_accurate_at_the_rim() {
+        let m = Material::lambert(lobe::Rgb::splat(0.8)).unwrap();
+        let wo = DVec3::new(0.0, 0.0, 1.0);
+        let res = 16;
+        let (_, e) = projected_histograms(&m, Strategy::Uniform, wo, 1_000_000, 1, res);
+        for i in 0..res {
+            let column: f64 = (0..res).map(|j| e[j * res + i]).sum();
+            let exact = 1_000_000.0 / res as f64;
+            assert!(
+                (column / exact - 1.0).abs() < 1e-6,
+                "column {i}: {column} vs {exact}"
+            );
+        }
+    }
+
+    #[test]
+    fn histograms_agree_for_cosine_sampling() {
+        let m = Material::lambert(lobe::Rgb::splat(0.8)).unwrap();
+        let wo = DVec3::new(0.5, 0.0, 0.75f64.sqrt());
+        let (o, e) = projected_histograms(&m, Strategy::Cosine, wo, 200_000, 3, 16);
+        let (so, se): (f64, f64) = (o.iter().sum(), e.iter().sum());
+        assert_eq!(so, 200_000.0);
+        assert!((se / 200_000.0 - 1.0).abs() < 2e-3, "{se}");
+    }
+}

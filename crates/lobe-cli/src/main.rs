@@ -11,6 +11,7 @@ mod estimate;
 mod eval;
 mod figures;
 mod plot;
+mod render;
 mod report;
 
 use clap::{Args, Parser, Subcommand};
@@ -39,6 +40,7 @@ enum Command {
     Converge(converge::ConvergeArgs),
     Plot(plot::PlotArgs),
     Report(report::ReportArgs),
+    Render(render::RenderArgs),
 }
 
 /// The arguments of `lobe demo`.
@@ -62,6 +64,7 @@ fn main() -> ExitCode {
         Command::Converge(args) => converge::run(&args),
         Command::Plot(args) => plot::run(&args),
         Command::Report(args) => report::run(&args),
+        Command::Render(args) => render::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -1,16 +1,320 @@
-//! `lobe plot` (being written).
+//! `lobe plot`: pictures of a material and a sampling strategy.
+//!
+//! * `polar`: `f_r` (no cosine) in the plane of incidence for the view
+//!   angles 0, 30, 60 and 80°.
+//! * `histogram`: Nori's warp test, observed against expected sample counts
+//!   over the projected hemisphere, with the p-value of the chi-square test
+//!   of `lobe::stats::chi2`.
+//! * `weights`: the sample weight `f·cos/pdf` over the projected hemisphere.
+//!
+//! The figures themselves are drawn by [`crate::figures`].
 
-use anyhow::Result;
+use crate::common::{ViewArgs, progress};
+use crate::eval::load_material;
+use crate::figures;
+use anyhow::{Context, Result, anyhow, bail};
 use clap::Args;
+use glam::DVec3;
+use lobe::math::luminance;
+use lobe::stats::chi2::{Chi2Config, chi2_test};
+use lobe::{Material, Strategy};
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::time::Duration;
 
+/// Largest accepted `--res`.
+const MAX_RES: usize = 1024;
+
+/// View angles (degrees) of the polar plot.
+const POLAR_VIEWS: [f64; 4] = [0.0, 30.0, 60.0, 80.0];
+
+/// The arguments of `lobe plot`.
 #[derive(Args, Debug)]
+#[command(
+    about = "Draw figures of a material and a sampling strategy (PNG)",
+    long_about = "Draw figures of a material and a sampling strategy as PNG files in --out:\n  \
+        polar      f_r (no cosine) in the plane of incidence at view angles 0, 30, 60, 80°\n             \
+        (ignores --theta/--wo and --strategy)                 -> polar.png\n  \
+        histogram  the warp test: observed against expected sample counts over the\n             \
+        projected hemisphere, with the chi-square p-value     -> histogram-<STRATEGY>.png\n  \
+        weights    the sample weight f·cos θi/pdf over the projected hemisphere,\n             \
+        directions never sampled in red                       -> weights-<STRATEGY>.png\n  \
+        all        the three\n\
+        Prints the paths it wrote, one per line; the chi-square result goes to stderr.",
+    after_help = "Examples:\n  \
+        lobe plot --material '{\"type\":\"cook-torrance\",\"alpha\":0.3}' --theta 60 --strategy vndf --out figs\n  \
+        lobe plot --material '{\"type\":\"phong\",\"exponent\":50}' --strategy uniform --kind weights --out figs\n  \
+        lobe plot --material @gold.toml --wo 0.5,0.2,0.8 --strategy brdf --kind histogram --samples 100000 --out figs"
+)]
 pub struct PlotArgs {
+    /// Material: JSON text, @FILE.json or @FILE.toml (keys: see `lobe eval --help`)
+    #[arg(long, short)]
+    pub material: String,
+    #[command(flatten)]
+    pub view: ViewArgs,
+    /// Sampling strategy: uniform, cosine, brdf, vndf, spherical-caps, bounded-vndf (not used by polar)
+    #[arg(long, short)]
+    pub strategy: Option<String>,
+    /// What to draw: polar, histogram, weights or all
+    #[arg(long, short, default_value = "all")]
+    pub kind: String,
+    /// Directory to write the PNG files to (created if missing)
+    #[arg(long, short)]
+    pub out: PathBuf,
+    /// Samples drawn for the histogram and the chi-square test
+    #[arg(long, short = 'n', default_value_t = 1_000_000)]
+    pub samples: usize,
+    /// Seed of the random stream of the histogram and the chi-square test
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Pixels per side of the histogram and weight maps, 1 to 1024
+    #[arg(long, default_value_t = 64)]
+    pub res: usize,
     /// No progress bars
     #[arg(long, short)]
     pub quiet: bool,
 }
 
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Kind {
+    Polar,
+    Histogram,
+    Weights,
+}
+
+/// Run `lobe plot`.
 pub fn run(args: &PlotArgs) -> Result<()> {
-    let _ = args;
-    anyhow::bail!("lobe plot is not written yet")
+    let kinds: Vec<Kind> = match args.kind.as_str() {
+        "polar" => vec![Kind::Polar],
+        "histogram" => vec![Kind::Histogram],
+        "weights" => vec![Kind::Weights],
+        "all" => vec![Kind::Polar, Kind::Histogram, Kind::Weights],
+        k => bail!("--kind {k}: unknown kind, expected polar, histogram, weights or all"),
+    };
+    let material = load_material(&args.material)?;
+    let wo = args.view.wo()?;
+    let needs_strategy = kinds.iter().any(|&k| k != Kind::Polar);
+    let strategy = match (&args.strategy, needs_strategy) {
+        (Some(s), _) => {
+            let s: Strategy = s.parse().map_err(|_| {
+                anyhow!(
+                    "--strategy {s}: unknown strategy, expected one of: {}",
+                    Strategy::names()
+                )
+            })?;
+            if needs_strategy {
+                material
+                    .check(s)
+                    .map_err(|e| anyhow!("--strategy {s}: {e}"))?;
+            }
+            Some(s)
+        }
+        (None, true) => bail!(
+            "--strategy is needed for --kind {}: one of {}",
+            args.kind,
+            Strategy::names()
+        ),
+        (None, false) => None,
+    };
+    if needs_strategy {
+        if args.samples == 0 && kinds.contains(&Kind::Histogram) {
+            bail!("--samples 0: the histogram needs at least one sample");
+        }
+        if args.res == 0 || args.res > MAX_RES {
+            bail!("--res {}: must be between 1 and {MAX_RES}", args.res);
+        }
+    }
+    prepare_dir(&args.out)?;
+
+    let label = material_label(&args.material, &material);
+    let view = view_label(args, wo);
+    for kind in kinds {
+        match kind {
+            Kind::Polar => {
+                let path = args.out.join("polar.png");
+                let curves = polar_curves(&material);
+                let title =
+                    format!("{label}: f_r (no cosine, luminance) in the plane of incidence");
+                figures::polar_plot_scaled(&path, &title, &curves, figures::PolarScale::PerCurve)?;
+                println!("{}", path.display());
+            }
+            Kind::Histogram => {
+                let s = strategy.expect("checked above");
+                let path = args.out.join(format!("histogram-{s}.png"));
+                histogram(
+                    args,
+                    &material,
+                    s,
+                    wo,
+                    &format!("{label}, {s}, {view}"),
+                    &path,
+                )?;
+                println!("{}", path.display());
+            }
+            Kind::Weights => {
+                let s = strategy.expect("checked above");
+                let path = args.out.join(format!("weights-{s}.png"));
+                let title = format!("{label}, {s}, {view}: sample weight f·cos θi / pdf");
+                figures::weight_heatmap(&path, &title, &material, s, wo, args.res)?;
+                println!("{}", path.display());
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Creates `dir` and checks that a file can be written in it, before any
+/// long computation.
+fn prepare_dir(dir: &Path) -> Result<()> {
+    std::fs::create_dir_all(dir)
+        .with_context(|| format!("--out {}: cannot create the directory", dir.display()))?;
+    let probe = dir.join(format!(".lobe-plot-probe-{}", std::process::id()));
+    std::fs::write(&probe, b"")
+        .with_context(|| format!("--out {}: cannot write in the directory", dir.display()))?;
+    let _ = std::fs::remove_file(&probe);
+    Ok(())
+}
+
+/// A short name of the material for titles: the file name, the JSON text
+/// in one line, or the model name when that is too long.
+fn material_label(arg: &str, m: &Material) -> String {
+    if let Some(path) = arg.strip_prefix('@') {
+        return Path::new(path)
+            .file_name()
+            .map_or_else(|| path.to_string(), |f| f.to_string_lossy().into_owned());
+    }
+    let compact = minify(arg);
+    if compact.chars().count() <= 60 {
+        compact
+    } else {
+        m.model_name().to_string()
+    }
+}
+
+/// JSON text on one line without the blanks outside strings, keys in the
+/// user's order.
+fn minify(json: &str) -> String {
+    let mut out = String::with_capacity(json.len());
+    let (mut in_string, mut escaped) = (false, false);
+    for c in json.trim().chars() {
+        if in_string {
+            out.push(c);
+            if escaped {
+                escaped = false;
+            } else if c == '\\' {
+                escaped = true;
+            } else if c == '"' {
+                in_string = false;
+            }
+        } else if c == '"' {
+            in_string = true;
+            out.push(c);
+        } else if !c.is_whitespace() {
+            out.push(c);
+        }
+    }
+    out
+}
+
+/// `θo = 60°` or `wo = (x, y, z)`.
+fn view_label(args: &PlotArgs, wo: DVec3) -> String {
+    if args.view.wo.is_some() {
+        format!("wo = ({:.3}, {:.3}, {:.3})", wo.x, wo.y, wo.z)
+    } else {
+        format!("θo = {}°", args.view.theta.unwrap_or(30.0))
+    }
+}
+
+/// `f_r` luminance in the plane of incidence, θi in (−90°, 90°) with
+/// negative angles on the viewer's side, for each view angle of
+/// [`POLAR_VIEWS`].
+fn polar_curves(m: &Material) -> Vec<(String, Vec<(f64, f64)>)> {
+    POLAR_VIEWS
+        .iter()
+        .map(|&deg| {
+            let t = deg.to_radians();
+            let wo = DVec3::new(t.sin(), 0.0, t.cos());
+            let pts = (-359..=359)
+                .map(|k| {
+                    let ti = (f64::from(k) * 0.25).to_radians();
+                    // The viewer is on +x, so negative θi means wi.x > 0.
+                    let wi = DVec3::new(-ti.sin(), 0.0, ti.cos());
+                    (ti, luminance(m.eval(wo, wi)))
+                })
+                .collect();
+            (format!("θo = {deg}°"), pts)
+        })
+        .collect()
+}
+
+/// The warp-test figure: histograms, the chi-square test, its summary on
+/// stderr.
+fn histogram(
+    args: &PlotArgs,
+    m: &Material,
+    s: Strategy,
+    wo: DVec3,
+    title: &str,
+    path: &Path,
+) -> Result<()> {
+    let pb = progress(args.samples as u64, "histogram", args.quiet);
+    let (observed, expected) = figures::projected_histograms_with_progress(
+        m,
+        s,
+        wo,
+        args.samples,
+        args.seed,
+        args.res,
+        &|k| pb.inc(k),
+    );
+    pb.finish_and_clear();
+
+    let cfg = Chi2Config {
+        samples: args.samples,
+        seed: args.seed,
+        ..Chi2Config::default()
+    };
+    let pb = progress(args.samples as u64, "chi-square test", args.quiet);
+    let drawn = AtomicU64::new(0);
+    let integrating = AtomicBool::new(false);
+    let result = chi2_test(
+        &cfg,
+        |uc, u| {
+            if drawn.fetch_add(1, Ordering::Relaxed) % 65_536 == 65_535 {
+                pb.inc(65_536);
+            }
+            m.sample(s, wo, uc, u).map(|x| x.wi)
+        },
+        |wi| {
+            // The first pdf call starts the cubature of the expected counts.
+            if !integrating.load(Ordering::Relaxed) && !integrating.swap(true, Ordering::Relaxed) {
+                pb.set_position(args.samples as u64);
+                pb.set_message("chi-square: expected");
+                pb.enable_steady_tick(Duration::from_millis(200));
+            }
+            m.pdf(s, wo, wi)
+        },
+    );
+    pb.finish_and_clear();
+    let verdict = if result.p_value > figures::PASS_LEVEL {
+        "pass"
+    } else {
+        "FAIL"
+    };
+    eprintln!(
+        "chi-square ({} × {} bins over the sphere, {} samples): statistic {:.1}, {} dof, p = {:.4e}: {verdict} at {}%{}",
+        cfg.n_z,
+        cfg.n_phi,
+        cfg.samples,
+        result.statistic,
+        result.dof,
+        result.p_value,
+        figures::PASS_LEVEL * 100.0,
+        result
+            .message
+            .as_deref()
+            .map(|m| format!(" ({m})"))
+            .unwrap_or_default()
+    );
+    figures::warp_histogram(path, title, &observed, &expected, args.res, result.p_value)
 }

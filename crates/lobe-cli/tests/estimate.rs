@@ -71,7 +71,10 @@ fn json_has_every_field_and_estimates_agree_with_the_reference() {
             "brdf",
             "vndf",
             "spherical-caps",
-            "bounded-vndf"
+            "bounded-vndf",
+        "light",
+        "mis",
+        "mis-power"
         ]
     );
     for s in v["strategies"].as_array().unwrap() {

@@ -118,6 +118,12 @@ pub enum Technique {
     Mis(Mis),
 }
 
+impl std::fmt::Display for Technique {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.name())
+    }
+}
+
 impl From<Strategy> for Technique {
     fn from(s: Strategy) -> Self {
         Technique::Bsdf(s)

@@ -1,0 +1,199 @@
+//! `lobe plot` end to end: the built binary writes readable PNGs of the
+//! expected sizes, and refuses bad input with one line and a non-zero exit.
+
+use std::collections::HashSet;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+const GGX: &str = r#"{"type":"cook-torrance","alpha":0.3}"#;
+const PHONG: &str = r#"{"type":"phong","exponent":50}"#;
+
+fn lobe(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_lobe"))
+        .args(args)
+        .output()
+        .expect("the lobe binary runs")
+}
+
+/// A fresh directory under Cargo's temporary directory for the tests.
+fn fresh_dir(name: &str) -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(name);
+    let _ = std::fs::remove_dir_all(&dir);
+    dir
+}
+
+fn stdout_lines(out: &Output) -> Vec<String> {
+    String::from_utf8_lossy(&out.stdout)
+        .lines()
+        .map(str::to_string)
+        .collect()
+}
+
+/// Decodes `path`, checks its size, that it is not one flat colour, and
+/// that the top strip (the title) holds dark pixels: text was drawn.
+fn check_png(path: &Path, size: (u32, u32)) {
+    let img = image::open(path)
+        .unwrap_or_else(|e| panic!("{} does not decode: {e}", path.display()))
+        .to_rgb8();
+    assert_eq!(img.dimensions(), size, "{}", path.display());
+    let colours: HashSet<[u8; 3]> = img.pixels().map(|p| p.0).collect();
+    assert!(
+        colours.len() > 20,
+        "{}: only {} colours",
+        path.display(),
+        colours.len()
+    );
+    let title_ink = (0..img.width())
+        .flat_map(|x| (0..30).map(move |y| (x, y)))
+        .filter(|&(x, y)| img.get_pixel(x, y).0.iter().all(|&c| c < 100))
+        .count();
+    assert!(
+        title_ink > 50,
+        "{}: no title text ({title_ink} dark pixels at the top)",
+        path.display()
+    );
+}
+
+#[test]
+fn all_kinds_write_readable_pngs() {
+    let dir = fresh_dir("plot-all");
+    let d = dir.to_str().unwrap();
+    let out = lobe(&[
+        "plot",
+        "--material",
+        GGX,
+        "--theta",
+        "60",
+        "--strategy",
+        "vndf",
+        "--kind",
+        "all",
+        "--samples",
+        "100000",
+        "--out",
+        d,
+        "--quiet",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let expected = [
+        ("polar.png", (800, 500)),
+        ("histogram-vndf.png", (800, 400)),
+        ("weights-vndf.png", (640, 600)),
+    ];
+    let lines = stdout_lines(&out);
+    assert_eq!(lines.len(), expected.len(), "stdout: {lines:?}");
+    for ((name, size), line) in expected.iter().zip(&lines) {
+        let path = dir.join(name);
+        assert_eq!(Path::new(line), path, "printed path");
+        check_png(&path, *size);
+    }
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("p = "),
+        "the chi-square p-value is reported: {err}"
+    );
+}
+
+#[test]
+fn uniform_sampling_of_phong_and_an_explicit_view() {
+    let dir = fresh_dir("plot-phong");
+    let d = dir.to_str().unwrap();
+    for kind in ["histogram", "weights"] {
+        let out = lobe(&[
+            "plot",
+            "--material",
+            PHONG,
+            "--wo",
+            "0.5,0.2,0.8",
+            "--strategy",
+            "uniform",
+            "--kind",
+            kind,
+            "--samples",
+            "100000",
+            "--res",
+            "32",
+            "--out",
+            d,
+            "-q",
+        ]);
+        assert!(
+            out.status.success(),
+            "{kind}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        assert_eq!(stdout_lines(&out).len(), 1);
+    }
+    check_png(&dir.join("histogram-uniform.png"), (800, 400));
+    check_png(&dir.join("weights-uniform.png"), (640, 600));
+}
+
+#[test]
+fn bad_input_fails_with_one_line() {
+    let dir = fresh_dir("plot-bad");
+    let d = dir.to_str().unwrap();
+    let file = dir.join("a-file");
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(&file, "").unwrap();
+    let under_file = file.join("sub");
+    let under_file = under_file.to_str().unwrap();
+    let cases: Vec<(Vec<&str>, &str)> = vec![
+        (vec!["--kind", "bogus", "--strategy", "vndf"], "--kind"),
+        (vec!["--strategy", "bogus"], "--strategy"),
+        (
+            vec!["--strategy", "spherical-caps", "--material", PHONG],
+            "does not apply",
+        ),
+        (
+            vec![
+                "--strategy",
+                "vndf",
+                "--kind",
+                "histogram",
+                "--samples",
+                "0",
+            ],
+            "--samples",
+        ),
+        (vec!["--strategy", "vndf", "--res", "0"], "--res"),
+        (vec!["--strategy", "vndf", "--res", "1025"], "--res"),
+        (vec!["--strategy", "vndf", "--theta", "90"], "--theta"),
+        (vec!["--strategy", "vndf", "--theta", "-1"], "--theta"),
+        (vec!["--kind", "weights"], "--strategy"),
+        (vec!["--strategy", "vndf", "--material", "{"], "material"),
+        (vec!["--strategy", "vndf", "--out", under_file], "--out"),
+    ];
+    for (extra, needle) in cases {
+        // A case may give its own --material or --out; the defaults are
+        // added only when it does not.
+        let mut full: Vec<&str> = vec!["plot", "-q"];
+        full.extend(&extra);
+        if !extra.contains(&"--material") {
+            full.extend(["--material", GGX]);
+        }
+        if !extra.contains(&"--out") {
+            full.extend(["--out", d]);
+        }
+        let out = lobe(&full);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{full:?}: {err}");
+        assert_eq!(err.trim_end().lines().count(), 1, "{full:?}: {err}");
+        assert!(
+            err.starts_with("lobe: error:") && err.contains(needle),
+            "{full:?}: {err}"
+        );
+        assert!(!err.contains("panicked"), "{full:?}: {err}");
+    }
+}
+
+#[test]
+fn help_shows_an_example() {
+    let out = lobe(&["plot", "--help"]);
+    assert!(out.status.success());
+    let help = String::from_utf8_lossy(&out.stdout);
+    assert!(help.contains("Examples:") && help.contains("lobe plot --material"));
+}

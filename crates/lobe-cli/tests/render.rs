@@ -1,0 +1,206 @@
+//! `lobe render` end to end: both files written and readable, the same
+//! image for any thread count, and one-line errors that name the file, the
+//! line and the field.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn lobe(args: &[&str], cwd: Option<&Path>) -> Output {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_lobe"));
+    c.args(args);
+    if let Some(d) = cwd {
+        c.current_dir(d);
+    }
+    c.output().expect("run lobe")
+}
+
+fn dir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("lobe-cli-render-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+const SCENE: &str = r#"[camera]
+origin = [0, 1, 4]
+target = [0, 1, 0]
+up = [0, 1, 0]
+fov_y = 40
+width = 20
+height = 14
+
+[environment]
+path = "sky"
+scale = 1.0
+rotation_y = 0.0
+
+[[object]]
+type = "sphere"
+center = [0, 1, 0]
+radius = 1
+material = { type = "cook-torrance", distribution = "ggx", alpha = 0.3 }
+
+[[object]]
+type = "plane"
+point = [0, 0, 0]
+normal = [0, 1, 0]
+material = { type = "phong", exponent = 20, kd = 0.4, ks = 0.3 }
+
+[render]
+spp = 64
+strategy = "mis"
+seed = 1
+max_depth = 1
+"#;
+
+fn one_line_error(o: &Output) -> String {
+    assert_eq!(o.status.code(), Some(1), "{o:?}");
+    let e = String::from_utf8(o.stderr.clone()).unwrap();
+    assert_eq!(e.lines().count(), 1, "{e}");
+    assert!(e.starts_with("lobe: error: "), "{e}");
+    e
+}
+
+#[test]
+fn writes_exr_and_png() {
+    let d = dir("out");
+    let scene = d.join("scene.toml");
+    std::fs::write(&scene, SCENE).unwrap();
+    let out = d.join("img");
+    let o = lobe(
+        &[
+            "render",
+            scene.to_str().unwrap(),
+            "--spp",
+            "2",
+            "--out",
+            out.to_str().unwrap(),
+            "--quiet",
+        ],
+        None,
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let png = image::open(d.join("img.png")).unwrap().to_rgb8();
+    assert_eq!(png.dimensions(), (20, 14));
+    // The EXR reads back (as an environment map, the same decoder) with the
+    // size of the image and finite, non-negative values.
+    let (exr, clamped) = lobe_render::load_envmap(&d.join("img.exr"), 1.0, 0.0).unwrap();
+    assert_eq!((exr.size(), clamped), ((20, 14), 0));
+    let sky = (0..20).map(|i| exr.texel(i, 0)).fold(0.0, |a, t| a + t.y);
+    assert!(sky > 0.0);
+
+    // By default the files are named after the scene, in the current
+    // directory; --strategy and --seed override the scene.
+    let o = lobe(
+        &[
+            "render",
+            "scene.toml",
+            "--spp",
+            "1",
+            "--strategy",
+            "vndf",
+            "--seed",
+            "5",
+            "--quiet",
+        ],
+        Some(&d),
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        stdout.contains("vndf") && stdout.contains("1 spp"),
+        "{stdout}"
+    );
+    assert!(d.join("scene.exr").exists() && d.join("scene.png").exists());
+}
+
+#[test]
+fn threads_do_not_change_the_image() {
+    let d = dir("threads");
+    let scene = d.join("s.toml");
+    std::fs::write(&scene, SCENE.replace("max_depth = 1", "max_depth = 4")).unwrap();
+    let mut files = Vec::new();
+    for t in ["1", "2"] {
+        let out = d.join(format!("t{t}"));
+        let o = lobe(
+            &[
+                "render",
+                scene.to_str().unwrap(),
+                "--spp",
+                "3",
+                "--threads",
+                t,
+                "--out",
+                out.to_str().unwrap(),
+                "--quiet",
+            ],
+            None,
+        );
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        files.push(std::fs::read(d.join(format!("t{t}.exr"))).unwrap());
+    }
+    assert_eq!(files[0], files[1]);
+}
+
+#[test]
+fn errors_are_one_line_and_name_file_line_and_field() {
+    let d = dir("errors");
+    let scene = d.join("scene.toml");
+    let run = |text: &str| {
+        std::fs::write(&scene, text).unwrap();
+        let out = d.join("x");
+        one_line_error(&lobe(
+            &[
+                "render",
+                scene.to_str().unwrap(),
+                "--quiet",
+                "--out",
+                out.to_str().unwrap(),
+            ],
+            None,
+        ))
+    };
+    let e = run(&SCENE.replace("radius = 1", "radius = \"a\""));
+    assert!(
+        e.contains(&format!(
+            "{}:17:10: field object[0].radius: invalid type: string \"a\", expected f64",
+            scene.display()
+        )),
+        "{e}"
+    );
+    let e = run(&SCENE.replace("alpha = 0.3", "alpha = 7"));
+    assert!(
+        e.contains("scene.toml:18:") && e.contains("field object[0].material.alpha: "),
+        "{e}"
+    );
+    let e = run(&SCENE.replace("fov_y = 40", "fov_y = 0"));
+    assert!(e.contains("scene.toml:5:9: field camera.fov_y: "), "{e}");
+    let e = run(&SCENE.replace("\"sky\"", "\"forest.hdr\""));
+    assert!(
+        e.contains(&d.join("forest.hdr").display().to_string()),
+        "{e}"
+    );
+    let e = run(&SCENE.replace(
+        "type = \"plane\"\npoint = [0, 0, 0]\nnormal = [0, 1, 0]",
+        "type = \"mesh\"\npath = \"meshes/bunny.obj\"",
+    ));
+    assert!(
+        e.contains(&d.join("meshes/bunny.obj").display().to_string()),
+        "{e}"
+    );
+    assert!(e.contains("field object[1].path"), "{e}");
+    let e = run("[camera\n");
+    assert!(e.contains("scene.toml:1:"), "{e}");
+
+    std::fs::write(&scene, SCENE).unwrap();
+    let e = one_line_error(&lobe(
+        &["render", scene.to_str().unwrap(), "--strategy", "fast"],
+        None,
+    ));
+    assert!(e.contains("--strategy: unknown strategy `fast`"), "{e}");
+    let e = one_line_error(&lobe(
+        &["render", d.join("none.toml").to_str().unwrap()],
+        None,
+    ));
+    assert!(e.contains("none.toml"), "{e}");
+}

@@ -1,0 +1,48 @@
+//! lobe-render: a small renderer that shows `lobe`'s samplers, light
+//! sampling and MIS as images.
+//!
+//! Spheres, infinite planes and OBJ triangle meshes (with a BVH) under an
+//! environment map, the only light, seen by a pinhole camera. Each camera
+//! ray's hit estimates the reflected radiance by BSDF sampling, light
+//! sampling or MIS exactly as `lobe::estimator` does, plus a shadow ray
+//! ([`render`] module docs); `max_depth > 1` adds path tracing.
+//!
+//! ```no_run
+//! use lobe_render::{load_scene, render, RenderOptions};
+//! let scene = load_scene(std::path::Path::new("scene.toml"))?;
+//! let image = render(&scene, &scene.options, |_| {});
+//! image.write_exr(std::path::Path::new("scene.exr"))?;
+//! image.write_png(std::path::Path::new("scene.png"))?;
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+//!
+//! A scene in code:
+//!
+//! ```
+//! use lobe_render::{Camera, Object, RenderOptions, Scene, Method, render};
+//! use lobe::{envmap::EnvMap, Material, Rgb, Strategy};
+//! use glam::DVec3;
+//! let camera = Camera::new(DVec3::new(0.0, 0.0, 4.0), DVec3::ZERO, DVec3::Y, 40.0, 8, 6)?;
+//! let scene = Scene::new(camera, EnvMap::constant(Rgb::ONE))
+//!     .with(Object::sphere(DVec3::ZERO, 1.0, Material::lambert(Rgb::ONE)?)?);
+//! let opts = RenderOptions { spp: 4, method: Method::Bsdf(Strategy::Cosine), ..Default::default() };
+//! let img = render(&scene, &opts, |_| {});
+//! assert!((img.get(4, 3).x - 1.0).abs() < 1e-9); // the white furnace
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+
+pub mod camera;
+pub mod envmap_io;
+pub mod geometry;
+pub mod mesh;
+pub mod output;
+pub mod render;
+pub mod scene;
+
+pub use camera::{Camera, CameraError};
+pub use envmap_io::{LoadError, load_envmap};
+pub use geometry::{Hit, Ray};
+pub use mesh::{Mesh, MeshError};
+pub use output::OutputError;
+pub use render::{Image, Method, RenderOptions, RenderStats, fallbacks, render};
+pub use scene::{Object, Scene, SceneDesc, SceneError, Shape, load_scene, parse_scene, showcase};

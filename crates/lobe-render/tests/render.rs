@@ -1,0 +1,448 @@
+//! The renderer against answers known in closed form: the white furnace,
+//! agreement between techniques, thread-count independence, orientation,
+//! and scene-file errors.
+
+use glam::DVec3;
+use lobe::envmap::EnvMap;
+use lobe::estimator::Heuristic;
+use lobe::{Material, MaterialDesc, Rgb, Strategy};
+use lobe_render::{Camera, Image, Mesh, Method, Object, RenderOptions, Scene, load_scene, render};
+use std::path::PathBuf;
+use std::sync::Arc;
+
+fn lambert(a: f64) -> Material {
+    Material::lambert(Rgb::splat(a)).unwrap()
+}
+
+fn opts(method: Method, spp: u32) -> RenderOptions {
+    RenderOptions {
+        spp,
+        method,
+        seed: 3,
+        max_depth: 1,
+        threads: None,
+    }
+}
+
+/// Pixels whose four corners all see `object` (fully covered pixels).
+fn covered(scene: &Scene, object: usize) -> Vec<(usize, usize)> {
+    let c = &scene.camera;
+    let mut v = Vec::new();
+    for y in 0..c.height as usize {
+        for x in 0..c.width as usize {
+            let all = [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (1.0, 1.0)]
+                .iter()
+                .all(|&(dx, dy)| {
+                    let r = c.ray(x as f64 + dx, y as f64 + dy);
+                    scene
+                        .intersect(&r, f64::INFINITY)
+                        .is_some_and(|(_, o)| o == object)
+                });
+            if all {
+                v.push((x, y));
+            }
+        }
+    }
+    v
+}
+
+/// Mean and standard error of the mean of the luminance of `px` over
+/// `pixels` (each pixel an independent estimate).
+fn mean_se(img: &Image, pixels: &[(usize, usize)], f: impl Fn(Rgb) -> f64) -> (f64, f64) {
+    let v: Vec<f64> = pixels.iter().map(|&(x, y)| f(img.get(x, y))).collect();
+    let n = v.len() as f64;
+    let m = v.iter().sum::<f64>() / n;
+    let var = v.iter().map(|x| (x - m) * (x - m)).sum::<f64>() / (n - 1.0);
+    (m, (var / n).sqrt())
+}
+
+fn furnace_scene(width: u32, height: u32) -> Scene {
+    let camera = Camera::new(
+        DVec3::new(0.0, 0.0, 3.5),
+        DVec3::ZERO,
+        DVec3::Y,
+        40.0,
+        width,
+        height,
+    )
+    .unwrap();
+    Scene::new(camera, EnvMap::constant(Rgb::ONE))
+        .with(Object::sphere(DVec3::ZERO, 1.0, lambert(1.0)).unwrap())
+}
+
+#[test]
+fn white_furnace_every_method() {
+    let scene = furnace_scene(32, 24);
+    let px = covered(&scene, 0);
+    assert!(px.len() > 150, "{} covered pixels", px.len());
+    for method in Method::all() {
+        let img = render(&scene, &opts(method, 16), |_| {});
+        assert_eq!(img.stats.nonfinite, 0);
+        // The background is the environment, 1.
+        assert_eq!(img.get(0, 0), Rgb::ONE, "{method}");
+        // Cosine and brdf sampling of a Lambertian (and the strategies that
+        // fall back to brdf) have weight f cos / p = 1 exactly, and nothing
+        // shadows a lone convex sphere.
+        let exact = matches!(method, Method::Bsdf(s) if s != Strategy::Uniform);
+        for c in 0..3 {
+            let (m, se) = mean_se(&img, &px, |p| p[c]);
+            if exact {
+                for &(x, y) in &px {
+                    let v = img.get(x, y)[c];
+                    assert!((v - 1.0).abs() < 1e-6, "{method}: pixel ({x}, {y}) = {v}");
+                }
+            } else {
+                assert!(se > 0.0, "{method}");
+                assert!(
+                    (m - 1.0).abs() < 4.0 * se,
+                    "{method}: mean {m} ± {se} over {} pixels",
+                    px.len()
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn white_furnace_convex_mesh_is_exact() {
+    // An octahedron with flat faces, white Lambert: every pixel on it is 1.
+    let obj = "v 1 0 0\nv -1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\nv 0 0 -1\n\
+               f 1 3 5\nf 3 2 5\nf 2 4 5\nf 4 1 5\nf 3 1 6\nf 2 3 6\nf 4 2 6\nf 1 4 6\n";
+    let mesh = Arc::new(Mesh::parse_obj(obj).unwrap());
+    let camera = Camera::new(
+        DVec3::new(1.0, 2.0, 3.0),
+        DVec3::ZERO,
+        DVec3::Y,
+        40.0,
+        24,
+        24,
+    )
+    .unwrap();
+    let scene =
+        Scene::new(camera, EnvMap::constant(Rgb::ONE)).with(Object::mesh(mesh, lambert(1.0)));
+    let px = covered(&scene, 0);
+    assert!(px.len() > 100);
+    let img = render(&scene, &opts(Method::Bsdf(Strategy::Cosine), 8), |_| {});
+    for &(x, y) in &px {
+        let v = img.get(x, y);
+        assert!(
+            (v - Rgb::ONE).abs().max_element() < 1e-6,
+            "({x}, {y}) = {v}"
+        );
+    }
+}
+
+#[test]
+fn white_furnace_with_bounces() {
+    // A white sphere above a white plane: with every bounce, the furnace
+    // gives 1 everywhere; depth 32 leaves a negligible truncation.
+    let camera = Camera::new(
+        DVec3::new(0.0, 2.0, 5.0),
+        DVec3::new(0.0, 1.0, 0.0),
+        DVec3::Y,
+        45.0,
+        24,
+        18,
+    )
+    .unwrap();
+    let scene = Scene::new(camera, EnvMap::constant(Rgb::ONE))
+        .with(Object::sphere(DVec3::new(0.0, 1.5, 0.0), 1.0, lambert(1.0)).unwrap())
+        .with(Object::plane(DVec3::ZERO, DVec3::Y, lambert(1.0)).unwrap());
+    let mut px = covered(&scene, 0);
+    px.extend(covered(&scene, 1));
+    for method in [
+        Method::Bsdf(Strategy::Cosine),
+        Method::Light,
+        Method::Mis(Heuristic::Balance),
+        Method::Mis(Heuristic::Power),
+    ] {
+        let o = RenderOptions {
+            max_depth: 32,
+            ..opts(method, 16)
+        };
+        let img = render(&scene, &o, |_| {});
+        let (m, se) = mean_se(&img, &px, |p| p.y);
+        assert!(
+            (m - 1.0).abs() < 4.0 * se + 1e-3,
+            "{method}: mean {m} ± {se}"
+        );
+        // Direct light alone is less than 1 where the sphere and the plane
+        // hide part of the sky from each other.
+        let direct = render(&scene, &opts(method, 16), |_| {});
+        let (md, _) = mean_se(&direct, &px, |p| p.y);
+        assert!(md < m - 0.02, "{method}: direct {md} vs paths {m}");
+    }
+}
+
+/// A smooth environment (no sun): a sky gradient with a warm patch.
+fn smooth_env() -> EnvMap {
+    let (w, h) = (32, 16);
+    let mut t = Vec::new();
+    for j in 0..h {
+        for i in 0..w {
+            let v = j as f64 / h as f64;
+            let u = i as f64 / w as f64;
+            let patch = if (0.2..0.35).contains(&u) && (0.2..0.4).contains(&v) {
+                8.0
+            } else {
+                0.0
+            };
+            t.push(Rgb::new(0.3 + patch, 0.5 + 0.5 * (1.0 - v), 1.0 - 0.7 * v));
+        }
+    }
+    EnvMap::new(w, h, t, 1.0, 30.0).unwrap().0
+}
+
+#[test]
+fn techniques_agree_pixel_by_pixel() {
+    // Every technique estimates the same image: the per-pixel difference of
+    // two renders with different seeds has mean zero.
+    let ggx = MaterialDesc::from_json(
+        r#"{"type":"cook-torrance","distribution":"ggx","alpha":0.25,"kd":0.3}"#,
+    )
+    .unwrap()
+    .build()
+    .unwrap();
+    let camera = Camera::new(
+        DVec3::new(0.0, 1.0, 3.0),
+        DVec3::new(0.0, 0.6, 0.0),
+        DVec3::Y,
+        40.0,
+        24,
+        20,
+    )
+    .unwrap();
+    let scene = Scene::new(camera, smooth_env())
+        .with(Object::sphere(DVec3::new(0.0, 0.6, 0.0), 0.6, ggx).unwrap())
+        .with(Object::plane(DVec3::ZERO, DVec3::Y, lambert(0.5)).unwrap());
+    let mut px = covered(&scene, 0);
+    px.extend(covered(&scene, 1));
+    let reference = render(&scene, &opts(Method::Mis(Heuristic::Balance), 64), |_| {});
+    for method in Method::all() {
+        let mut o = opts(method, 32);
+        o.seed = 11;
+        let img = render(&scene, &o, |_| {});
+        let diff = Image {
+            pixels: img
+                .pixels
+                .iter()
+                .zip(&reference.pixels)
+                .map(|(a, b)| *a - *b)
+                .collect(),
+            ..img.clone()
+        };
+        let (m, se) = mean_se(&diff, &px, lobe::math::luminance);
+        assert!(m.abs() < 4.5 * se, "{method}: mean difference {m} ± {se}");
+    }
+}
+
+#[test]
+fn the_same_image_for_any_thread_count() {
+    let obj = "v -0.5 0 -0.5\nv 0.5 0 -0.5\nv 0 0.9 0\nv 0 0 0.6\n\
+               vn 0 -1 0\nvn 0 1 0\nvn 1 0 0\nvn 0 0 1\n\
+               f 1//1 2//1 4//1\nf 1//2 3//2 2//2\nf 2//3 3//3 4//3\nf 4//4 3//4 1//4\n";
+    let mesh = Arc::new(Mesh::parse_obj(obj).unwrap());
+    let ggx = MaterialDesc::from_json(r#"{"type":"cook-torrance","alpha":0.2}"#)
+        .unwrap()
+        .build()
+        .unwrap();
+    let camera = Camera::new(
+        DVec3::new(0.5, 1.0, 3.0),
+        DVec3::new(0.0, 0.4, 0.0),
+        DVec3::Y,
+        50.0,
+        37,
+        23,
+    )
+    .unwrap();
+    let scene = Scene::new(camera, EnvMap::sky(64, 32, 30.0, 20.0))
+        .with(Object::mesh(mesh, lambert(0.7)))
+        .with(Object::sphere(DVec3::new(-0.9, 0.4, 0.0), 0.4, ggx).unwrap())
+        .with(Object::plane(DVec3::ZERO, DVec3::Y, lambert(0.5)).unwrap());
+    for method in [
+        Method::Mis(Heuristic::Power),
+        Method::Bsdf(Strategy::Vndf),
+        Method::Light,
+    ] {
+        let mut o = opts(method, 4);
+        o.max_depth = 6;
+        let one = render(
+            &scene,
+            &RenderOptions {
+                threads: Some(1),
+                ..o
+            },
+            |_| {},
+        );
+        let two = render(
+            &scene,
+            &RenderOptions {
+                threads: Some(2),
+                ..o
+            },
+            |_| {},
+        );
+        let bits = |i: &Image| -> Vec<u64> {
+            i.pixels
+                .iter()
+                .flat_map(|p| p.to_array().map(f64::to_bits))
+                .collect()
+        };
+        assert_eq!(bits(&one), bits(&two), "{method}");
+        assert_eq!(one.stats, two.stats);
+        let mut o2 = o;
+        o2.seed += 1;
+        assert_ne!(
+            bits(&one),
+            bits(&render(&scene, &o2, |_| {})),
+            "the seed matters"
+        );
+    }
+}
+
+#[test]
+fn right_and_top_of_the_scene_are_right_and_top_of_the_image() {
+    // A black sphere up and to the camera's right, on a white background.
+    let camera = Camera::new(
+        DVec3::new(0.0, 0.0, 5.0),
+        DVec3::ZERO,
+        DVec3::Y,
+        40.0,
+        40,
+        30,
+    )
+    .unwrap();
+    let center = DVec3::new(0.9, 0.6, 0.0);
+    let scene = Scene::new(camera, EnvMap::constant(Rgb::ONE))
+        .with(Object::sphere(center, 0.3, lambert(0.0)).unwrap());
+    let img = render(&scene, &opts(Method::Bsdf(Strategy::Cosine), 4), |_| {});
+    let (mut sx, mut sy, mut n) = (0.0, 0.0, 0.0);
+    for y in 0..img.height {
+        for x in 0..img.width {
+            if img.get(x, y).x < 0.5 {
+                sx += x as f64 + 0.5;
+                sy += y as f64 + 0.5;
+                n += 1.0;
+            }
+        }
+    }
+    assert!(n > 10.0);
+    let (cx, cy) = (sx / n, sy / n);
+    assert!(cx > 0.6 * img.width as f64, "dark centroid x {cx}");
+    assert!(cy < 0.4 * img.height as f64, "dark centroid y {cy}");
+    let (px, py) = scene.camera.project(center).unwrap();
+    assert!((px - cx).abs() < 1.0 && (py - cy).abs() < 1.0);
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("lobe-render-it-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d.join(name)
+}
+
+const SCENE: &str = r#"[camera]
+origin = [0, 1, 4]
+target = [0, 1, 0]
+width = 16
+height = 12
+
+[environment]
+path = "sky"
+
+[[object]]
+type = "sphere"
+center = [0, 1, 0]
+radius = 1
+material = { type = "phong", exponent = 50 }
+
+[[object]]
+type = "mesh"
+path = "tri.obj"
+material = { type = "lambert", albedo = 0.5 }
+
+[render]
+spp = 2
+strategy = "vndf"
+"#;
+
+#[test]
+fn scene_files_load_and_their_errors_name_file_line_and_field() {
+    let dir = tmp("scenes");
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(
+        dir.join("tri.obj"),
+        "v -5 0 -5\nv 5 0 -5\nv 0 0 5\nf 1 2 3\n",
+    )
+    .unwrap();
+    let good = dir.join("good.toml");
+    std::fs::write(&good, SCENE).unwrap();
+    let scene = load_scene(&good).unwrap();
+    assert_eq!(scene.objects.len(), 2);
+    // vndf does not apply to Phong or Lambert: both fall back to brdf.
+    assert_eq!(
+        lobe_render::fallbacks(&scene, scene.options.method).len(),
+        2
+    );
+    let img = render(&scene, &scene.options, |_| {});
+    assert!(img.pixels.iter().all(|p| p.is_finite()));
+
+    let bad = dir.join("bad.toml");
+    std::fs::write(&bad, SCENE.replace("radius = 1", "radius = \"a\"")).unwrap();
+    let e = load_scene(&bad).unwrap_err().to_string();
+    assert_eq!(
+        e,
+        format!(
+            "{}:13:10: field object[0].radius: invalid type: string \"a\", expected f64",
+            bad.display()
+        )
+    );
+    std::fs::write(&bad, SCENE.replace("exponent = 50", "exponent = -50")).unwrap();
+    let e = load_scene(&bad).unwrap_err().to_string();
+    assert!(
+        e.contains("bad.toml:14:") && e.contains("field object[0].material.exponent: "),
+        "{e}"
+    );
+
+    std::fs::write(&bad, SCENE.replace("\"sky\"", "\"maps/forest.hdr\"")).unwrap();
+    let e = load_scene(&bad).unwrap_err().to_string();
+    assert!(e.contains("field environment.path: "), "{e}");
+    assert!(
+        e.contains(&dir.join("maps/forest.hdr").display().to_string()),
+        "{e}"
+    );
+
+    std::fs::write(&bad, SCENE.replace("tri.obj", "bunny.obj")).unwrap();
+    let e = load_scene(&bad).unwrap_err().to_string();
+    assert!(e.contains("field object[1].path: "), "{e}");
+    assert!(
+        e.contains(&dir.join("bunny.obj").display().to_string()),
+        "{e}"
+    );
+
+    std::fs::write(dir.join("broken.obj"), "v 0 0 0\nv 1 0 0\nf 1 2 7\n").unwrap();
+    std::fs::write(&bad, SCENE.replace("tri.obj", "broken.obj")).unwrap();
+    let e = load_scene(&bad).unwrap_err().to_string();
+    assert!(e.contains("broken.obj:3: "), "{e}");
+
+    let e = load_scene(&dir.join("none.toml")).unwrap_err().to_string();
+    assert!(e.contains("none.toml"), "{e}");
+}
+
+#[test]
+fn the_shipped_scenes_and_the_showcase_render() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
+    let file = load_scene(&dir.join("spheres-ground.toml")).unwrap();
+    load_scene(&dir.join("spheres.toml")).unwrap();
+    let built = lobe_render::showcase(32, 24).unwrap();
+    assert_eq!(file.objects.len(), built.objects.len());
+    for (a, b) in file.objects.iter().zip(&built.objects) {
+        assert_eq!(a.material, b.material);
+    }
+    let img = render(&built, &opts(Method::Mis(Heuristic::Power), 2), |_| {});
+    assert!(
+        img.pixels
+            .iter()
+            .all(|p| p.is_finite() && p.min_element() >= 0.0)
+    );
+    assert_eq!(img.stats.camera_rays, 32 * 24 * 2);
+}
