@@ -1,89 +1,330 @@
-//! `lobe demo`: the README's main command. For the lecture's three models it
-//! estimates the light reflected at 30° under a uniform white sky (the
-//! furnace, so the answer is the directional albedo) with uniform hemisphere
-//! sampling and with importance sampling, at the same number of samples, and
-//! prints how far each lands from the quadrature reference.
+//! `lobe demo`: the README's main command, on built-in inputs only.
+//!
+//! 1. A short tour: for the lecture's models (Phong, Blinn-Phong,
+//!    Cook-Torrance with GGX and Beckmann) at θo = 30° under a white
+//!    furnace, uniform hemisphere sampling against the importance samplers
+//!    at the same number of samples ([`crate::estimate::run_table`]).
+//! 2. The showcase: a row of spheres, two of each model, on a grey ground
+//!    under the built-in sky, rendered with BSDF sampling, light sampling
+//!    and MIS at equal samples next to a reference, drawn as the grid of
+//!    `lobe compare` with error maps and RMSE.
 
+use crate::compare::{
+    FigureSpec, Label, Settings, print_table, run_comparison, summary,
+    write_grid, write_json,
+};
+use anyhow::{Context, Result};
+use clap::Args;
 use glam::DVec3;
-use lobe::estimator::{estimate, reference, Plan};
+use lobe::estimator::{Heuristic, Technique};
 use lobe::math::luminance;
+use lobe::sequence::Sequence;
 use lobe::{Light, MaterialDesc, Rgb, Strategy};
+use lobe_render::{Camera, Method, Object, Scene, load_envmap};
+use std::path::{Path, PathBuf};
+use std::time::Instant;
 
-const SAMPLES: usize = 256;
-const RUNS: u64 = 200;
+/// The arguments of `lobe demo`.
+#[derive(Args, Debug)]
+#[command(
+    about = "Tour: uniform against importance sampling, then a rendered showcase",
+    long_about = "The README's main command; it needs no file. First, for the lecture's models \
+                  (Phong n=100, Blinn-Phong n=100, Cook-Torrance GGX and Beckmann alpha=0.2) at \
+                  theta_o = 30° under a white furnace, it estimates the reflected radiance with uniform \
+                  hemisphere sampling and with each importance sampler at the same number of samples, \
+                  and prints the relative error, the per-sample variance and the variance reduction.\n\n\
+                  Then it renders the showcase: eight spheres (Phong n=20 and 300, Blinn-Phong n=80 and \
+                  1200, GGX alpha=0.3 and 0.06, Beckmann gold alpha=0.3 and 0.06) on a grey ground under \
+                  the built-in sky, with brdf, light and mis at 16 samples per pixel next to a mis \
+                  reference at 256, and writes DIR/showcase.png (the renders with their error maps and \
+                  RMSE, as `lobe compare` draws them), DIR/showcase.json (the numbers) and each render \
+                  as DIR/<strategy>.png.",
+    after_help = "Examples:\n  lobe demo\n  lobe demo --out /tmp/demo --quiet"
+)]
+pub struct DemoArgs {
+    /// Directory of the showcase images and numbers
+    #[arg(long, value_name = "DIR", default_value = "lobe-demo")]
+    pub out: PathBuf,
+    /// Everything tiny and fast (a smoke test, not a demonstration)
+    #[arg(long)]
+    pub quick: bool,
+    /// No progress bars
+    #[arg(long, short)]
+    pub quiet: bool,
+}
 
-/// Print the uniform-versus-importance-sampling comparison.
-pub fn run(quiet: bool) -> anyhow::Result<()> {
-    let _ = quiet;
-    let models = [
-        ("Phong n=100", r#"{"type":"phong","exponent":100}"#),
-        (
-            "Blinn-Phong n=100",
-            r#"{"type":"blinn-phong","exponent":100}"#,
-        ),
-        (
-            "Cook-Torrance GGX a=0.2",
-            r#"{"type":"cook-torrance","distribution":"ggx","alpha":0.2}"#,
-        ),
-        (
-            "Cook-Torrance Beckmann a=0.2",
-            r#"{"type":"cook-torrance","distribution":"beckmann","alpha":0.2}"#,
-        ),
-    ];
-    let theta = 30f64.to_radians();
-    let wo = DVec3::new(theta.sin(), 0.0, theta.cos());
+/// Sizes of the run.
+struct Plan {
+    tour_samples: usize,
+    width: u32,
+    height: u32,
+    spp: u32,
+    reference_spp: u32,
+}
+
+impl Plan {
+    fn new(quick: bool) -> Plan {
+        if quick {
+            Plan {
+                tour_samples: 1024,
+                width: 96,
+                height: 30,
+                spp: 2,
+                reference_spp: 16,
+            }
+        } else {
+            Plan {
+                tour_samples: 65536,
+                width: 640,
+                height: 200,
+                spp: 16,
+                reference_spp: 256,
+            }
+        }
+    }
+}
+
+/// The lecture's models of the tour.
+const TOUR: [(&str, &str); 4] = [
+    ("Phong n=100", r#"{"type":"phong","exponent":100}"#),
+    (
+        "Blinn-Phong n=100",
+        r#"{"type":"blinn-phong","exponent":100}"#,
+    ),
+    (
+        "Cook-Torrance GGX α=0.2",
+        r#"{"type":"cook-torrance","distribution":"ggx","alpha":0.2}"#,
+    ),
+    (
+        "Cook-Torrance Beckmann α=0.2",
+        r#"{"type":"cook-torrance","distribution":"beckmann","alpha":0.2}"#,
+    ),
+];
+
+/// Run `lobe demo`.
+pub fn run(args: &DemoArgs) -> Result<()> {
+    let t0 = Instant::now();
+    let plan = Plan::new(args.quick);
+    tour(&plan, args.quiet)?;
+    showcase(&plan, &args.out, args.quiet)?;
+    println!("\ndone in {}", crate::compare::fmt_time(t0.elapsed().as_secs_f64()));
+    Ok(())
+}
+
+fn tour(plan: &Plan, quiet: bool) -> Result<()> {
+    let wo = crate::common::theta_to_wo(30.0)?;
     let light = Light::Constant(Rgb::ONE);
-    println!("lobe demo: L_o = ∫ f_r L_i cos dω at θo = 30° under a white furnace (L_i = 1),");
-    println!("{SAMPLES} samples per estimate, RMSE over {RUNS} independent estimates.\n");
-    println!(
-        "{:<30} {:<15} {:>10} {:>10} {:>10} {:>12} {:>10}",
-        "model", "strategy", "reference", "estimate", "RMSE", "variance", "vs uniform"
-    );
-    for (label, json) in models {
+    let n = plan.tour_samples;
+    println!("lobe demo, part 1: L_o = ∫ f_r L_i cos dω at θo = 30° under a white furnace (L_i = 1),");
+    println!("so L_o is the directional albedo. Each strategy gets {n} samples; the reference is");
+    println!("adaptive quadrature. 'vs uniform' is uniform's variance over this strategy's: how many");
+    println!("times fewer samples it needs for the same noise.\n");
+    for (label, json) in TOUR {
         let m = MaterialDesc::from_json(json)?.build()?;
-        let r = luminance(reference(&m, wo, &light, 1e-8));
-        let mut uniform_var = None;
-        for s in m.strategies() {
-            if s == Strategy::Cosine {
-                continue;
-            }
-            let mut sq = 0.0;
-            let mut var = 0.0;
-            let mut first = 0.0;
-            for run in 0..RUNS {
-                let acc = estimate(&m, wo, &light, &Plan::independent(s, SAMPLES, run));
-                let e = luminance(acc.mean());
-                if run == 0 {
-                    first = e;
-                }
-                sq += (e - r) * (e - r);
-                var += acc.lum.variance();
-            }
-            let rmse = (sq / RUNS as f64).sqrt();
-            let var = var / RUNS as f64;
-            let base = *uniform_var.get_or_insert(var);
-            let reduction = if var > 0.0 {
-                format!("{:.1}x", base / var)
-            } else {
-                "exact".into()
-            };
+        let techniques: Vec<Technique> = m
+            .strategies()
+            .into_iter()
+            .filter(|s| *s != Strategy::Cosine)
+            .map(Technique::from)
+            .collect();
+        let table = crate::estimate::run_table(
+            &m,
+            wo,
+            &light,
+            &techniques,
+            Sequence::Independent,
+            n,
+            1,
+            quiet,
+        );
+        println!(
+            "{label}: reference {:.5}",
+            luminance(Rgb::from_array(table.reference))
+        );
+        println!(
+            "  {:<15} {:>10} {:>10} {:>11} {:>11}",
+            "strategy", "estimate", "rel. err", "variance", "vs uniform"
+        );
+        for r in &table.strategies {
+            let red = r
+                .variance_reduction
+                .map_or("zero var".to_string(), |x| format!("{x:.1}x"));
             println!(
-                "{label:<30} {:<15} {r:>10.5} {first:>10.5} {rmse:>10.5} {var:>12.4e} {reduction:>10}",
-                s.name()
+                "  {:<15} {:>10.5} {:>10.2e} {:>11.3e} {:>11}",
+                r.name,
+                luminance(Rgb::from_array(r.mean)),
+                r.relative_error,
+                r.variance,
+                red
             );
         }
-        println!();
     }
     println!(
-        "'variance' is the per-sample variance of f·L·cos/p; 'vs uniform' is uniform's variance over this one,"
-    );
-    println!("the factor by which importance sampling cuts the samples needed for the same noise.");
-    println!(
-        "brdf is the lecture's sampler (Phong: lobe around the mirror direction; Blinn-Phong: half vector"
+        "\nbrdf is the lecture's sampler (Phong: a lobe about the mirror direction; Blinn-Phong: the half"
     );
     println!(
-        "with the 1/(4 v·h) Jacobian; Cook-Torrance: D(h) cos θh); vndf, spherical-caps and bounded-vndf"
+        "vector with the 1/(4 v·h) Jacobian; Cook-Torrance: D(h) cos θh); vndf, spherical-caps and"
     );
-    println!("sample only the microfacets the viewer sees.");
+    println!("bounded-vndf sample only the microfacets the viewer sees.");
+    println!(
+        "More: `lobe estimate --help` (any material, light and view), `lobe report --out report`"
+    );
+    println!("(the full report with figures), `lobe compare --help` (your own scene).\n");
+    Ok(())
+}
+
+/// The showcase's spheres, two per model: the model, the parameter, the
+/// material.
+const SPHERES: [(&str, &str, &str); 8] = [
+    (
+        "Phong",
+        "n = 20",
+        r#"{"type":"phong","exponent":20,"kd":[0.45,0.1,0.07],"ks":0.45}"#,
+    ),
+    (
+        "Phong",
+        "n = 300",
+        r#"{"type":"phong","exponent":300,"kd":[0.45,0.1,0.07],"ks":0.45}"#,
+    ),
+    (
+        "Blinn-Phong",
+        "n = 80",
+        r#"{"type":"blinn-phong","exponent":80,"kd":[0.1,0.4,0.12],"ks":0.45}"#,
+    ),
+    (
+        "Blinn-Phong",
+        "n = 1200",
+        r#"{"type":"blinn-phong","exponent":1200,"kd":[0.1,0.4,0.12],"ks":0.45}"#,
+    ),
+    (
+        "GGX",
+        "α = 0.3",
+        r#"{"type":"cook-torrance","distribution":"ggx","alpha":0.3,"kd":[0.08,0.18,0.5],"ks":0.6}"#,
+    ),
+    (
+        "GGX",
+        "α = 0.06",
+        r#"{"type":"cook-torrance","distribution":"ggx","alpha":0.06,"kd":[0.08,0.18,0.5],"ks":0.6}"#,
+    ),
+    (
+        "Beckmann (gold)",
+        "α = 0.3",
+        r#"{"type":"cook-torrance","distribution":"beckmann","alpha":0.3,"fresnel":{"type":"conductor"}}"#,
+    ),
+    (
+        "Beckmann (gold)",
+        "α = 0.06",
+        r#"{"type":"cook-torrance","distribution":"beckmann","alpha":0.06,"fresnel":{"type":"conductor"}}"#,
+    ),
+];
+
+const SPACING: f64 = 1.2;
+const RADIUS: f64 = 0.5;
+
+/// The showcase scene at `width × height`, and the labels under the
+/// spheres (in pixels of the render).
+fn showcase_scene(width: u32, height: u32) -> Result<(Scene, Vec<Label>)> {
+    let camera = Camera::new(
+        DVec3::new(0.0, 1.5, 9.5),
+        DVec3::new(0.0, 0.42, 0.0),
+        DVec3::Y,
+        18.0,
+        width,
+        height,
+    )?;
+    let (sky, _) = load_envmap(Path::new("sky"), 1.0, 0.0)?;
+    let mut scene = Scene::new(camera, sky);
+    let mut labels = Vec::new();
+    let x0 = -0.5 * SPACING * (SPHERES.len() - 1) as f64;
+    for (k, (model, param, json)) in SPHERES.iter().enumerate() {
+        let m = MaterialDesc::from_json(json)?.build()?;
+        let c = DVec3::new(x0 + SPACING * k as f64, RADIUS, 0.0);
+        scene = scene.with(Object::sphere(c, RADIUS, m)?);
+        // On the ground in front of the sphere: its parameter, and below,
+        // between the two spheres of a model, the model's name.
+        if let Some((x, y)) = camera.project(DVec3::new(c.x, 0.0, 0.9)) {
+            labels.push(Label {
+                x,
+                y,
+                text: (*param).to_string(),
+            });
+        }
+        if k % 2 == 1
+            && let Some((x, y)) = camera.project(DVec3::new(c.x - 0.5 * SPACING, 0.0, 2.0))
+        {
+            labels.push(Label {
+                x,
+                y,
+                text: (*model).to_string(),
+            });
+        }
+    }
+    let ground = MaterialDesc::from_json(r#"{"type":"lambert","albedo":0.5}"#)?.build()?;
+    scene = scene.with(Object::plane(DVec3::ZERO, DVec3::Y, ground)?);
+    Ok((scene, labels))
+}
+
+fn showcase(plan: &Plan, dir: &Path, quiet: bool) -> Result<()> {
+    let (scene, labels) = showcase_scene(plan.width, plan.height)?;
+    let settings = Settings {
+        methods: vec![
+            Method::Bsdf(Strategy::Brdf),
+            Method::Light,
+            Method::Mis(Heuristic::Balance),
+        ],
+        spp: plan.spp,
+        reference_spp: plan.reference_spp,
+        seed: 1,
+        max_depth: 1,
+        threads: None,
+        equal_time: false,
+        quiet,
+    };
+    println!(
+        "lobe demo, part 2: the showcase, {}×{}: eight spheres (Phong, Blinn-Phong, GGX, Beckmann gold; a",
+        plan.width, plan.height
+    );
+    println!(
+        "broad and a sharp lobe each) on a grey ground under the built-in sky with its sun, rendered by"
+    );
+    println!(
+        "BSDF sampling (brdf), light sampling and MIS at {} spp; the reference is MIS at {} spp.",
+        settings.spp, settings.reference_spp
+    );
+    std::fs::create_dir_all(dir)
+        .with_context(|| format!("{}: cannot create the directory", dir.display()))?;
+    let cmp = run_comparison(&scene, &settings);
+    let png = dir.join("showcase.png");
+    let json = dir.join("showcase.json");
+    let figure = write_grid(
+        &png,
+        &FigureSpec {
+            title: format!(
+                "lobe demo: BSDF sampling, light sampling and MIS at {} spp under the built-in sky ({}×{}, direct light)",
+                settings.spp, plan.width, plan.height
+            ),
+            cmp: &cmp,
+            labels,
+        },
+    )?;
+    write_json(&json, &summary("built-in showcase", &settings, &cmp, figure))?;
+    let mut renders = vec![dir.join("reference.png")];
+    cmp.reference.image.write_png(&renders[0])?;
+    for s in &cmp.equal_samples {
+        let p = dir.join(format!("{}.png", s.method.name()));
+        s.image.write_png(&p)?;
+        renders.push(p);
+    }
+    print_table(&cmp);
+    println!(
+        "\nwrote {} (the renders with their error maps) and {} (the numbers),",
+        png.display(),
+        json.display()
+    );
+    let names: Vec<String> = renders
+        .iter()
+        .map(|p| p.file_name().unwrap_or_default().to_string_lossy().into_owned())
+        .collect();
+    println!("and the renders {} in {}", names.join(", "), dir.display());
     Ok(())
 }

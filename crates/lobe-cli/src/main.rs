@@ -5,6 +5,7 @@
 //! errors exit 2).
 
 mod common;
+mod compare;
 mod converge;
 mod demo;
 mod estimate;
@@ -14,7 +15,7 @@ mod plot;
 mod render;
 mod report;
 
-use clap::{Args, Parser, Subcommand};
+use clap::{Parser, Subcommand};
 use std::process::ExitCode;
 
 #[derive(Parser, Debug)]
@@ -34,37 +35,27 @@ struct Cli {
 
 #[derive(Subcommand, Debug)]
 enum Command {
-    Demo(DemoArgs),
+    Demo(demo::DemoArgs),
     Eval(eval::EvalArgs),
     Estimate(estimate::EstimateArgs),
     Converge(converge::ConvergeArgs),
     Plot(plot::PlotArgs),
     Report(report::ReportArgs),
     Render(render::RenderArgs),
-}
-
-/// The arguments of `lobe demo`.
-#[derive(Args, Debug)]
-#[command(
-    about = "Compare uniform sampling with importance sampling",
-    after_help = "Example:\n  lobe demo --quiet"
-)]
-struct DemoArgs {
-    /// Print less
-    #[arg(long, short)]
-    quiet: bool,
+    Compare(compare::CompareArgs),
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
-        Command::Demo(args) => demo::run(args.quiet),
+        Command::Demo(args) => demo::run(&args),
         Command::Eval(args) => eval::run(&args),
         Command::Estimate(args) => estimate::run(&args),
         Command::Converge(args) => converge::run(&args),
         Command::Plot(args) => plot::run(&args),
         Command::Report(args) => report::run(&args),
         Command::Render(args) => render::run(&args),
+        Command::Compare(args) => compare::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -5,10 +5,10 @@
 //! environment map, the only light, seen by a pinhole camera. Each camera
 //! ray's hit estimates the reflected radiance by BSDF sampling, light
 //! sampling or MIS exactly as `lobe::estimator` does, plus a shadow ray
-//! ([`render`] module docs); `max_depth > 1` adds path tracing.
+//! ([`mod@render`] module docs); `max_depth > 1` adds path tracing.
 //!
 //! ```no_run
-//! use lobe_render::{load_scene, render, RenderOptions};
+//! use lobe_render::{load_scene, render};
 //! let scene = load_scene(std::path::Path::new("scene.toml"))?;
 //! let image = render(&scene, &scene.options, |_| {});
 //! image.write_exr(std::path::Path::new("scene.exr"))?;

@@ -214,7 +214,18 @@ impl MaterialDesc {
             _ => {
                 let ndf: Ndf = self.distribution.as_deref().unwrap_or("ggx").parse()?;
                 let (ax, ay) = self.alphas()?;
-                let mf = Microfacet::new(ndf, ax, ay)?;
+                let mf = Microfacet::new(ndf, ax, ay).map_err(|e| match e {
+                    // Name the key the user wrote.
+                    Error::Param { message, .. } if self.alpha.is_some() => Error::Param {
+                        field: "alpha".into(),
+                        message,
+                    },
+                    Error::Param { message, .. } if self.roughness.is_some() => Error::Param {
+                        field: "roughness".into(),
+                        message: format!("gives {message} (alpha = roughness²)"),
+                    },
+                    e => e,
+                })?;
                 let shadowing: Shadowing = self
                     .shadowing
                     .as_deref()
@@ -394,7 +405,11 @@ mod tests {
     #[test]
     fn bad_input_names_the_field() {
         assert!(err(r#"{"type":"phong","exponent":-1}"#).contains("`exponent`"));
-        assert!(err(r#"{"type":"cook-torrance","alpha":-0.1}"#).contains("alpha"));
+        assert!(err(r#"{"type":"cook-torrance","alpha":-0.1}"#).contains("`alpha`:"));
+        assert!(err(r#"{"type":"cook-torrance","roughness":2}"#).contains("`roughness`:"));
+        assert!(
+            err(r#"{"type":"cook-torrance","alpha_u":0.1,"alpha_v":9}"#).contains("`alpha_v`:")
+        );
         assert!(
             err(r#"{"type":"cook-torrance","distribution":"ggz"}"#)
                 .contains("`distribution`: unknown value `ggz`")

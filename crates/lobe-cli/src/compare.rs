@@ -1,0 +1,1293 @@
+//! `lobe compare`: render one scene under several strategies, at equal
+//! samples and at equal time, next to a high-spp reference, and draw one
+//! grid of the renders with their per-pixel error maps and RMSE.
+//!
+//! The pieces are public to the crate so that `lobe demo` can run the same
+//! comparison on its built-in showcase and draw the same grid:
+//! [`run_comparison`], [`write_grid`], [`summary`].
+//!
+//! * **RMSE**: the root mean square, over all pixels and the three channels,
+//!   of the linear RGB difference from the reference.
+//! * **Error map**: per pixel, the relative error of luminance
+//!   `|Y − Y_ref| / (Y_ref + ε)`, with `ε` 1 % of the reference's mean
+//!   luminance (so that black pixels do not divide by zero), on one
+//!   logarithmic colour scale shared by every map of the figure.
+//! * **Equal time**: the budget is the wall time of `mis` at equal samples
+//!   (of the slowest strategy when `mis` is not compared). Each strategy's
+//!   equal-samples render is its pilot: its time per sample per pixel gives
+//!   the spp that fit in the budget (at least 1), and the strategy is
+//!   rendered again with that spp.
+//! * **Reference**: `mis` at the reference spp, with the bitwise complement
+//!   of the seed, so that its samples are independent of the compared
+//!   renders' (the same seed would make `mis`'s first samples the
+//!   reference's own and flatter its error).
+
+use crate::common::progress;
+use crate::figures::viridis;
+use anyhow::{Result, anyhow, bail};
+use clap::Args;
+use lobe::Strategy;
+use lobe::estimator::Heuristic;
+use lobe::math::luminance;
+use lobe_render::{Image, Method, RenderOptions, Scene, fallbacks, load_scene, render};
+use plotters::coord::Shift;
+use plotters::element::BitMapElement;
+use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
+use serde::Serialize;
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
+use std::time::Instant;
+
+/// The arguments of `lobe compare`.
+#[derive(Args, Debug)]
+#[command(
+    about = "Compare strategies on a scene at equal samples and equal time, with error maps",
+    long_about = "Render a scene file (the format of `lobe render --help`) with each strategy twice: at \
+                  equal samples (every strategy at --spp) and at equal time (every strategy with as many \
+                  samples per pixel as fit in the time mis took at --spp, or the slowest strategy when mis \
+                  is not compared; each strategy's equal-samples render is the pilot that measures its \
+                  time per sample). A reference is rendered with mis at --reference-spp, from an \
+                  independent seed.\n\n\
+                  Writes NAME.png, one figure: the reference, and for each strategy and each row (equal \
+                  samples, equal time) the render (tone-mapped as `lobe render`'s PNG) with its per-pixel \
+                  error map: the relative error of luminance |Y - Y_ref| / (Y_ref + eps), eps = 1% of the \
+                  reference's mean luminance, on one logarithmic colour scale shared by every map. Each \
+                  caption gives the strategy, spp, wall time and RMSE (over all pixels and the three \
+                  channels of linear RGB, against the reference). NAME.json holds the numbers: \
+                  {\"reference\":{\"spp\",\"time_s\",..},\"equal_samples\":[{\"strategy\",\"spp\",\"time_s\",\
+                  \"rmse\"}],\"equal_time\":[..],..}.\n\n\
+                  The renders are the same for a given seed and spp on any thread count; the equal-time \
+                  spp depend on the measured times.",
+    after_help = "Examples:\n  \
+                  lobe compare scene.toml --spp 16 --out cmp\n  \
+                  lobe compare scene.toml --strategies brdf,light,mis,mis-power --reference-spp 4096 --threads 2"
+)]
+pub struct CompareArgs {
+    /// The scene file (TOML; `lobe render --help` shows the format)
+    pub scene: PathBuf,
+    /// Samples per pixel of the equal-samples row (default: the scene's render.spp)
+    #[arg(long)]
+    pub spp: Option<u32>,
+    /// Seed of the random streams (default: the scene's render.seed)
+    #[arg(long)]
+    pub seed: Option<u64>,
+    /// Worker threads (default: one per core)
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=4096))]
+    pub threads: Option<u32>,
+    /// Output name: writes NAME.png and NAME.json (default: the scene file's
+    /// stem followed by -compare, in the current directory)
+    #[arg(long, value_name = "NAME")]
+    pub out: Option<PathBuf>,
+    /// Samples per pixel of the mis reference (default: 16 × spp, at least 1024)
+    #[arg(long, value_name = "R")]
+    pub reference_spp: Option<u32>,
+    /// Comma-separated strategies: uniform, cosine, brdf, vndf, spherical-caps,
+    /// bounded-vndf, light, mis, mis-power (default: brdf, light, mis, and vndf
+    /// when an object's material has it)
+    #[arg(long, value_name = "LIST")]
+    pub strategies: Option<String>,
+    /// No progress bars and no notes
+    #[arg(long, short)]
+    pub quiet: bool,
+}
+
+/// The method of the reference render.
+pub const REFERENCE_METHOD: Method = Method::Mis(Heuristic::Balance);
+
+/// Most samples per pixel an equal-time render may take.
+const MAX_EQUAL_TIME_SPP: f64 = 1_048_576.0;
+
+/// What to compare and how.
+#[derive(Debug, Clone)]
+pub struct Settings {
+    pub methods: Vec<Method>,
+    /// Samples per pixel at equal samples.
+    pub spp: u32,
+    pub reference_spp: u32,
+    pub seed: u64,
+    pub max_depth: u32,
+    pub threads: Option<usize>,
+    /// Render the equal-time row too.
+    pub equal_time: bool,
+    pub quiet: bool,
+}
+
+/// One render of a comparison.
+#[derive(Debug, Clone)]
+pub struct Shot {
+    pub method: Method,
+    pub spp: u32,
+    /// Wall time of the render.
+    pub time_s: f64,
+    /// Against the reference (0 for the reference itself).
+    pub rmse: f64,
+    pub image: Image,
+}
+
+/// The equal-time row.
+#[derive(Debug, Clone)]
+pub struct EqualTime {
+    /// The time each strategy was given.
+    pub budget_s: f64,
+    /// Where the budget comes from, e.g. `mis at 16 spp`.
+    pub budget_from: String,
+    pub shots: Vec<Shot>,
+}
+
+/// Every render of a comparison.
+#[derive(Debug, Clone)]
+pub struct Comparison {
+    pub reference: Shot,
+    pub reference_seed: u64,
+    pub equal_samples: Vec<Shot>,
+    pub equal_time: Option<EqualTime>,
+}
+
+/// The default strategies for `scene`: brdf, vndf (when an object's
+/// material has it), light and mis.
+#[must_use]
+pub fn default_methods(scene: &Scene) -> Vec<Method> {
+    let mut v = vec![Method::Bsdf(Strategy::Brdf)];
+    if scene
+        .objects
+        .iter()
+        .any(|o| o.material.check(Strategy::Vndf).is_ok())
+    {
+        v.push(Method::Bsdf(Strategy::Vndf));
+    }
+    v.extend([Method::Light, Method::Mis(Heuristic::Balance)]);
+    v
+}
+
+/// Parse `--strategies`: a comma-separated list of method names, each once.
+pub fn parse_methods(spec: &str) -> Result<Vec<Method>> {
+    let mut v = Vec::new();
+    for name in spec.split(',').map(str::trim) {
+        if name.is_empty() {
+            bail!(
+                "--strategies {spec}: an empty name; expected a comma-separated list of: {}",
+                Method::NAMES
+            );
+        }
+        let m: Method = name.parse().map_err(|e| anyhow!("--strategies: {e}"))?;
+        if !v.contains(&m) {
+            v.push(m);
+        }
+    }
+    Ok(v)
+}
+
+/// The seed of the reference: the complement of `seed`, so that its pixel
+/// streams are independent of the compared renders'.
+#[must_use]
+pub fn reference_seed(seed: u64) -> u64 {
+    !seed
+}
+
+/// The default reference spp: 16 × `spp`, at least 1024.
+#[must_use]
+pub fn default_reference_spp(spp: u32) -> u32 {
+    spp.saturating_mul(16).max(1024)
+}
+
+fn render_one(
+    scene: &Scene,
+    s: &Settings,
+    method: Method,
+    spp: u32,
+    seed: u64,
+    what: &str,
+) -> (Image, f64) {
+    let opts = RenderOptions {
+        spp,
+        method,
+        seed,
+        max_depth: s.max_depth,
+        threads: s.threads,
+    };
+    let pixels = u64::from(scene.camera.width) * u64::from(scene.camera.height);
+    let pb = progress(pixels, &format!("{what}: {method} {spp} spp"), s.quiet);
+    let t0 = Instant::now();
+    let image = render(scene, &opts, |n| pb.inc(n));
+    let time = t0.elapsed().as_secs_f64();
+    pb.finish_and_clear();
+    if image.stats.nonfinite > 0 {
+        eprintln!(
+            "lobe: warning: {method} at {spp} spp: {} path samples were not finite numbers and counted as 0",
+            image.stats.nonfinite
+        );
+    }
+    (image, time)
+}
+
+/// Render every strategy at equal samples (and at equal time when
+/// `s.equal_time`), then the reference, and measure each render's RMSE.
+#[must_use]
+pub fn run_comparison(scene: &Scene, s: &Settings) -> Comparison {
+    let spp = s.spp.max(1);
+    let mut equal_samples = Vec::new();
+    for &m in &s.methods {
+        let (image, time_s) = render_one(scene, s, m, spp, s.seed, "equal samples");
+        equal_samples.push(Shot {
+            method: m,
+            spp,
+            time_s,
+            rmse: f64::NAN,
+            image,
+        });
+    }
+    let equal_time = s.equal_time.then(|| {
+        let mis = equal_samples
+            .iter()
+            .find(|x| x.method == Method::Mis(Heuristic::Balance));
+        let (budget_s, budget_from) = match mis {
+            Some(x) => (x.time_s, format!("the time of mis at {spp} spp")),
+            None => {
+                let slowest = equal_samples
+                    .iter()
+                    .max_by(|a, b| a.time_s.total_cmp(&b.time_s))
+                    .expect("at least one strategy");
+                (
+                    slowest.time_s,
+                    format!("the time of {} at {spp} spp, the slowest", slowest.method),
+                )
+            }
+        };
+        let shots = equal_samples
+            .iter()
+            .map(|pilot| {
+                let per_spp = pilot.time_s.max(1e-9) / f64::from(spp);
+                let n = (budget_s / per_spp).round().clamp(1.0, MAX_EQUAL_TIME_SPP) as u32;
+                if n == spp {
+                    return pilot.clone();
+                }
+                let (image, time_s) = render_one(scene, s, pilot.method, n, s.seed, "equal time");
+                Shot {
+                    method: pilot.method,
+                    spp: n,
+                    time_s,
+                    rmse: f64::NAN,
+                    image,
+                }
+            })
+            .collect();
+        EqualTime {
+            budget_s,
+            budget_from,
+            shots,
+        }
+    });
+    let seed = reference_seed(s.seed);
+    let (image, time_s) = render_one(
+        scene,
+        s,
+        REFERENCE_METHOD,
+        s.reference_spp.max(1),
+        seed,
+        "reference",
+    );
+    let reference = Shot {
+        method: REFERENCE_METHOD,
+        spp: s.reference_spp.max(1),
+        time_s,
+        rmse: 0.0,
+        image,
+    };
+    let mut cmp = Comparison {
+        reference,
+        reference_seed: seed,
+        equal_samples,
+        equal_time,
+    };
+    let r = cmp.reference.image.clone();
+    for shot in cmp.shots_mut() {
+        shot.rmse = rmse(&shot.image, &r);
+    }
+    cmp
+}
+
+impl Comparison {
+    /// The rows of the figure: equal samples, then equal time if rendered.
+    #[must_use]
+    pub fn sections(&self) -> Vec<(String, &[Shot])> {
+        let spp = self.equal_samples.first().map_or(0, |s| s.spp);
+        let mut v = vec![(
+            format!("Equal samples: {spp} spp each"),
+            self.equal_samples.as_slice(),
+        )];
+        if let Some(et) = &self.equal_time {
+            v.push((
+                format!(
+                    "Equal time: {} each ({})",
+                    fmt_time(et.budget_s),
+                    et.budget_from
+                ),
+                et.shots.as_slice(),
+            ));
+        }
+        v
+    }
+
+    fn shots_mut(&mut self) -> impl Iterator<Item = &mut Shot> {
+        self.equal_samples.iter_mut().chain(
+            self.equal_time
+                .as_mut()
+                .map(|e| e.shots.iter_mut())
+                .into_iter()
+                .flatten(),
+        )
+    }
+}
+
+/// Root mean square over all pixels and channels of the linear RGB
+/// difference `a − reference`.
+#[must_use]
+pub fn rmse(a: &Image, reference: &Image) -> f64 {
+    let n = a.pixels.len().min(reference.pixels.len());
+    if n == 0 {
+        return 0.0;
+    }
+    let sum: f64 = a
+        .pixels
+        .iter()
+        .zip(&reference.pixels)
+        .map(|(p, r)| (*p - *r).length_squared())
+        .sum();
+    (sum / (3 * n) as f64).sqrt()
+}
+
+/// `ε` of the error maps: 1 % of the reference's mean luminance (1e-6 when
+/// the reference is black).
+#[must_use]
+pub fn error_epsilon(reference: &Image) -> f64 {
+    let n = reference.pixels.len().max(1) as f64;
+    let mean = reference
+        .pixels
+        .iter()
+        .map(|p| luminance(*p).max(0.0))
+        .sum::<f64>()
+        / n;
+    if mean > 0.0 && mean.is_finite() {
+        0.01 * mean
+    } else {
+        1e-6
+    }
+}
+
+/// Per pixel, `|Y − Y_ref| / (Y_ref + ε)` of luminance.
+#[must_use]
+pub fn error_map(image: &Image, reference: &Image, eps: f64) -> Vec<f64> {
+    image
+        .pixels
+        .iter()
+        .zip(&reference.pixels)
+        .map(|(p, r)| {
+            let yr = luminance(*r).max(0.0);
+            (luminance(*p) - yr).abs() / (yr + eps)
+        })
+        .collect()
+}
+
+/// A logarithmic colour scale from `lo` to `hi` (both powers of ten).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct LogScale {
+    pub lo: f64,
+    pub hi: f64,
+}
+
+/// Decades the error colour scale spans.
+const SCALE_DECADES: i32 = 4;
+
+impl LogScale {
+    /// The scale of `maps`: its top is the power of ten at or above the
+    /// 99.9th percentile of the positive values, and it spans
+    /// [`SCALE_DECADES`] decades.
+    #[must_use]
+    pub fn of(maps: &[Vec<f64>]) -> LogScale {
+        let mut v: Vec<f64> = maps
+            .iter()
+            .flatten()
+            .copied()
+            .filter(|x| *x > 0.0 && x.is_finite())
+            .collect();
+        let top = if v.is_empty() {
+            0
+        } else {
+            let k = ((v.len() - 1) as f64 * 0.999).round() as usize;
+            let (_, p, _) = v.select_nth_unstable_by(k, f64::total_cmp);
+            p.log10().ceil() as i32
+        };
+        LogScale {
+            lo: 10f64.powi(top - SCALE_DECADES),
+            hi: 10f64.powi(top),
+        }
+    }
+
+    /// Position of `x` on the scale, clamped to [0, 1].
+    #[must_use]
+    pub fn t(&self, x: f64) -> f64 {
+        if !(x > self.lo) {
+            return 0.0;
+        }
+        ((x.log10() - self.lo.log10()) / (self.hi.log10() - self.lo.log10())).clamp(0.0, 1.0)
+    }
+}
+
+// ---------------------------------------------------------------------------
+// The figure
+// ---------------------------------------------------------------------------
+
+/// A text label drawn on the reference render at pixel `(x, y)` of the
+/// render (centred there; `\n` separates lines).
+#[derive(Debug, Clone)]
+pub struct Label {
+    pub x: f64,
+    pub y: f64,
+    pub text: String,
+}
+
+/// What [`write_grid`] draws.
+#[derive(Debug, Clone)]
+pub struct FigureSpec<'a> {
+    pub title: String,
+    pub cmp: &'a Comparison,
+    pub labels: Vec<Label>,
+}
+
+/// The layout [`write_grid`] chose, for the JSON.
+#[derive(Debug, Clone, Serialize)]
+pub struct FigureInfo {
+    pub width: u32,
+    pub height: u32,
+    /// `sections-as-rows` (rows: equal samples, equal time; columns: the
+    /// reference, then the strategies) or `strategies-as-rows` (the
+    /// reference on top, then a row per strategy; columns: equal samples,
+    /// equal time).
+    pub layout: &'static str,
+    /// Where each error map is: `below` or `beside` its render.
+    pub error_map: &'static str,
+    /// Size each render is shown at (scaled by a whole factor from the
+    /// render's size when it is very small or very large).
+    pub image_width: u32,
+    pub image_height: u32,
+    pub error_scale: LogScale,
+    pub error_epsilon: f64,
+}
+
+static FONT_BYTES: &[u8] = include_bytes!("../assets/DejaVuSans.ttf");
+const FONT: &str = "sans-serif";
+
+fn register_font() -> Result<()> {
+    static DONE: OnceLock<bool> = OnceLock::new();
+    if *DONE.get_or_init(|| {
+        plotters::style::register_font(FONT, FontStyle::Normal, FONT_BYTES).is_ok()
+    }) {
+        Ok(())
+    } else {
+        Err(anyhow!("the embedded font could not be loaded"))
+    }
+}
+
+const TEXT: RGBColor = RGBColor(30, 30, 30);
+const DIM: RGBColor = RGBColor(90, 90, 90);
+const MARGIN: i32 = 18;
+const GAP_X: i32 = 18;
+const GAP_Y: i32 = 10;
+const INNER: i32 = 4;
+const HEAD_H: i32 = 28;
+const LINE_H: i32 = 19;
+const CAPTION_SIZE: f64 = 15.0;
+
+fn font(size: f64) -> FontDesc<'static> {
+    (FONT, size).into_font()
+}
+
+fn text_width(s: &str, size: f64) -> i32 {
+    font(size).box_size(s).map_or(0, |(w, _)| w as i32)
+}
+
+/// The largest size ≤ `size` (not below 9) at which `s` fits in `width`.
+fn fit(s: &str, size: f64, width: i32) -> f64 {
+    let mut size = size;
+    while size > 9.0 && text_width(s, size) > width {
+        size -= 0.5;
+    }
+    size
+}
+
+fn de(e: impl std::fmt::Display) -> anyhow::Error {
+    anyhow!("{e}")
+}
+
+type Area<'a> = DrawingArea<BitMapBackend<'a>, Shift>;
+
+fn put(
+    area: &Area,
+    s: &str,
+    (x, y): (i32, i32),
+    size: f64,
+    color: RGBColor,
+    (h, v): (HPos, VPos),
+) -> Result<()> {
+    let style = font(size).color(&color).pos(Pos::new(h, v));
+    area.draw_text(s, &style, (x, y)).map_err(de)
+}
+
+/// A time for captions: `0.84 s`, `12.3 s`, `95 s`.
+#[must_use]
+pub fn fmt_time(t: f64) -> String {
+    if t < 10.0 {
+        format!("{t:.2} s")
+    } else if t < 100.0 {
+        format!("{t:.1} s")
+    } else {
+        format!("{t:.0} s")
+    }
+}
+
+/// Three significant digits, in plain decimals from 0.001 to 10000.
+#[must_use]
+pub fn sig3(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() {
+        return format!("{x}");
+    }
+    let a = x.abs();
+    if (1e-3..1e4).contains(&a) {
+        let digits = (2 - a.log10().floor() as i32).max(0) as usize;
+        format!("{x:.digits$}")
+    } else {
+        format!("{x:.2e}")
+    }
+}
+
+/// The caption lines of a shot at `width` pixels: one line when it fits
+/// at a readable size, else two.
+fn caption_lines(head: &str, tail: Option<&str>, width: i32) -> Vec<String> {
+    let one = match tail {
+        Some(t) => format!("{head} · {t}"),
+        None => head.to_string(),
+    };
+    if tail.is_none() || fit(&one, CAPTION_SIZE, width) >= 12.0 {
+        vec![one]
+    } else {
+        vec![head.to_string(), tail.unwrap_or_default().to_string()]
+    }
+}
+
+fn shot_caption(s: &Shot) -> (String, Option<String>) {
+    (
+        format!("{} · {} spp · {}", s.method, s.spp, fmt_time(s.time_s)),
+        Some(format!("RMSE {}", sig3(s.rmse))),
+    )
+}
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Arrange {
+    SectionsAsRows,
+    StrategiesAsRows,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Pair {
+    Below,
+    Beside,
+}
+
+/// Where everything goes.
+#[derive(Debug, Clone)]
+struct Geometry {
+    arrange: Arrange,
+    pair: Pair,
+    /// Display size of one image.
+    dw: i32,
+    dh: i32,
+    caption_lines: usize,
+    cell_w: i32,
+    width: i32,
+    height: i32,
+    /// Top-left of the reference cell.
+    reference: (i32, i32),
+    /// Top-left of each cell, `[section][strategy]`.
+    cells: Vec<Vec<(i32, i32)>>,
+    /// Heading text, left x, top y and width of each heading.
+    headings: Vec<(String, i32, i32, i32)>,
+}
+
+impl Geometry {
+    fn content(&self) -> (i32, i32) {
+        match self.pair {
+            Pair::Below => (self.dw, 2 * self.dh + INNER),
+            Pair::Beside => (2 * self.dw + INNER, self.dh),
+        }
+    }
+
+    fn caption_h(&self) -> i32 {
+        self.caption_lines as i32 * LINE_H + 4
+    }
+
+    fn cell_h(&self) -> i32 {
+        self.caption_h() + self.content().1
+    }
+
+    /// Where the second image of a cell (the error map) starts, relative to
+    /// the first.
+    fn second(&self) -> (i32, i32) {
+        match self.pair {
+            Pair::Below => (0, self.dh + INNER),
+            Pair::Beside => (self.dw + INNER, 0),
+        }
+    }
+}
+
+/// The display size of a `w × h` render: scaled up by a whole factor to
+/// at least 240 pixels wide, or down to at most 720.
+fn display_scale(w: usize) -> (usize, usize) {
+    if w < 240 {
+        (240usize.div_ceil(w.max(1)), 1)
+    } else if w > 720 {
+        (1, w.div_ceil(720))
+    } else {
+        (1, 1)
+    }
+}
+
+fn layout(spec: &FigureSpec, title_h: i32, arrange: Arrange, pair: Pair) -> Geometry {
+    let cmp = spec.cmp;
+    let img = &cmp.reference.image;
+    let (up, down) = display_scale(img.width);
+    let dw = (img.width * up / down).max(1) as i32;
+    let dh = (img.height * up / down).max(1) as i32;
+    let sections = cmp.sections();
+    let n = sections.iter().map(|s| s.1.len()).max().unwrap_or(0);
+    let mut g = Geometry {
+        arrange,
+        pair,
+        dw,
+        dh,
+        caption_lines: 1,
+        cell_w: 0,
+        width: 0,
+        height: 0,
+        reference: (0, 0),
+        cells: Vec::new(),
+        headings: Vec::new(),
+    };
+    let (cw, _) = g.content();
+    g.cell_w = cw;
+    g.caption_lines = sections
+        .iter()
+        .flat_map(|s| s.1.iter())
+        .map(|s| {
+            let (h, t) = shot_caption(s);
+            caption_lines(&h, t.as_deref(), cw).len()
+        })
+        .max()
+        .unwrap_or(1);
+    let cell_h = g.cell_h();
+    let x = |col: usize| MARGIN + col as i32 * (cw + GAP_X);
+    match arrange {
+        Arrange::SectionsAsRows => {
+            let mut y = title_h;
+            for (r, (heading, shots)) in sections.iter().enumerate() {
+                if r == 0 {
+                    g.headings.push(("Reference".into(), x(0), y, cw));
+                    g.reference = (x(0), y + HEAD_H);
+                }
+                g.headings
+                    .push((heading.clone(), x(1), y, x(n) + cw - x(1)));
+                g.cells.push(
+                    (0..shots.len())
+                        .map(|i| (x(i + 1), y + HEAD_H))
+                        .collect(),
+                );
+                y += HEAD_H + cell_h + GAP_Y;
+            }
+            g.width = x(n) + cw + MARGIN;
+            g.height = y - GAP_Y + MARGIN - 4;
+        }
+        Arrange::StrategiesAsRows => {
+            let mut y = title_h;
+            g.headings.push(("Reference".into(), x(0), y, cw));
+            g.reference = (x(0), y + HEAD_H);
+            y += HEAD_H + cell_h + GAP_Y;
+            for (c, (heading, _)) in sections.iter().enumerate() {
+                g.headings.push((heading.clone(), x(c), y, cw));
+            }
+            y += HEAD_H;
+            g.cells = sections.iter().map(|_| Vec::new()).collect();
+            for i in 0..n {
+                for (c, (_, shots)) in sections.iter().enumerate() {
+                    if i < shots.len() {
+                        g.cells[c].push((x(c), y));
+                    }
+                }
+                y += cell_h + GAP_Y;
+            }
+            g.width = x(sections.len().max(1) - 1) + cw + MARGIN;
+            g.height = y - GAP_Y + MARGIN - 4;
+        }
+    }
+    g
+}
+
+/// The layout whose shape is nearest 3:2 (on a log scale).
+fn best_layout(spec: &FigureSpec, title_h: i32) -> Geometry {
+    let mut best: Option<(f64, Geometry)> = None;
+    for arrange in [Arrange::SectionsAsRows, Arrange::StrategiesAsRows] {
+        for pair in [Pair::Below, Pair::Beside] {
+            let g = layout(spec, title_h, arrange, pair);
+            let score = (f64::from(g.width) / f64::from(g.height) / 1.5).ln().abs();
+            if best.as_ref().is_none_or(|(s, _)| score < *s - 1e-9) {
+                best = Some((score, g));
+            }
+        }
+    }
+    best.expect("four layouts").1
+}
+
+/// Resize RGB bytes by `up` (nearest) or `down` (box average).
+fn resample(rgb: &[u8], w: usize, h: usize, up: usize, down: usize) -> (Vec<u8>, usize, usize) {
+    if up > 1 {
+        let (ow, oh) = (w * up, h * up);
+        let mut out = vec![0u8; ow * oh * 3];
+        for y in 0..oh {
+            for x in 0..ow {
+                let s = ((y / up) * w + x / up) * 3;
+                let d = (y * ow + x) * 3;
+                out[d..d + 3].copy_from_slice(&rgb[s..s + 3]);
+            }
+        }
+        (out, ow, oh)
+    } else if down > 1 {
+        let (ow, oh) = ((w / down).max(1), (h / down).max(1));
+        let mut out = vec![0u8; ow * oh * 3];
+        for y in 0..oh {
+            for x in 0..ow {
+                let mut acc = [0u32; 3];
+                let mut cnt = 0u32;
+                for yy in y * down..((y + 1) * down).min(h) {
+                    for xx in x * down..((x + 1) * down).min(w) {
+                        let s = (yy * w + xx) * 3;
+                        for c in 0..3 {
+                            acc[c] += u32::from(rgb[s + c]);
+                        }
+                        cnt += 1;
+                    }
+                }
+                let d = (y * ow + x) * 3;
+                for c in 0..3 {
+                    out[d + c] = ((acc[c] + cnt / 2) / cnt.max(1)) as u8;
+                }
+            }
+        }
+        (out, ow, oh)
+    } else {
+        (rgb.to_vec(), w, h)
+    }
+}
+
+fn blit(area: &Area, rgb: Vec<u8>, (x, y): (i32, i32), (w, h): (i32, i32)) -> Result<()> {
+    let el = BitMapElement::with_owned_buffer((x, y), (w as u32, h as u32), rgb)
+        .ok_or_else(|| anyhow!("an image buffer does not match its size"))?;
+    area.draw(&el).map_err(de)
+}
+
+fn error_rgb(map: &[f64], scale: &LogScale) -> Vec<u8> {
+    map.iter()
+        .flat_map(|e| {
+            let c = viridis(scale.t(*e));
+            [c.0, c.1, c.2]
+        })
+        .collect()
+}
+
+/// `10^k` with superscript digits.
+fn decade(k: i32) -> String {
+    let sup: String = k
+        .to_string()
+        .chars()
+        .map(|c| match c {
+            '-' => '⁻',
+            '0' => '⁰',
+            '1' => '¹',
+            '2' => '²',
+            '3' => '³',
+            '4' => '⁴',
+            '5' => '⁵',
+            '6' => '⁶',
+            '7' => '⁷',
+            '8' => '⁸',
+            _ => '⁹',
+        })
+        .collect();
+    format!("10{sup}")
+}
+
+/// The colour bar, in the reference cell's second slot.
+fn draw_colorbar(
+    area: &Area,
+    (x, y): (i32, i32),
+    (w, h): (i32, i32),
+    scale: &LogScale,
+) -> Result<()> {
+    area.draw(&Rectangle::new(
+        [(x, y), (x + w - 1, y + h - 1)],
+        RGBColor(247, 247, 247).filled(),
+    ))
+    .map_err(de)?;
+    let title = "error map: |Y − Y_ref| / (Y_ref + ε) of luminance";
+    let note = "ε = 1% of the reference's mean; one scale for every map";
+    let ts = fit(title, 14.0, w - 16);
+    let ns = fit(note, 12.0, w - 16);
+    let bar_h = (h / 8).clamp(10, 22);
+    let tick_s = 12.0;
+    let show_note = h >= 110;
+    let block = ts as i32 + 8 + bar_h + 6 + tick_s as i32 + if show_note { 10 + ns as i32 } else { 0 };
+    let mut cy = y + ((h - block) / 2).max(2);
+    put(
+        area,
+        title,
+        (x + w / 2, cy),
+        ts,
+        TEXT,
+        (HPos::Center, VPos::Top),
+    )?;
+    cy += ts as i32 + 8;
+    let bx0 = x + w / 12;
+    let bw = (w - 2 * (w / 12)).max(1);
+    for k in 0..bw {
+        let t = (f64::from(k) + 0.5) / f64::from(bw);
+        area.draw(&Rectangle::new(
+            [(bx0 + k, cy), (bx0 + k + 1, cy + bar_h)],
+            viridis(t).filled(),
+        ))
+        .map_err(de)?;
+    }
+    area.draw(&Rectangle::new(
+        [(bx0, cy), (bx0 + bw, cy + bar_h)],
+        RGBColor(120, 120, 120).stroke_width(1),
+    ))
+    .map_err(de)?;
+    let (klo, khi) = (
+        scale.lo.log10().round() as i32,
+        scale.hi.log10().round() as i32,
+    );
+    for k in klo..=khi {
+        let t = f64::from(k - klo) / f64::from((khi - klo).max(1));
+        let tx = bx0 + (t * f64::from(bw)).round() as i32;
+        area.draw(&PathElement::new(
+            vec![(tx, cy + bar_h), (tx, cy + bar_h + 4)],
+            BLACK.stroke_width(1),
+        ))
+        .map_err(de)?;
+        let label = if k == klo {
+            format!("≤{}", decade(k))
+        } else {
+            decade(k)
+        };
+        put(
+            area,
+            &label,
+            (tx, cy + bar_h + 6),
+            tick_s,
+            TEXT,
+            (HPos::Center, VPos::Top),
+        )?;
+    }
+    if show_note {
+        cy += bar_h + 6 + tick_s as i32 + 10;
+        put(
+            area,
+            note,
+            (x + w / 2, cy),
+            ns,
+            DIM,
+            (HPos::Center, VPos::Top),
+        )?;
+    }
+    Ok(())
+}
+
+/// White text with a dark outline, centred at `(x, y)`, line by line.
+fn draw_label(area: &Area, text: &str, (x, y): (i32, i32), size: f64) -> Result<()> {
+    let lines: Vec<&str> = text.lines().collect();
+    let lh = (size * 1.15).round() as i32;
+    let top = y - lh * lines.len() as i32 / 2;
+    for (k, line) in lines.iter().enumerate() {
+        let p = (x, top + k as i32 * lh);
+        for (dx, dy) in [
+            (-1, -1),
+            (0, -1),
+            (1, -1),
+            (-1, 0),
+            (1, 0),
+            (-1, 1),
+            (0, 1),
+            (1, 1),
+        ] {
+            put(
+                area,
+                line,
+                (p.0 + dx, p.1 + dy),
+                size,
+                RGBColor(20, 20, 20),
+                (HPos::Center, VPos::Top),
+            )?;
+        }
+        put(area, line, p, size, WHITE, (HPos::Center, VPos::Top))?;
+    }
+    Ok(())
+}
+
+/// Draw the comparison grid to `path` (a PNG): the reference with the
+/// colour bar, and every render with its error map and caption.
+pub fn write_grid(path: &Path, spec: &FigureSpec) -> Result<FigureInfo> {
+    register_font()?;
+    let cmp = spec.cmp;
+    let reference = &cmp.reference.image;
+    let eps = error_epsilon(reference);
+    let sections = cmp.sections();
+    let maps: Vec<Vec<Vec<f64>>> = sections
+        .iter()
+        .map(|(_, shots)| {
+            shots
+                .iter()
+                .map(|s| error_map(&s.image, reference, eps))
+                .collect()
+        })
+        .collect();
+    let scale = LogScale::of(&maps.iter().flatten().cloned().collect::<Vec<_>>());
+
+    let title_size = 21.0;
+    let title_h = MARGIN + title_size as i32 + 12;
+    let g = best_layout(spec, title_h);
+    let (up, down) = display_scale(reference.width);
+    let shown = path.display();
+    let root = BitMapBackend::new(path, (g.width as u32, g.height as u32)).into_drawing_area();
+    root.fill(&WHITE).map_err(de)?;
+    let ts = fit(&spec.title, title_size, g.width - 2 * MARGIN);
+    put(
+        &root,
+        &spec.title,
+        (MARGIN, MARGIN),
+        ts,
+        TEXT,
+        (HPos::Left, VPos::Top),
+    )?;
+    for (text, x, y, w) in &g.headings {
+        let size = fit(text, 17.0, *w);
+        put(
+            &root,
+            text,
+            (*x, y + HEAD_H - 6),
+            size,
+            TEXT,
+            (HPos::Left, VPos::Bottom),
+        )?;
+        root.draw(&PathElement::new(
+            vec![(*x, y + HEAD_H - 2), (x + w, y + HEAD_H - 2)],
+            RGBColor(180, 180, 180).stroke_width(1),
+        ))
+        .map_err(de)?;
+    }
+    let (w, h) = (reference.width, reference.height);
+    let show = |rgb: Vec<u8>| resample(&rgb, w, h, up, down).0;
+    let second = g.second();
+    let caption = |x: i32, y: i32, head: &str, tail: Option<&str>| -> Result<()> {
+        let lines = caption_lines(head, tail, g.cell_w);
+        let base = y + g.caption_h() - 5 - (lines.len() as i32 - 1) * LINE_H;
+        for (k, line) in lines.iter().enumerate() {
+            let size = fit(line, CAPTION_SIZE, g.cell_w);
+            put(
+                &root,
+                line,
+                (x, base + k as i32 * LINE_H),
+                size,
+                TEXT,
+                (HPos::Left, VPos::Bottom),
+            )?;
+        }
+        Ok(())
+    };
+
+    // The reference, its labels, and the colour bar beside or below it.
+    let (rx, ry) = g.reference;
+    let r = &cmp.reference;
+    caption(
+        rx,
+        ry,
+        &format!("{} · {} spp · {}", r.method, r.spp, fmt_time(r.time_s)),
+        None,
+    )?;
+    let top = ry + g.caption_h();
+    blit(&root, show(reference.to_srgb8()), (rx, top), (g.dw, g.dh))?;
+    let k = g.dw as f64 / w as f64;
+    let label_size = (f64::from(g.dh) / 15.0).clamp(9.0, 13.0);
+    for l in &spec.labels {
+        draw_label(
+            &root,
+            &l.text,
+            ((l.x * k).round() as i32 + rx, (l.y * k).round() as i32 + top),
+            label_size,
+        )?;
+    }
+    draw_colorbar(
+        &root,
+        (rx + second.0, top + second.1),
+        (g.dw, g.dh),
+        &scale,
+    )?;
+
+    for (c, (_, shots)) in sections.iter().enumerate() {
+        for (i, s) in shots.iter().enumerate() {
+            let (x, y) = g.cells[c][i];
+            let (head, tail) = shot_caption(s);
+            caption(x, y, &head, tail.as_deref())?;
+            let top = y + g.caption_h();
+            blit(&root, show(s.image.to_srgb8()), (x, top), (g.dw, g.dh))?;
+            blit(
+                &root,
+                show(error_rgb(&maps[c][i], &scale)),
+                (x + second.0, top + second.1),
+                (g.dw, g.dh),
+            )?;
+        }
+    }
+    root.present()
+        .map_err(|e| anyhow!("cannot write {shown}: {e}"))?;
+    Ok(FigureInfo {
+        width: g.width as u32,
+        height: g.height as u32,
+        layout: match g.arrange {
+            Arrange::SectionsAsRows => "sections-as-rows",
+            Arrange::StrategiesAsRows => "strategies-as-rows",
+        },
+        error_map: match g.pair {
+            Pair::Below => "below",
+            Pair::Beside => "beside",
+        },
+        image_width: g.dw as u32,
+        image_height: g.dh as u32,
+        error_scale: scale,
+        error_epsilon: eps,
+    })
+}
+
+// ---------------------------------------------------------------------------
+// The numbers
+// ---------------------------------------------------------------------------
+
+#[derive(Debug, Clone, Serialize)]
+pub struct ShotJson {
+    pub strategy: String,
+    pub spp: u32,
+    pub time_s: f64,
+    pub rmse: f64,
+}
+
+#[derive(Debug, Clone, Serialize)]
+pub struct ReferenceJson {
+    pub strategy: String,
+    pub spp: u32,
+    pub time_s: f64,
+    pub seed: u64,
+}
+
+/// NAME.json.
+#[derive(Debug, Clone, Serialize)]
+pub struct Summary {
+    pub scene: String,
+    pub width: usize,
+    pub height: usize,
+    pub seed: u64,
+    pub max_depth: u32,
+    pub reference: ReferenceJson,
+    pub equal_samples: Vec<ShotJson>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub equal_time: Option<Vec<ShotJson>>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub time_budget_s: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub time_budget_from: Option<String>,
+    pub rmse: &'static str,
+    pub error_map: &'static str,
+    pub figure: FigureInfo,
+}
+
+fn shots_json(shots: &[Shot]) -> Vec<ShotJson> {
+    shots
+        .iter()
+        .map(|s| ShotJson {
+            strategy: s.method.name().to_string(),
+            spp: s.spp,
+            time_s: s.time_s,
+            rmse: s.rmse,
+        })
+        .collect()
+}
+
+/// The numbers of a comparison, for NAME.json.
+#[must_use]
+pub fn summary(scene: &str, s: &Settings, cmp: &Comparison, figure: FigureInfo) -> Summary {
+    let r = &cmp.reference;
+    Summary {
+        scene: scene.to_string(),
+        width: r.image.width,
+        height: r.image.height,
+        seed: s.seed,
+        max_depth: s.max_depth,
+        reference: ReferenceJson {
+            strategy: r.method.name().to_string(),
+            spp: r.spp,
+            time_s: r.time_s,
+            seed: cmp.reference_seed,
+        },
+        equal_samples: shots_json(&cmp.equal_samples),
+        equal_time: cmp.equal_time.as_ref().map(|e| shots_json(&e.shots)),
+        time_budget_s: cmp.equal_time.as_ref().map(|e| e.budget_s),
+        time_budget_from: cmp.equal_time.as_ref().map(|e| e.budget_from.clone()),
+        rmse: "root mean square over all pixels and the three channels of (render - reference), linear RGB",
+        error_map: "per pixel |Y - Y_ref| / (Y_ref + eps) of luminance, eps = 1% of the reference's mean luminance",
+        figure,
+    }
+}
+
+/// Write `summary` as pretty JSON to `path`.
+pub fn write_json(path: &Path, summary: &Summary) -> Result<()> {
+    let text = serde_json::to_string_pretty(summary)?;
+    std::fs::write(path, text + "\n")
+        .map_err(|e| anyhow!("{}: cannot write: {e}", path.display()))
+}
+
+/// The table of a comparison, for stdout.
+pub fn print_table(cmp: &Comparison) {
+    let r = &cmp.reference;
+    println!(
+        "reference: {} at {} spp, {}",
+        r.method,
+        r.spp,
+        fmt_time(r.time_s)
+    );
+    for (heading, shots) in cmp.sections() {
+        println!("{heading}");
+        println!("  {:<15} {:>8} {:>10} {:>12}", "strategy", "spp", "time", "RMSE");
+        for s in shots {
+            println!(
+                "  {:<15} {:>8} {:>10} {:>12}",
+                s.method.name(),
+                s.spp,
+                fmt_time(s.time_s),
+                sig3(s.rmse)
+            );
+        }
+    }
+}
+
+/// `NAME` for `--out NAME` (a trailing .png or .json dropped), or the
+/// scene's stem followed by `-compare`.
+fn output_base(args: &CompareArgs) -> Result<PathBuf> {
+    match &args.out {
+        Some(p) => {
+            let ext = p
+                .extension()
+                .and_then(|e| e.to_str())
+                .map(str::to_ascii_lowercase);
+            Ok(if matches!(ext.as_deref(), Some("png" | "json")) {
+                p.with_extension("")
+            } else {
+                p.clone()
+            })
+        }
+        None => {
+            let stem = args.scene.file_stem().ok_or_else(|| {
+                anyhow!(
+                    "{}: cannot name the output after the scene file; give --out NAME",
+                    args.scene.display()
+                )
+            })?;
+            let mut s = stem.to_owned();
+            s.push("-compare");
+            Ok(PathBuf::from(s))
+        }
+    }
+}
+
+/// `base` with `.ext` appended (keeping any dots in the name).
+#[must_use]
+pub fn with_ext(base: &Path, ext: &str) -> PathBuf {
+    let mut s = base.as_os_str().to_owned();
+    s.push(".");
+    s.push(ext);
+    PathBuf::from(s)
+}
+
+/// Run `lobe compare`.
+pub fn run(args: &CompareArgs) -> Result<()> {
+    if args.spp == Some(0) {
+        bail!("--spp 0: at least 1 sample per pixel");
+    }
+    if args.reference_spp == Some(0) {
+        bail!("--reference-spp 0: at least 1 sample per pixel");
+    }
+    let methods = args
+        .strategies
+        .as_deref()
+        .map(parse_methods)
+        .transpose()?;
+    let base = output_base(args)?;
+    let scene = load_scene(&args.scene)?;
+    let methods = methods.unwrap_or_else(|| default_methods(&scene));
+    let spp = args.spp.unwrap_or(scene.options.spp).max(1);
+    let settings = Settings {
+        methods,
+        spp,
+        reference_spp: args
+            .reference_spp
+            .unwrap_or_else(|| default_reference_spp(spp)),
+        seed: args.seed.unwrap_or(scene.options.seed),
+        max_depth: scene.options.max_depth,
+        threads: args.threads.map(|t| t as usize),
+        equal_time: true,
+        quiet: args.quiet,
+    };
+    for w in &scene.warnings {
+        eprintln!("lobe: warning: {w}");
+    }
+    if !args.quiet {
+        for &m in &settings.methods {
+            for f in fallbacks(&scene, m) {
+                eprintln!(
+                    "lobe: note: object {} ({}): {} does not apply to its material, using {}",
+                    f.object, f.model, f.requested, f.used
+                );
+            }
+        }
+        if settings.reference_spp <= spp {
+            eprintln!(
+                "lobe: note: the reference ({} spp) has no more samples than the compared renders ({spp} spp): its own noise will dominate the errors",
+                settings.reference_spp
+            );
+        }
+    }
+    let cmp = run_comparison(&scene, &settings);
+    let png = with_ext(&base, "png");
+    let json = with_ext(&base, "json");
+    let (w, h) = (scene.camera.width, scene.camera.height);
+    let name = args.scene.display().to_string();
+    let figure = write_grid(
+        &png,
+        &FigureSpec {
+            title: format!(
+                "lobe compare: {name} · {w}×{h} · seed {} · max_depth {}",
+                settings.seed, settings.max_depth
+            ),
+            cmp: &cmp,
+            labels: Vec::new(),
+        },
+    )?;
+    write_json(&json, &summary(&name, &settings, &cmp, figure))?;
+    print_table(&cmp);
+    println!("wrote {} and {}", png.display(), json.display());
+    Ok(())
+}
