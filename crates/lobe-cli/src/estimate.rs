@@ -259,8 +259,11 @@ pub fn run(args: &EstimateArgs) -> Result<()> {
     let m = crate::eval::load_material(&args.material)?;
     let wo = args.view.wo()?;
     let light = args.light.light()?;
-    if args.samples == 0 {
-        bail!("--samples 0: an estimate needs at least one sample");
+    if args.samples < 2 {
+        bail!(
+            "--samples {}: an estimate with a variance needs at least 2 samples",
+            args.samples
+        );
     }
     let mis_bsdf = match &args.mis_bsdf {
         Some(name) => {
