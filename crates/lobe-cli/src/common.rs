@@ -199,3 +199,18 @@ pub fn estimate_par(
     }
     acc
 }
+
+/// [`lobe::estimator::reference`] with an environment map's rows summed on
+/// rayon's pool (in row order, so the same number for any thread count).
+pub fn reference_par(m: &Material, wo: DVec3, light: &Light, rel: f64) -> Rgb {
+    match light {
+        Light::Env { map, frame } => {
+            let rows: Vec<Rgb> = (0..map.size().1)
+                .into_par_iter()
+                .map(|j| lobe::estimator::reference_env_row(m, wo, map, frame, j, rel))
+                .collect();
+            rows.iter().fold(Rgb::ZERO, |a, &b| a + b)
+        }
+        _ => lobe::estimator::reference(m, wo, light, rel),
+    }
+}

@@ -5,7 +5,7 @@ use crate::common::{LightArgs, ViewArgs, estimate_par, progress};
 use anyhow::{Result, bail};
 use clap::Args;
 use glam::DVec3;
-use lobe::estimator::{Heuristic, Mis, MisForm, Plan, Technique, reference};
+use lobe::estimator::{Heuristic, Mis, MisForm, Plan, Technique};
 use lobe::math::luminance;
 use lobe::sequence::Sequence;
 use lobe::{Light, Material, Strategy};
@@ -192,7 +192,7 @@ pub fn run_table(
     seed: u64,
     quiet: bool,
 ) -> Table {
-    let reference = reference(m, wo, light, REFERENCE_TOLERANCE);
+    let reference = crate::common::reference_par(m, wo, light, REFERENCE_TOLERANCE);
     let r_lum = luminance(reference);
     let uniform = Technique::Bsdf(Strategy::Uniform);
     let mut todo: Vec<Technique> = techniques.to_vec();
@@ -249,7 +249,11 @@ pub fn run_table(
     }
     Table {
         reference: reference.to_array(),
-        reference_method: "deterministic adaptive quadrature (Gauss-Kronrod, f64, relative tolerance 1e-9)",
+        reference_method: if matches!(light, Light::Env { .. }) {
+            "a sum over the map's texels of radiance × ∫ f cos dω (4×4 Gauss-Legendre per texel, refined to 1e-9 relative, f64)"
+        } else {
+            "deterministic adaptive quadrature (Gauss-Kronrod, f64, relative tolerance 1e-9)"
+        },
         sequence: sequence.name().to_string(),
         strategies: out,
     }
