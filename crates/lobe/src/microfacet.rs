@@ -468,31 +468,34 @@ fn beckmann_visible_slope_11(cos_theta: f64, u: DVec2) -> (f64, f64) {
     let inv_sqrt_pi = 1.0 / PI.sqrt();
     let c = libm::erf(cot_t);
     let norm = 1.0 / (1.0 + c + inv_sqrt_pi * tan_t * (-cot_t * cot_t).exp());
-    let (mut lo, mut hi) = (-1.0f64, c);
-    let mut b = 0.5 * (lo + hi);
+    // Newton's method on the slope itself, kept inside a bisection bracket:
+    // one erf and one exp per step. Below -8 the CDF is under 1e-27·tanθ.
+    let (mut lo, mut hi) = (-8.0f64, cot_t);
+    let two_inv_sqrt_pi = 2.0 * inv_sqrt_pi;
+    let mut x = erf_inv_estimate(2.0 * u1 - 1.0).clamp(lo, hi);
     for _ in 0..100 {
-        let x = erf_inv(b);
-        let value = norm * (1.0 + b + inv_sqrt_pi * tan_t * (-x * x).exp()) - u1;
-        if value.abs() < 1e-13 {
+        let e = (-x * x).exp();
+        let value = norm * (1.0 + libm::erf(x) + inv_sqrt_pi * tan_t * e) - u1;
+        if value.abs() < 1e-14 {
             break;
         }
         if value > 0.0 {
-            hi = b;
+            hi = x;
         } else {
-            lo = b;
+            lo = x;
         }
-        let deriv = norm * (1.0 - x * tan_t);
-        let next = b - value / deriv;
-        b = if next > lo && next < hi && next.is_finite() {
+        let deriv = norm * two_inv_sqrt_pi * e * (1.0 - x * tan_t);
+        let next = x - value / deriv;
+        x = if next > lo && next < hi && next.is_finite() {
             next
         } else {
             0.5 * (lo + hi)
         };
-        if hi - lo < 1e-15 {
+        if hi - lo < 1e-14 {
             break;
         }
     }
-    (erf_inv(b), sy)
+    (x, sy)
 }
 
 /// Inverse error function in f64: Giles' approximation refined by Newton
@@ -505,9 +508,24 @@ pub fn erf_inv(y: f64) -> f64 {
     if y >= 1.0 {
         return f64::INFINITY;
     }
-    // M. Giles, "Approximating the erfinv function" (single-precision branch).
+    let mut x = erf_inv_estimate(y);
+    let two_over_sqrt_pi = 2.0 / PI.sqrt();
+    for _ in 0..3 {
+        let err = libm::erf(x) - y;
+        let d = two_over_sqrt_pi * (-x * x).exp();
+        if d == 0.0 {
+            break;
+        }
+        x -= err / d;
+    }
+    x
+}
+
+/// Giles' single-precision approximation of the inverse error function
+/// (M. Giles, "Approximating the erfinv function"), about 1e-7 accurate.
+fn erf_inv_estimate(y: f64) -> f64 {
     let w = -((1.0 - y) * (1.0 + y)).ln();
-    let mut x = if w < 5.0 {
+    if w < 5.0 {
         let w = w - 2.5;
         let mut p = 2.810_226_36e-08;
         p = 3.432_739_39e-07 + p * w;
@@ -531,17 +549,7 @@ pub fn erf_inv(y: f64) -> f64 {
         p = 1.001_674_06 + p * w;
         p = 2.832_976_82 + p * w;
         p * y
-    };
-    let two_over_sqrt_pi = 2.0 / PI.sqrt();
-    for _ in 0..3 {
-        let err = libm::erf(x) - y;
-        let d = two_over_sqrt_pi * (-x * x).exp();
-        if d == 0.0 {
-            break;
-        }
-        x -= err / d;
     }
-    x
 }
 
 #[cfg(test)]
