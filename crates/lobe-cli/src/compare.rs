@@ -36,7 +36,6 @@ use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 use serde::Serialize;
 use std::path::{Path, PathBuf};
-use std::sync::OnceLock;
 use std::time::Instant;
 
 /// The arguments of `lobe compare`.
@@ -207,7 +206,13 @@ fn render_one(
         threads: s.threads,
     };
     let pixels = u64::from(scene.camera.width) * u64::from(scene.camera.height);
-    let pb = progress(pixels, &format!("{what}: {method} {spp} spp"), s.quiet);
+    // `brdf 16 spp`, `brdf 40 spp, eq. time`, `reference 1024 spp`.
+    let message = match what {
+        "" => format!("{method} {spp} spp"),
+        "reference" => format!("reference {spp} spp"),
+        _ => format!("{method} {spp} spp, {what}"),
+    };
+    let pb = progress(pixels, &message, s.quiet);
     let t0 = Instant::now();
     let image = render(scene, &opts, |n| pb.inc(n));
     let time = t0.elapsed().as_secs_f64();
@@ -228,7 +233,7 @@ pub fn run_comparison(scene: &Scene, s: &Settings) -> Comparison {
     let spp = s.spp.max(1);
     let mut equal_samples = Vec::new();
     for &m in &s.methods {
-        let (image, time_s) = render_one(scene, s, m, spp, s.seed, "equal samples");
+        let (image, time_s) = render_one(scene, s, m, spp, s.seed, "");
         equal_samples.push(Shot {
             method: m,
             spp,
@@ -262,7 +267,7 @@ pub fn run_comparison(scene: &Scene, s: &Settings) -> Comparison {
                 if n == spp {
                     return pilot.clone();
                 }
-                let (image, time_s) = render_one(scene, s, pilot.method, n, s.seed, "equal time");
+                let (image, time_s) = render_one(scene, s, pilot.method, n, s.seed, "eq. time");
                 Shot {
                     method: pilot.method,
                     spp: n,
@@ -401,7 +406,7 @@ const SCALE_DECADES: i32 = 4;
 
 impl LogScale {
     /// The scale of `maps`: its top is the power of ten at or above the
-    /// 99.9th percentile of the positive values, and it spans
+    /// 99th percentile of the positive values, and it spans
     /// [`SCALE_DECADES`] decades.
     #[must_use]
     pub fn of(maps: &[Vec<f64>]) -> LogScale {
@@ -414,7 +419,7 @@ impl LogScale {
         let top = if v.is_empty() {
             0
         } else {
-            let k = ((v.len() - 1) as f64 * 0.999).round() as usize;
+            let k = ((v.len() - 1) as f64 * 0.99).round() as usize;
             let (_, p, _) = v.select_nth_unstable_by(k, f64::total_cmp);
             p.log10().ceil() as i32
         };
@@ -427,7 +432,7 @@ impl LogScale {
     /// Position of `x` on the scale, clamped to [0, 1].
     #[must_use]
     pub fn t(&self, x: f64) -> f64 {
-        if !(x > self.lo) {
+        if x.is_nan() || x <= self.lo {
             return 0.0;
         }
         ((x.log10() - self.lo.log10()) / (self.hi.log10() - self.lo.log10())).clamp(0.0, 1.0)
@@ -475,19 +480,8 @@ pub struct FigureInfo {
     pub error_epsilon: f64,
 }
 
-static FONT_BYTES: &[u8] = include_bytes!("../assets/DejaVuSans.ttf");
+/// The family the embedded DejaVu Sans is registered under (by `figures`).
 const FONT: &str = "sans-serif";
-
-fn register_font() -> Result<()> {
-    static DONE: OnceLock<bool> = OnceLock::new();
-    if *DONE.get_or_init(|| {
-        plotters::style::register_font(FONT, FontStyle::Normal, FONT_BYTES).is_ok()
-    }) {
-        Ok(())
-    } else {
-        Err(anyhow!("the embedded font could not be loaded"))
-    }
-}
 
 const TEXT: RGBColor = RGBColor(30, 30, 30);
 const DIM: RGBColor = RGBColor(90, 90, 90);
@@ -534,10 +528,14 @@ fn put(
     area.draw_text(s, &style, (x, y)).map_err(de)
 }
 
-/// A time for captions: `0.84 s`, `12.3 s`, `95 s`.
+/// A time for captions: `4.2 ms`, `85 ms`, `0.84 s`, `12.3 s`, `95 s`.
 #[must_use]
 pub fn fmt_time(t: f64) -> String {
-    if t < 10.0 {
+    if t < 0.01 {
+        format!("{:.1} ms", t * 1e3)
+    } else if t < 0.1 {
+        format!("{:.0} ms", t * 1e3)
+    } else if t < 10.0 {
         format!("{t:.2} s")
     } else if t < 100.0 {
         format!("{t:.1} s")
@@ -696,15 +694,12 @@ fn layout(spec: &FigureSpec, title_h: i32, arrange: Arrange, pair: Pair) -> Geom
                 }
                 g.headings
                     .push((heading.clone(), x(1), y, x(n) + cw - x(1)));
-                g.cells.push(
-                    (0..shots.len())
-                        .map(|i| (x(i + 1), y + HEAD_H))
-                        .collect(),
-                );
+                g.cells
+                    .push((0..shots.len()).map(|i| (x(i + 1), y + HEAD_H)).collect());
                 y += HEAD_H + cell_h + GAP_Y;
             }
             g.width = x(n) + cw + MARGIN;
-            g.height = y - GAP_Y + MARGIN - 4;
+            g.height = y - GAP_Y + MARGIN;
         }
         Arrange::StrategiesAsRows => {
             let mut y = title_h;
@@ -725,7 +720,7 @@ fn layout(spec: &FigureSpec, title_h: i32, arrange: Arrange, pair: Pair) -> Geom
                 y += cell_h + GAP_Y;
             }
             g.width = x(sections.len().max(1) - 1) + cw + MARGIN;
-            g.height = y - GAP_Y + MARGIN - 4;
+            g.height = y - GAP_Y + MARGIN;
         }
     }
     g
@@ -843,7 +838,8 @@ fn draw_colorbar(
     let bar_h = (h / 8).clamp(10, 22);
     let tick_s = 12.0;
     let show_note = h >= 110;
-    let block = ts as i32 + 8 + bar_h + 6 + tick_s as i32 + if show_note { 10 + ns as i32 } else { 0 };
+    let block =
+        ts as i32 + 8 + bar_h + 6 + tick_s as i32 + if show_note { 10 + ns as i32 } else { 0 };
     let mut cy = y + ((h - block) / 2).max(2);
     put(
         area,
@@ -909,33 +905,29 @@ fn draw_colorbar(
     Ok(())
 }
 
-/// White text with a dark outline, centred at `(x, y)`, line by line.
+/// Dark text on a translucent white box, centred at `(x, y)`, line by line.
 fn draw_label(area: &Area, text: &str, (x, y): (i32, i32), size: f64) -> Result<()> {
     let lines: Vec<&str> = text.lines().collect();
-    let lh = (size * 1.15).round() as i32;
+    let lh = (size * 1.2).round() as i32;
     let top = y - lh * lines.len() as i32 / 2;
+    let w = lines.iter().map(|l| text_width(l, size)).max().unwrap_or(0);
+    area.draw(&Rectangle::new(
+        [
+            (x - w / 2 - 4, top - 1),
+            (x + w / 2 + 4, top + lh * lines.len() as i32 + 1),
+        ],
+        WHITE.mix(0.6).filled(),
+    ))
+    .map_err(de)?;
     for (k, line) in lines.iter().enumerate() {
-        let p = (x, top + k as i32 * lh);
-        for (dx, dy) in [
-            (-1, -1),
-            (0, -1),
-            (1, -1),
-            (-1, 0),
-            (1, 0),
-            (-1, 1),
-            (0, 1),
-            (1, 1),
-        ] {
-            put(
-                area,
-                line,
-                (p.0 + dx, p.1 + dy),
-                size,
-                RGBColor(20, 20, 20),
-                (HPos::Center, VPos::Top),
-            )?;
-        }
-        put(area, line, p, size, WHITE, (HPos::Center, VPos::Top))?;
+        put(
+            area,
+            line,
+            (x, top + k as i32 * lh + lh / 2),
+            size,
+            TEXT,
+            (HPos::Center, VPos::Center),
+        )?;
     }
     Ok(())
 }
@@ -943,7 +935,7 @@ fn draw_label(area: &Area, text: &str, (x, y): (i32, i32), size: f64) -> Result<
 /// Draw the comparison grid to `path` (a PNG): the reference with the
 /// colour bar, and every render with its error map and caption.
 pub fn write_grid(path: &Path, spec: &FigureSpec) -> Result<FigureInfo> {
-    register_font()?;
+    crate::figures::register_fonts()?;
     let cmp = spec.cmp;
     let reference = &cmp.reference.image;
     let eps = error_epsilon(reference);
@@ -1028,16 +1020,14 @@ pub fn write_grid(path: &Path, spec: &FigureSpec) -> Result<FigureInfo> {
         draw_label(
             &root,
             &l.text,
-            ((l.x * k).round() as i32 + rx, (l.y * k).round() as i32 + top),
+            (
+                (l.x * k).round() as i32 + rx,
+                (l.y * k).round() as i32 + top,
+            ),
             label_size,
         )?;
     }
-    draw_colorbar(
-        &root,
-        (rx + second.0, top + second.1),
-        (g.dw, g.dh),
-        &scale,
-    )?;
+    draw_colorbar(&root, (rx + second.0, top + second.1), (g.dw, g.dh), &scale)?;
 
     for (c, (_, shots)) in sections.iter().enumerate() {
         for (i, s) in shots.iter().enumerate() {
@@ -1156,8 +1146,7 @@ pub fn summary(scene: &str, s: &Settings, cmp: &Comparison, figure: FigureInfo) 
 /// Write `summary` as pretty JSON to `path`.
 pub fn write_json(path: &Path, summary: &Summary) -> Result<()> {
     let text = serde_json::to_string_pretty(summary)?;
-    std::fs::write(path, text + "\n")
-        .map_err(|e| anyhow!("{}: cannot write: {e}", path.display()))
+    std::fs::write(path, text + "\n").map_err(|e| anyhow!("{}: cannot write: {e}", path.display()))
 }
 
 /// The table of a comparison, for stdout.
@@ -1171,7 +1160,10 @@ pub fn print_table(cmp: &Comparison) {
     );
     for (heading, shots) in cmp.sections() {
         println!("{heading}");
-        println!("  {:<15} {:>8} {:>10} {:>12}", "strategy", "spp", "time", "RMSE");
+        println!(
+            "  {:<15} {:>8} {:>10} {:>12}",
+            "strategy", "spp", "time", "RMSE"
+        );
         for s in shots {
             println!(
                 "  {:<15} {:>8} {:>10} {:>12}",
@@ -1230,11 +1222,7 @@ pub fn run(args: &CompareArgs) -> Result<()> {
     if args.reference_spp == Some(0) {
         bail!("--reference-spp 0: at least 1 sample per pixel");
     }
-    let methods = args
-        .strategies
-        .as_deref()
-        .map(parse_methods)
-        .transpose()?;
+    let methods = args.strategies.as_deref().map(parse_methods).transpose()?;
     let base = output_base(args)?;
     let scene = load_scene(&args.scene)?;
     let methods = methods.unwrap_or_else(|| default_methods(&scene));

@@ -24,10 +24,10 @@ use anyhow::{Context, Result, anyhow, bail};
 use clap::Args;
 use glam::DVec3;
 use indicatif::ProgressBar;
+use lobe::estimator::Technique;
 use lobe::estimator::{Plan, estimate, reference};
 use lobe::math::luminance;
 use lobe::sequence::{Sequence, hash64};
-use lobe::estimator::Technique;
 use lobe::{Light, Material};
 use rayon::prelude::*;
 use std::fmt::Write as _;
@@ -340,7 +340,13 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
     let m = crate::eval::load_material(&args.material)?;
     let wo = args.view.wo()?;
     let light = args.light.light()?;
-    let strategies = crate::estimate::parse_techniques(&args.strategy, &m, crate::estimate::best_bsdf_strategy(&m), 1, 1)?;
+    let strategies = crate::estimate::parse_techniques(
+        &args.strategy,
+        &m,
+        crate::estimate::best_bsdf_strategy(&m),
+        1,
+        1,
+    )?;
     let setup = Setup {
         strategies,
         sequences,

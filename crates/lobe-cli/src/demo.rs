@@ -10,8 +10,7 @@
 //!    `lobe compare` with error maps and RMSE.
 
 use crate::compare::{
-    FigureSpec, Label, Settings, print_table, run_comparison, summary,
-    write_grid, write_json,
+    FigureSpec, Label, Settings, print_table, run_comparison, summary, write_grid, write_json,
 };
 use anyhow::{Context, Result};
 use clap::Args;
@@ -107,7 +106,10 @@ pub fn run(args: &DemoArgs) -> Result<()> {
     let plan = Plan::new(args.quick);
     tour(&plan, args.quiet)?;
     showcase(&plan, &args.out, args.quiet)?;
-    println!("\ndone in {}", crate::compare::fmt_time(t0.elapsed().as_secs_f64()));
+    println!(
+        "\ndone in {}",
+        crate::compare::fmt_time(t0.elapsed().as_secs_f64())
+    );
     Ok(())
 }
 
@@ -115,9 +117,13 @@ fn tour(plan: &Plan, quiet: bool) -> Result<()> {
     let wo = crate::common::theta_to_wo(30.0)?;
     let light = Light::Constant(Rgb::ONE);
     let n = plan.tour_samples;
-    println!("lobe demo, part 1: L_o = ∫ f_r L_i cos dω at θo = 30° under a white furnace (L_i = 1),");
+    println!(
+        "lobe demo, part 1: L_o = ∫ f_r L_i cos dω at θo = 30° under a white furnace (L_i = 1),"
+    );
     println!("so L_o is the directional albedo. Each strategy gets {n} samples; the reference is");
-    println!("adaptive quadrature. 'vs uniform' is uniform's variance over this strategy's: how many");
+    println!(
+        "adaptive quadrature. 'vs uniform' is uniform's variance over this strategy's: how many"
+    );
     println!("times fewer samples it needs for the same noise.\n");
     for (label, json) in TOUR {
         let m = MaterialDesc::from_json(json)?.build()?;
@@ -240,23 +246,27 @@ fn showcase_scene(width: u32, height: u32) -> Result<(Scene, Vec<Label>)> {
         let m = MaterialDesc::from_json(json)?.build()?;
         let c = DVec3::new(x0 + SPACING * k as f64, RADIUS, 0.0);
         scene = scene.with(Object::sphere(c, RADIUS, m)?);
-        // On the ground in front of the sphere: its parameter, and below,
-        // between the two spheres of a model, the model's name.
-        if let Some((x, y)) = camera.project(DVec3::new(c.x, 0.0, 0.9)) {
+        // On the ground below the sphere in the image: its parameter, and
+        // under it, between the two spheres of a model, the model's name.
+        let h = f64::from(height);
+        if let (Some((x, _)), Some((_, y))) = (
+            camera.project(c),
+            camera.project(c - DVec3::new(0.0, RADIUS, 0.0)),
+        ) {
             labels.push(Label {
                 x,
-                y,
+                y: y + 0.1 * h,
                 text: (*param).to_string(),
             });
-        }
-        if k % 2 == 1
-            && let Some((x, y)) = camera.project(DVec3::new(c.x - 0.5 * SPACING, 0.0, 2.0))
-        {
-            labels.push(Label {
-                x,
-                y,
-                text: (*model).to_string(),
-            });
+            if k % 2 == 1
+                && let Some((x0, _)) = camera.project(c - DVec3::new(SPACING, 0.0, 0.0))
+            {
+                labels.push(Label {
+                    x: 0.5 * (x0 + x),
+                    y: y + 0.2 * h,
+                    text: (*model).to_string(),
+                });
+            }
         }
     }
     let ground = MaterialDesc::from_json(r#"{"type":"lambert","albedo":0.5}"#)?.build()?;
@@ -307,7 +317,10 @@ fn showcase(plan: &Plan, dir: &Path, quiet: bool) -> Result<()> {
             labels,
         },
     )?;
-    write_json(&json, &summary("built-in showcase", &settings, &cmp, figure))?;
+    write_json(
+        &json,
+        &summary("built-in showcase", &settings, &cmp, figure),
+    )?;
     let mut renders = vec![dir.join("reference.png")];
     cmp.reference.image.write_png(&renders[0])?;
     for s in &cmp.equal_samples {
@@ -323,7 +336,12 @@ fn showcase(plan: &Plan, dir: &Path, quiet: bool) -> Result<()> {
     );
     let names: Vec<String> = renders
         .iter()
-        .map(|p| p.file_name().unwrap_or_default().to_string_lossy().into_owned())
+        .map(|p| {
+            p.file_name()
+                .unwrap_or_default()
+                .to_string_lossy()
+                .into_owned()
+        })
         .collect();
     println!("and the renders {} in {}", names.join(", "), dir.display());
     Ok(())

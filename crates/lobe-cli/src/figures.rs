@@ -405,7 +405,7 @@ trait Figure {
 }
 
 /// Registers the embedded DejaVu Sans once; plotters' ab_glyph text needs it.
-fn register_fonts() -> Result<()> {
+pub(crate) fn register_fonts() -> Result<()> {
     static DONE: OnceLock<bool> = OnceLock::new();
     let ok = *DONE.get_or_init(|| {
         ["sans-serif", "serif", "monospace"].iter().all(|family| {

@@ -72,9 +72,9 @@ fn json_has_every_field_and_estimates_agree_with_the_reference() {
             "vndf",
             "spherical-caps",
             "bounded-vndf",
-        "light",
-        "mis",
-        "mis-power"
+            "light",
+            "mis",
+            "mis-power"
         ]
     );
     for s in v["strategies"].as_array().unwrap() {
