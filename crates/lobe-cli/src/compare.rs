@@ -799,24 +799,7 @@ fn error_rgb(map: &[f64], scale: &LogScale) -> Vec<u8> {
 
 /// `10^k` with superscript digits.
 fn decade(k: i32) -> String {
-    let sup: String = k
-        .to_string()
-        .chars()
-        .map(|c| match c {
-            '-' => '⁻',
-            '0' => '⁰',
-            '1' => '¹',
-            '2' => '²',
-            '3' => '³',
-            '4' => '⁴',
-            '5' => '⁵',
-            '6' => '⁶',
-            '7' => '⁷',
-            '8' => '⁸',
-            _ => '⁹',
-        })
-        .collect();
-    format!("10{sup}")
+    format!("10{}", crate::figures::superscript(i64::from(k)))
 }
 
 /// The colour bar, in the reference cell's second slot.

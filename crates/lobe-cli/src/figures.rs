@@ -528,7 +528,7 @@ fn draw_title<DB: DrawingBackend>(
 }
 
 /// `n` as Unicode superscript digits, with a real minus sign.
-fn superscript(n: i64) -> String {
+pub(crate) fn superscript(n: i64) -> String {
     n.to_string()
         .chars()
         .map(|c| match c {
