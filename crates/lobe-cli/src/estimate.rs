@@ -180,6 +180,7 @@ pub fn parse_sequence(spec: &str) -> Result<Sequence> {
     })
 }
 
+#[allow(clippy::too_many_arguments)]
 /// Run every strategy with the same samples, sequence and seed; the
 /// variance reduction is against `uniform`, run too if not in the list.
 pub fn run_table(

@@ -58,12 +58,10 @@ pub fn load_envmap(path: &Path, scale: f64, rotation_y: f64) -> Result<(EnvMap, 
     let format = match ext.as_deref() {
         Some("hdr") | Some("pic") => image::ImageFormat::Hdr,
         Some("exr") => {
-            if let Some(name) = exr_compression(&bytes).map_err(format_err)? {
-                if name == "DWAA" || name == "DWAB" {
-                    return Err(format_err(format!(
-                        "OpenEXR compression {name} is not supported; re-save the file with ZIP, PIZ, RLE or no compression"
-                    )));
-                }
+            if let Some(name @ ("DWAA" | "DWAB")) = exr_compression(&bytes).map_err(format_err)? {
+                return Err(format_err(format!(
+                    "OpenEXR compression {name} is not supported; re-save the file with ZIP, PIZ, RLE or no compression"
+                )));
             }
             image::ImageFormat::OpenExr
         }

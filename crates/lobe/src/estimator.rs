@@ -226,12 +226,11 @@ pub fn technique_value(
                         }
                     }
                     for p in &points[mis.n_bsdf as usize..] {
-                        if let Some((wi, pl)) = light.sample_mis(DVec2::new(p[1], p[2])) {
-                            if wi.z > 0.0 {
-                                let w =
-                                    heuristic(mis.heuristic, nl * pl, nb * m.pdf(mis.bsdf, wo, wi));
-                                sum += m.eval(wo, wi) * light.radiance(wi) * (wi.z * w / (nl * pl));
-                            }
+                        if let Some((wi, pl)) = light.sample_mis(DVec2::new(p[1], p[2]))
+                            && wi.z > 0.0
+                        {
+                            let w = heuristic(mis.heuristic, nl * pl, nb * m.pdf(mis.bsdf, wo, wi));
+                            sum += m.eval(wo, wi) * light.radiance(wi) * (wi.z * w / (nl * pl));
                         }
                     }
                     sum

@@ -117,7 +117,7 @@ pub fn fill(seq: Sequence, seed: u64, n: usize, chunk: usize, first: usize, out:
 pub fn grid_shape(n: usize) -> (usize, usize) {
     let mut nx = (n as f64).sqrt().floor() as usize;
     while nx > 0 {
-        if n % nx == 0 {
+        if n.is_multiple_of(nx) {
             let ny = n / nx;
             return if ny <= 4 * nx { (nx, ny) } else { (0, 0) };
         }
