@@ -49,24 +49,6 @@ pub fn mirror_z(w: DVec3) -> DVec3 {
     DVec3::new(-w.x, -w.y, w.z)
 }
 
-#[inline]
-#[must_use]
-pub fn cos2_theta(w: DVec3) -> f64 {
-    w.z * w.z
-}
-
-#[inline]
-#[must_use]
-pub fn sin2_theta(w: DVec3) -> f64 {
-    (1.0 - w.z * w.z).max(0.0)
-}
-
-#[inline]
-#[must_use]
-pub fn tan2_theta(w: DVec3) -> f64 {
-    sin2_theta(w) / cos2_theta(w)
-}
-
 /// `(cos φ, sin φ)` of a direction, `(1, 0)` at the pole.
 #[inline]
 #[must_use]
@@ -80,14 +62,6 @@ pub fn cos_sin_phi(w: DVec3) -> (f64, f64) {
     }
 }
 
-/// Unit direction from spherical coordinates around `+z`.
-#[inline]
-#[must_use]
-pub fn spherical_direction(sin_theta: f64, cos_theta: f64, phi: f64) -> DVec3 {
-    let (s, c) = phi.sin_cos();
-    DVec3::new(sin_theta * c, sin_theta * s, cos_theta)
-}
-
 /// `true` when `w` is a unit vector to `1e-6` (for debug assertions).
 #[inline]
 #[must_use]
@@ -95,9 +69,3 @@ pub fn is_unit(w: DVec3) -> bool {
     (w.length_squared() - 1.0).abs() < 1e-6
 }
 
-/// `true` when every channel is finite.
-#[inline]
-#[must_use]
-pub fn is_finite_rgb(c: Rgb) -> bool {
-    c.is_finite()
-}
