@@ -168,9 +168,11 @@ pub fn progress(len: u64, message: &str, quiet: bool) -> ProgressBar {
     }
     let pb = ProgressBar::new(len);
     pb.set_style(
-        ProgressStyle::with_template("{msg:>20} [{wide_bar}] {human_pos}/{human_len} {elapsed}<{eta}")
-            .expect("progress template is valid")
-            .progress_chars("=> "),
+        ProgressStyle::with_template(
+            "{msg:>20} [{wide_bar}] {human_pos}/{human_len} {elapsed}<{eta}",
+        )
+        .expect("progress template is valid")
+        .progress_chars("=> "),
     );
     pb.set_message(message.to_string());
     pb

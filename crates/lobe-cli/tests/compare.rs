@@ -3,6 +3,9 @@
 //! finite positive RMSE, MIS is no worse than the worse of BSDF and light
 //! sampling, and bad input fails with one line.
 
+mod common;
+use common::one_line_error;
+
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -49,14 +52,6 @@ material = { type = "lambert", albedo = 0.5 }
 [render]
 spp = 8
 "#;
-
-fn one_line_error(o: &Output) -> String {
-    assert_eq!(o.status.code(), Some(1), "{o:?}");
-    let e = String::from_utf8(o.stderr.clone()).unwrap();
-    assert_eq!(e.lines().count(), 1, "{e}");
-    assert!(e.starts_with("lobe: error: "), "{e}");
-    e
-}
 
 #[test]
 fn writes_the_grid_and_the_numbers() {

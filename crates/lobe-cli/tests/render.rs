@@ -2,6 +2,9 @@
 //! image for any thread count, and one-line errors that name the file, the
 //! line and the field.
 
+mod common;
+use common::one_line_error;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -52,14 +55,6 @@ strategy = "mis"
 seed = 1
 max_depth = 1
 "#;
-
-fn one_line_error(o: &Output) -> String {
-    assert_eq!(o.status.code(), Some(1), "{o:?}");
-    let e = String::from_utf8(o.stderr.clone()).unwrap();
-    assert_eq!(e.lines().count(), 1, "{e}");
-    assert!(e.starts_with("lobe: error: "), "{e}");
-    e
-}
 
 #[test]
 fn writes_exr_and_png() {

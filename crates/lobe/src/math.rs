@@ -68,4 +68,3 @@ pub fn cos_sin_phi(w: DVec3) -> (f64, f64) {
 pub fn is_unit(w: DVec3) -> bool {
     (w.length_squared() - 1.0).abs() < 1e-6
 }
-
