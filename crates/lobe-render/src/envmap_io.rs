@@ -157,6 +157,54 @@ mod tests {
         }
     }
 
+    /// Scanline and tiled OpenEXR files with every lossless compression the
+    /// issue names read back to the texels that were written.
+    #[test]
+    fn exr_scanline_and_tiled_with_each_compression() {
+        use exr::prelude::*;
+        let (w, h) = (40usize, 20usize);
+        let px = |p: Vec2<usize>| (p.x() as f32 * 0.25, p.y() as f32, 0.5f32);
+        let blocks = [
+            ("scan", Blocks::ScanLines),
+            ("tiled", Blocks::Tiles(Vec2(16, 8))),
+        ];
+        let compressions = [
+            ("none", Compression::Uncompressed),
+            ("rle", Compression::RLE),
+            ("zip", Compression::ZIP16),
+            ("zips", Compression::ZIP1),
+            ("piz", Compression::PIZ),
+        ];
+        for (bname, b) in blocks {
+            for (cname, c) in compressions {
+                let encoding = Encoding {
+                    compression: c,
+                    blocks: b,
+                    line_order: LineOrder::Increasing,
+                };
+                let layer = Layer::new(
+                    (w, h),
+                    LayerAttributes::named("rgb"),
+                    encoding,
+                    SpecificChannels::rgb(px),
+                );
+                let p = tmp(&format!("{bname}-{cname}.exr"));
+                Image::from_layer(layer).write().to_file(&p).unwrap();
+                let (m, _) =
+                    load_envmap(&p, 1.0, 0.0).unwrap_or_else(|e| panic!("{bname} {cname}: {e}"));
+                assert_eq!(m.size(), (w, h), "{bname} {cname}");
+                for (i, j) in [(0, 0), (7, 3), (39, 19), (21, 11)] {
+                    let t = m.texel(i, j);
+                    let e = px(Vec2(i, j));
+                    assert!(
+                        (t.x - f64::from(e.0)).abs() < 1e-6 && (t.y - f64::from(e.1)).abs() < 1e-6,
+                        "{bname} {cname} ({i}, {j}): {t}"
+                    );
+                }
+            }
+        }
+    }
+
     #[test]
     fn dwa_compression_is_named() {
         // A minimal header with compression = DWAB (9).
