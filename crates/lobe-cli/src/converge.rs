@@ -340,13 +340,8 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
     let m = crate::eval::load_material(&args.material)?;
     let wo = args.view.wo()?;
     let light = args.light.light()?;
-    let strategies = crate::estimate::parse_techniques(
-        &args.strategy,
-        &m,
-        crate::estimate::best_bsdf_strategy(&m),
-        1,
-        1,
-    )?;
+    let strategies =
+        crate::estimate::parse_techniques(&args.strategy, &m, m.best_bsdf_strategy(), 1, 1)?;
     let setup = Setup {
         strategies,
         sequences,

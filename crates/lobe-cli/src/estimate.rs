@@ -94,16 +94,6 @@ pub struct Table {
     pub strategies: Vec<Row>,
 }
 
-/// The BSDF strategy MIS uses by default: visible normals where the
-/// material has them, else the lecture's `brdf`.
-pub fn best_bsdf_strategy(m: &Material) -> Strategy {
-    if m.check(Strategy::Vndf).is_ok() {
-        Strategy::Vndf
-    } else {
-        Strategy::Brdf
-    }
-}
-
 /// Parse `all` or a list of technique names: the BSDF strategies
 /// (uniform, cosine, brdf, vndf, spherical-caps, bounded-vndf), `light`,
 /// and MIS: `mis` (balance) and `mis-power`, multi-sample, or `mis-one` and
@@ -281,7 +271,7 @@ pub fn run(args: &EstimateArgs) -> Result<()> {
             m.check(s).map_err(|e| anyhow::anyhow!("--mis-bsdf: {e}"))?;
             s
         }
-        None => best_bsdf_strategy(&m),
+        None => m.best_bsdf_strategy(),
     };
     let (n_bsdf, n_light) = parse_mis_samples(&args.mis_samples)?;
     let strategies = parse_techniques(&args.strategy, &m, mis_bsdf, n_bsdf, n_light)?;

@@ -206,16 +206,6 @@ pub enum Escape {
     Mis(Heuristic),
 }
 
-/// `vndf` where the material has it, else `brdf` (the MIS default).
-#[must_use]
-pub fn best_bsdf_strategy(m: &Material) -> Strategy {
-    if m.check(Strategy::Vndf).is_ok() {
-        Strategy::Vndf
-    } else {
-        Strategy::Brdf
-    }
-}
-
 /// The plan for a material under `method` (with the `brdf` fallback).
 #[must_use]
 pub fn plan(method: Method, m: &Material) -> ObjectPlan {
@@ -230,12 +220,12 @@ pub fn plan(method: Method, m: &Material) -> ObjectPlan {
             escape: Escape::Full,
         },
         Method::Light => ObjectPlan {
-            bsdf: best_bsdf_strategy(m),
+            bsdf: m.best_bsdf_strategy(),
             light: true,
             escape: Escape::None,
         },
         Method::Mis(h) => ObjectPlan {
-            bsdf: best_bsdf_strategy(m),
+            bsdf: m.best_bsdf_strategy(),
             light: true,
             escape: Escape::Mis(h),
         },
@@ -350,14 +340,6 @@ fn mix64(mut z: u64) -> u64 {
     z ^ (z >> 31)
 }
 
-#[inline]
-fn weight(h: Heuristic, a: f64, b: f64) -> f64 {
-    match h {
-        Heuristic::Balance => a / (a + b),
-        Heuristic::Power => a * a / (a * a + b * b),
-    }
-}
-
 struct Context<'a> {
     scene: &'a Scene,
     env: &'a EnvMap,
@@ -436,7 +418,7 @@ impl Context<'_> {
                             stats.rays += 1;
                             if !self.scene.occluded(&spawn_ray(hit.p, ng, d)) {
                                 let w = match plan.escape {
-                                    Escape::Mis(h) => weight(h, pl, m.pdf(plan.bsdf, wo, wi)),
+                                    Escape::Mis(h) => h.weight(pl, m.pdf(plan.bsdf, wo, wi)),
                                     _ => 1.0,
                                 };
                                 l += beta * f * self.env.eval(d) * (wi.z * w / pl);
@@ -462,7 +444,7 @@ impl Context<'_> {
                     let w = match plan.escape {
                         Escape::Full => 1.0,
                         Escape::None => 0.0,
-                        Escape::Mis(h) => weight(h, s.pdf, self.env.pdf_compensated(d)),
+                        Escape::Mis(h) => h.weight(s.pdf, self.env.pdf_compensated(d)),
                     };
                     if w > 0.0 {
                         l += beta * s.weight * self.env.eval(d) * w;

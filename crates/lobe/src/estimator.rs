@@ -185,11 +185,16 @@ pub fn sample_value(m: &Material, s: Strategy, wo: DVec3, light: &Light, uc: f64
     }
 }
 
-#[inline]
-fn heuristic(h: Heuristic, a: f64, b: f64) -> f64 {
-    match h {
-        Heuristic::Balance => a / (a + b),
-        Heuristic::Power => a * a / (a * a + b * b),
+impl Heuristic {
+    /// The weight of a technique whose (count-scaled) density is `a`
+    /// against another's `b`.
+    #[inline]
+    #[must_use]
+    pub fn weight(self, a: f64, b: f64) -> f64 {
+        match self {
+            Heuristic::Balance => a / (a + b),
+            Heuristic::Power => a * a / (a * a + b * b),
+        }
     }
 }
 
@@ -221,7 +226,7 @@ pub fn technique_value(
                     let mut sum = Rgb::ZERO;
                     for p in &points[..mis.n_bsdf as usize] {
                         if let Some(x) = m.sample(mis.bsdf, wo, p[0], DVec2::new(p[1], p[2])) {
-                            let w = heuristic(mis.heuristic, nb * x.pdf, nl * light.pdf_mis(x.wi));
+                            let w = mis.heuristic.weight(nb * x.pdf, nl * light.pdf_mis(x.wi));
                             sum += x.weight * light.radiance(x.wi) * (w / nb);
                         }
                     }
@@ -229,7 +234,7 @@ pub fn technique_value(
                         if let Some((wi, pl)) = light.sample_mis(DVec2::new(p[1], p[2]))
                             && wi.z > 0.0
                         {
-                            let w = heuristic(mis.heuristic, nl * pl, nb * m.pdf(mis.bsdf, wo, wi));
+                            let w = mis.heuristic.weight(nl * pl, nb * m.pdf(mis.bsdf, wo, wi));
                             sum += m.eval(wo, wi) * light.radiance(wi) * (wi.z * w / (nl * pl));
                         }
                     }
@@ -244,8 +249,7 @@ pub fn technique_value(
                         let uc = p[0] / cb;
                         match m.sample(mis.bsdf, wo, uc, DVec2::new(p[1], p[2])) {
                             Some(x) => {
-                                let w =
-                                    heuristic(mis.heuristic, cb * x.pdf, cl * light.pdf_mis(x.wi));
+                                let w = mis.heuristic.weight(cb * x.pdf, cl * light.pdf_mis(x.wi));
                                 x.weight * light.radiance(x.wi) * (w / cb)
                             }
                             None => Rgb::ZERO,
@@ -253,8 +257,7 @@ pub fn technique_value(
                     } else {
                         match light.sample_mis(DVec2::new(p[1], p[2])) {
                             Some((wi, pl)) if wi.z > 0.0 => {
-                                let w =
-                                    heuristic(mis.heuristic, cl * pl, cb * m.pdf(mis.bsdf, wo, wi));
+                                let w = mis.heuristic.weight(cl * pl, cb * m.pdf(mis.bsdf, wo, wi));
                                 m.eval(wo, wi) * light.radiance(wi) * (wi.z * w / (cl * pl))
                             }
                             _ => Rgb::ZERO,

@@ -94,6 +94,17 @@ impl Material {
             .collect()
     }
 
+    /// The BSDF strategy to pair with light sampling in MIS: visible normals
+    /// where the material has them, else the lecture's `brdf`.
+    #[must_use]
+    pub fn best_bsdf_strategy(&self) -> Strategy {
+        if self.check(Strategy::Vndf).is_ok() {
+            Strategy::Vndf
+        } else {
+            Strategy::Brdf
+        }
+    }
+
     /// Probability of choosing the glossy lobe for `wo`.
     #[inline]
     #[must_use]
