@@ -9,6 +9,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use lobe::estimator::{Accumulator, Plan, estimate_chunk};
 use lobe::{Frame, Light, Material, Rgb};
 use rayon::prelude::*;
+use std::path::{Path, PathBuf};
 
 /// `--theta DEG` or `--wo x,y,z`: the view direction in the local frame.
 #[derive(Args, Debug, Clone)]
@@ -215,4 +216,44 @@ pub fn reference_par(m: &Material, wo: DVec3, light: &Light, rel: f64) -> Rgb {
         }
         _ => lobe::estimator::reference(m, wo, light, rel),
     }
+}
+
+/// `base` with `.ext` appended (keeping any dots already in the name).
+#[must_use]
+pub fn with_ext(base: &Path, ext: &str) -> PathBuf {
+    let mut s = base.as_os_str().to_owned();
+    s.push(".");
+    s.push(ext);
+    PathBuf::from(s)
+}
+
+/// The base name of a command's output files: `--out NAME` with a trailing
+/// extension from `written` dropped, or else the scene file's stem followed
+/// by `suffix`, in the current directory.
+pub fn output_base(
+    out: Option<&Path>,
+    scene: &Path,
+    written: &[&str],
+    suffix: &str,
+) -> Result<PathBuf> {
+    if let Some(p) = out {
+        let ext = p
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase);
+        return Ok(if ext.is_some_and(|e| written.contains(&e.as_str())) {
+            p.with_extension("")
+        } else {
+            p.to_path_buf()
+        });
+    }
+    let stem = scene.file_stem().ok_or_else(|| {
+        anyhow!(
+            "{}: cannot name the output after the scene file; give --out NAME",
+            scene.display()
+        )
+    })?;
+    let mut s = stem.to_owned();
+    s.push(suffix);
+    Ok(PathBuf::from(s))
 }

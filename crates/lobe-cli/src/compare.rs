@@ -1159,44 +1159,6 @@ pub fn print_table(cmp: &Comparison) {
     }
 }
 
-/// `NAME` for `--out NAME` (a trailing .png or .json dropped), or the
-/// scene's stem followed by `-compare`.
-fn output_base(args: &CompareArgs) -> Result<PathBuf> {
-    match &args.out {
-        Some(p) => {
-            let ext = p
-                .extension()
-                .and_then(|e| e.to_str())
-                .map(str::to_ascii_lowercase);
-            Ok(if matches!(ext.as_deref(), Some("png" | "json")) {
-                p.with_extension("")
-            } else {
-                p.clone()
-            })
-        }
-        None => {
-            let stem = args.scene.file_stem().ok_or_else(|| {
-                anyhow!(
-                    "{}: cannot name the output after the scene file; give --out NAME",
-                    args.scene.display()
-                )
-            })?;
-            let mut s = stem.to_owned();
-            s.push("-compare");
-            Ok(PathBuf::from(s))
-        }
-    }
-}
-
-/// `base` with `.ext` appended (keeping any dots in the name).
-#[must_use]
-pub fn with_ext(base: &Path, ext: &str) -> PathBuf {
-    let mut s = base.as_os_str().to_owned();
-    s.push(".");
-    s.push(ext);
-    PathBuf::from(s)
-}
-
 /// Run `lobe compare`.
 pub fn run(args: &CompareArgs) -> Result<()> {
     if args.spp == Some(0) {
@@ -1206,7 +1168,12 @@ pub fn run(args: &CompareArgs) -> Result<()> {
         bail!("--reference-spp 0: at least 1 sample per pixel");
     }
     let methods = args.strategies.as_deref().map(parse_methods).transpose()?;
-    let base = output_base(args)?;
+    let base = crate::common::output_base(
+        args.out.as_deref(),
+        &args.scene,
+        &["png", "json"],
+        "-compare",
+    )?;
     let scene = load_scene(&args.scene)?;
     let methods = methods.unwrap_or_else(|| default_methods(&scene));
     let spp = args.spp.unwrap_or(scene.options.spp).max(1);
@@ -1242,8 +1209,8 @@ pub fn run(args: &CompareArgs) -> Result<()> {
         }
     }
     let cmp = run_comparison(&scene, &settings);
-    let png = with_ext(&base, "png");
-    let json = with_ext(&base, "json");
+    let png = crate::common::with_ext(&base, "png");
+    let json = crate::common::with_ext(&base, "json");
     let (w, h) = (scene.camera.width, scene.camera.height);
     let name = args.scene.display().to_string();
     let figure = write_grid(

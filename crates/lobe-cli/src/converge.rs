@@ -18,6 +18,7 @@
 //! (series, run, N); each task depends only on its inputs, so the numbers do
 //! not depend on the thread count.
 
+use crate::common::with_ext;
 use crate::common::{LightArgs, ViewArgs, progress};
 use crate::figures::{self, Series};
 use anyhow::{Context, Result, anyhow, bail};
@@ -31,7 +32,7 @@ use lobe::sequence::{Sequence, hash64};
 use lobe::{Light, Material};
 use rayon::prelude::*;
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// Relative tolerance of the quadrature reference.
 pub const REFERENCE_TOLERANCE: f64 = 1e-9;
@@ -279,14 +280,6 @@ pub fn csv(curves: &[Curve]) -> String {
         }
     }
     s
-}
-
-/// `PREFIX` + `.ext` (appended, so that a prefix with dots keeps them).
-fn with_ext(prefix: &Path, ext: &str) -> PathBuf {
-    let mut s = prefix.as_os_str().to_owned();
-    s.push(".");
-    s.push(ext);
-    PathBuf::from(s)
 }
 
 /// The slopes as an aligned table: one row per strategy, one column per sequence.

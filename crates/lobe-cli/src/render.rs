@@ -4,7 +4,7 @@ use crate::common::progress;
 use anyhow::{Result, anyhow, bail};
 use clap::Args;
 use lobe_render::{Method, fallbacks, load_scene, render};
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::Instant;
 
 /// The arguments of `lobe render`.
@@ -84,43 +84,9 @@ Examples:
   lobe render scene.toml --spp 16 --strategy light --out light-16
   lobe render scene.toml --threads 1 --seed 7 --quiet";
 
-/// `NAME.exr` and `NAME.png` for `--out NAME` (a trailing .exr or .png is
-/// dropped), or for the scene's stem in the current directory.
-fn output_base(args: &RenderArgs) -> Result<PathBuf> {
-    match &args.out {
-        Some(p) => {
-            let ext = p
-                .extension()
-                .and_then(|e| e.to_str())
-                .map(str::to_ascii_lowercase);
-            if matches!(ext.as_deref(), Some("exr" | "png")) {
-                Ok(p.with_extension(""))
-            } else {
-                Ok(p.clone())
-            }
-        }
-        None => {
-            let stem = args.scene.file_stem().ok_or_else(|| {
-                anyhow!(
-                    "{}: cannot name the output after the scene file; give --out NAME",
-                    args.scene.display()
-                )
-            })?;
-            Ok(PathBuf::from(stem))
-        }
-    }
-}
-
-fn with_ext(base: &Path, ext: &str) -> PathBuf {
-    let mut s = base.as_os_str().to_owned();
-    s.push(".");
-    s.push(ext);
-    PathBuf::from(s)
-}
-
 /// Run `lobe render`.
 pub fn run(args: &RenderArgs) -> Result<()> {
-    let base = output_base(args)?;
+    let base = crate::common::output_base(args.out.as_deref(), &args.scene, &["exr", "png"], "")?;
     if args.spp == Some(0) {
         bail!("--spp 0: at least 1 sample per pixel");
     }
@@ -164,8 +130,8 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             image.stats.nonfinite
         );
     }
-    let exr = with_ext(&base, "exr");
-    let png = with_ext(&base, "png");
+    let exr = crate::common::with_ext(&base, "exr");
+    let png = crate::common::with_ext(&base, "png");
     image.write_exr(&exr)?;
     image.write_png(&png)?;
     let samples = image.stats.camera_rays as f64;
