@@ -21,7 +21,7 @@
 use crate::common::with_ext;
 use crate::common::{LightArgs, ViewArgs, progress};
 use crate::figures::{self, Series};
-use anyhow::{Context, Result, anyhow, bail};
+use anyhow::{Context, Result, bail};
 use clap::Args;
 use glam::DVec3;
 use indicatif::ProgressBar;
@@ -238,11 +238,7 @@ pub fn fit_slope(points: &[(usize, f64)]) -> Option<f64> {
 pub fn parse_sequences(spec: &str) -> Result<Vec<Sequence>> {
     let mut v = Vec::new();
     for name in spec.split(',').map(str::trim) {
-        let q: Sequence = name.parse().map_err(|_| {
-            anyhow!(
-                "--sequence {spec}: unknown sequence `{name}`, expected a comma-separated list of: independent, stratified, sobol"
-            )
-        })?;
+        let q = crate::estimate::parse_sequence(name)?;
         if !v.contains(&q) {
             v.push(q);
         }

@@ -54,6 +54,7 @@ use glam::DVec2;
 use lobe::envmap::EnvMap;
 use lobe::estimator::Heuristic;
 use lobe::math::Rgb;
+use lobe::sequence::hash64;
 use lobe::{Frame, Material, Strategy};
 use rand::RngExt;
 use rand_pcg::Pcg64;
@@ -322,22 +323,14 @@ fn render_on_pool(scene: &Scene, opts: &RenderOptions, progress: &(impl Fn(u64) 
 /// streams are unrelated).
 #[must_use]
 pub fn pixel_rng(seed: u64, index: u64) -> Pcg64 {
-    let a = mix64(seed ^ 0x6c6f_6265_7265_6e64);
-    let b = mix64(index ^ a.rotate_left(23));
-    let c = mix64(b ^ 0x9e37_79b9_7f4a_7c15);
-    let d = mix64(a ^ c);
+    let a = hash64(seed ^ 0x6c6f_6265_7265_6e64);
+    let b = hash64(index ^ a.rotate_left(23));
+    let c = hash64(b ^ 0x9e37_79b9_7f4a_7c15);
+    let d = hash64(a ^ c);
     Pcg64::new(
         (u128::from(a) << 64) | u128::from(b),
         (u128::from(c) << 64) | u128::from(d ^ index),
     )
-}
-
-/// SplitMix64's finalizer.
-fn mix64(mut z: u64) -> u64 {
-    z = z.wrapping_add(0x9e37_79b9_7f4a_7c15);
-    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-    z ^ (z >> 31)
 }
 
 struct Context<'a> {
