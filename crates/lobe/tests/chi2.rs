@@ -15,7 +15,6 @@ use lobe::stats::chi2::{Chi2Config, chi2_test, sidak, success_probability};
 fn run(cases: Vec<Case>) {
     let alpha = sidak(0.01, common::grid_size());
     let cfg = Chi2Config::default();
-    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("chi2-failures");
     let mut failures = Vec::new();
     let mut count = 0;
     for c in &cases {
@@ -39,9 +38,7 @@ fn run(cases: Vec<Case>) {
                 );
             }
             if !r.passes(alpha) {
-                std::fs::create_dir_all(&dir).unwrap();
-                let path = dir.join(format!("{label}.csv"));
-                r.write_tables(&cfg, &path).unwrap();
+                let path = common::write_failure(&r, &cfg, &label);
                 failures.push(format!(
                     "{} {s} θ={theta}: χ²={:.1} dof={} p={:.3e} < {alpha:.2e} {} (tables: {})",
                     c.json,

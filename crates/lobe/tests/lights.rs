@@ -71,10 +71,7 @@ fn environment_sampling_matches_its_pdf() {
             |z0, z1, p0, p1| cell_probability(&map, z0, z1, p0, p1),
         );
         if !r.passes(0.01 / 4.0) {
-            let path = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
-                .join(format!("chi2-failures/envmap-{name}.csv"));
-            std::fs::create_dir_all(path.parent().unwrap()).unwrap();
-            r.write_tables(&cfg, &path).unwrap();
+            let path = common::write_failure(&r, &cfg, &format!("envmap-{name}"));
             panic!(
                 "{name}: p = {} {:?}, tables in {}",
                 r.p_value,

@@ -110,3 +110,17 @@ pub fn plan(m: &Material) -> Vec<(Strategy, f64)> {
 pub fn grid_size() -> usize {
     all_cases().iter().map(|c| plan(&c.material).len()).sum()
 }
+
+/// Write a failed chi-square test's observed and expected tables to
+/// `target/tmp/chi2-failures/<label>.csv` and return the path.
+pub fn write_failure(
+    r: &lobe::stats::chi2::Chi2Result,
+    cfg: &lobe::stats::chi2::Chi2Config,
+    label: &str,
+) -> std::path::PathBuf {
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("chi2-failures");
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join(format!("{label}.csv"));
+    r.write_tables(cfg, &path).unwrap();
+    path
+}
