@@ -6,7 +6,7 @@ use anyhow::{Result, anyhow, bail};
 use clap::Args;
 use glam::DVec3;
 use indicatif::{ProgressBar, ProgressStyle};
-use lobe::estimator::{Accumulator, Plan, estimate_chunk};
+use lobe::estimator::{Accumulator, Plan, ShadingPoint, estimate_chunk};
 use lobe::{Frame, Light, Material, Rgb};
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
@@ -101,13 +101,29 @@ impl LightArgs {
         })
     }
 
-    /// The light in the local frame.
+    /// The light. An analytic light is given in the local frame (its
+    /// world direction taken there by `--normal` and `--tangent`); an
+    /// environment map in the world.
     pub fn light(&self) -> Result<Light> {
         parse_light(&self.light, &self.frame()?)
     }
+
+    /// The shading point of `light` ([`LightArgs::light`]) with view `wo`:
+    /// the frame of `--normal` and `--tangent` under an environment map, the
+    /// local frame itself under an analytic light (which is given in it).
+    pub fn shading_point(&self, light: &Light, wo: DVec3) -> Result<ShadingPoint> {
+        Ok(match light {
+            Light::Env(_) => ShadingPoint {
+                frame: self.frame()?,
+                wo,
+            },
+            _ => ShadingPoint::local(wo),
+        })
+    }
 }
 
-/// Parse a light description (see [`LightArgs`]) into the local `frame`.
+/// Parse a light description (see [`LightArgs`]); an analytic light's
+/// direction is taken to the local `frame`.
 pub fn parse_light(spec: &str, frame: &Frame) -> Result<Light> {
     let mut parts = spec.split(':');
     let kind = parts.next().unwrap_or_default();
@@ -137,7 +153,7 @@ pub fn parse_light(spec: &str, frame: &Frame) -> Result<Light> {
             if parts.next().is_some() {
                 bail!("--light {spec}: expected lobe[:K[:X,Y,Z[:VALUE]]]");
             }
-            Ok(Light::Lobe {
+            Ok(Light::Beam {
                 dir: frame.to_local(d.normalize()),
                 exponent: k,
                 radiance: Rgb::splat(v),
@@ -150,10 +166,7 @@ pub fn parse_light(spec: &str, frame: &Frame) -> Result<Light> {
                     "lobe: warning: {spec}: {clamped} texels had negative or NaN values, clamped to 0"
                 );
             }
-            Ok(Light::Env {
-                map: std::sync::Arc::new(map),
-                frame: *frame,
-            })
+            Ok(Light::Env(std::sync::Arc::new(map)))
         }
         _ => bail!(
             "--light {spec}: unknown light `{kind}`, expected constant[:VALUE], lobe[:K[:X,Y,Z[:VALUE]]], sky, or an environment map FILE.hdr / FILE.exr"
@@ -183,15 +196,16 @@ pub fn progress(len: u64, message: &str, quiet: bool) -> ProgressBar {
 /// the chunks in order: the same numbers for any thread count.
 pub fn estimate_par(
     m: &Material,
-    wo: DVec3,
+    sp: &ShadingPoint,
     light: &Light,
     plan: &Plan,
     pb: &ProgressBar,
-) -> Accumulator {
+) -> Result<Accumulator> {
+    let est = plan.technique.for_material(m)?;
     let parts: Vec<Accumulator> = (0..plan.chunks())
         .into_par_iter()
         .map(|c| {
-            let a = estimate_chunk(m, wo, light, plan, c);
+            let a = estimate_chunk(&est, sp, light, plan, c);
             pb.inc(a.count() as u64);
             a
         })
@@ -200,21 +214,21 @@ pub fn estimate_par(
     for p in &parts {
         acc.merge(p);
     }
-    acc
+    Ok(acc)
 }
 
 /// [`lobe::estimator::reference`] with an environment map's rows summed on
 /// rayon's pool (in row order, so the same number for any thread count).
-pub fn reference_par(m: &Material, wo: DVec3, light: &Light, rel: f64) -> Rgb {
+pub fn reference_par(m: &Material, sp: &ShadingPoint, light: &Light, rel: f64) -> Rgb {
     match light {
-        Light::Env { map, frame } => {
+        Light::Env(map) => {
             let rows: Vec<Rgb> = (0..map.size().1)
                 .into_par_iter()
-                .map(|j| lobe::estimator::reference_env_row(m, wo, map, frame, j, rel))
+                .map(|j| lobe::estimator::reference_env_row(m, sp, map, j, rel))
                 .collect();
             rows.iter().fold(Rgb::ZERO, |a, &b| a + b)
         }
-        _ => lobe::estimator::reference(m, wo, light, rel),
+        _ => lobe::estimator::reference(m, sp, light, rel),
     }
 }
 

@@ -27,9 +27,9 @@ use crate::figures::viridis;
 use anyhow::{Result, anyhow, bail};
 use clap::Args;
 use lobe::Strategy;
-use lobe::estimator::Heuristic;
+use lobe::estimator::{Heuristic, Technique};
 use lobe::math::luminance;
-use lobe_render::{Image, Method, RenderOptions, Scene, fallbacks, load_scene, render};
+use lobe_render::{Image, RenderOptions, Scene, fallbacks, load_scene, render};
 use plotters::coord::Shift;
 use plotters::element::BitMapElement;
 use plotters::prelude::*;
@@ -92,7 +92,7 @@ pub struct CompareArgs {
 }
 
 /// The method of the reference render.
-pub const REFERENCE_METHOD: Method = Method::Mis(Heuristic::Balance);
+pub const REFERENCE_METHOD: Technique = Technique::mis(Heuristic::Balance);
 
 /// Most samples per pixel an equal-time render may take.
 const MAX_EQUAL_TIME_SPP: f64 = 1_048_576.0;
@@ -100,7 +100,7 @@ const MAX_EQUAL_TIME_SPP: f64 = 1_048_576.0;
 /// What to compare and how.
 #[derive(Debug, Clone)]
 pub struct Settings {
-    pub methods: Vec<Method>,
+    pub methods: Vec<Technique>,
     /// Samples per pixel at equal samples.
     pub spp: u32,
     pub reference_spp: u32,
@@ -115,7 +115,7 @@ pub struct Settings {
 /// One render of a comparison.
 #[derive(Debug, Clone)]
 pub struct Shot {
-    pub method: Method,
+    pub method: Technique,
     pub spp: u32,
     /// Wall time of the render.
     pub time_s: f64,
@@ -146,30 +146,30 @@ pub struct Comparison {
 /// The default strategies for `scene`: brdf, vndf (when an object's
 /// material has it), light and mis.
 #[must_use]
-pub fn default_methods(scene: &Scene) -> Vec<Method> {
-    let mut v = vec![Method::Bsdf(Strategy::Brdf)];
+pub fn default_methods(scene: &Scene) -> Vec<Technique> {
+    let mut v = vec![Technique::Bsdf(Strategy::Brdf)];
     if scene
         .objects
         .iter()
         .any(|o| o.material.check(Strategy::Vndf).is_ok())
     {
-        v.push(Method::Bsdf(Strategy::Vndf));
+        v.push(Technique::Bsdf(Strategy::Vndf));
     }
-    v.extend([Method::Light, Method::Mis(Heuristic::Balance)]);
+    v.extend([Technique::Light, Technique::mis(Heuristic::Balance)]);
     v
 }
 
 /// Parse `--strategies`: a comma-separated list of method names, each once.
-pub fn parse_methods(spec: &str) -> Result<Vec<Method>> {
+pub fn parse_methods(spec: &str) -> Result<Vec<Technique>> {
     let mut v = Vec::new();
     for name in spec.split(',').map(str::trim) {
         if name.is_empty() {
             bail!(
                 "--strategies {spec}: an empty name; expected a comma-separated list of: {}",
-                Method::NAMES
+                Technique::names()
             );
         }
-        let m: Method = name.parse().map_err(|e| anyhow!("--strategies: {e}"))?;
+        let m: Technique = name.parse().map_err(|e| anyhow!("--strategies: {e}"))?;
         if !v.contains(&m) {
             v.push(m);
         }
@@ -193,14 +193,14 @@ pub fn default_reference_spp(spp: u32) -> u32 {
 fn render_one(
     scene: &Scene,
     s: &Settings,
-    method: Method,
+    method: Technique,
     spp: u32,
     seed: u64,
     what: &str,
 ) -> (Image, f64) {
     let opts = RenderOptions {
         spp,
-        method,
+        technique: method,
         seed,
         max_depth: s.max_depth,
         threads: s.threads,
@@ -245,7 +245,7 @@ pub fn run_comparison(scene: &Scene, s: &Settings) -> Comparison {
     let equal_time = s.equal_time.then(|| {
         let mis = equal_samples
             .iter()
-            .find(|x| x.method == Method::Mis(Heuristic::Balance));
+            .find(|x| x.method == Technique::mis(Heuristic::Balance));
         let (budget_s, budget_from) = match mis {
             Some(x) => (x.time_s, format!("the time of mis at {spp} spp")),
             None => {

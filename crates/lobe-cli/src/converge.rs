@@ -23,10 +23,9 @@ use crate::common::{LightArgs, ViewArgs, progress};
 use crate::figures::{self, Series};
 use anyhow::{Context, Result, bail};
 use clap::Args;
-use glam::DVec3;
 use indicatif::ProgressBar;
 use lobe::estimator::Technique;
-use lobe::estimator::{Plan, estimate, reference};
+use lobe::estimator::{Plan, ShadingPoint, estimate, reference};
 use lobe::math::luminance;
 use lobe::sequence::{Sequence, hash64};
 use lobe::{Light, Material};
@@ -153,7 +152,7 @@ pub fn total_samples(series: usize, runs: usize, max_exp: u32) -> u64 {
 #[allow(clippy::too_many_arguments)]
 pub fn curves(
     m: &Material,
-    wo: DVec3,
+    sp: &ShadingPoint,
     light: &Light,
     target: f64,
     series: &[(Technique, Sequence)],
@@ -183,7 +182,7 @@ pub fn curves(
                 samples: 1usize << k,
                 seed: run_seed(seed, r, k),
             };
-            let acc = estimate(m, wo, light, &plan);
+            let acc = estimate(m, sp, light, &plan).expect("techniques are checked when parsed");
             pb.inc(plan.samples as u64);
             acc.lum.mean() - target
         })
@@ -329,6 +328,7 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
     let m = crate::eval::load_material(&args.material)?;
     let wo = args.view.wo()?;
     let light = args.light.light()?;
+    let sp = args.light.shading_point(&light, wo)?;
     let strategies =
         crate::estimate::parse_techniques(&args.strategy, &m, m.best_bsdf_strategy(), 1, 1)?;
     let setup = Setup {
@@ -339,7 +339,7 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
         seed: args.seed,
     };
 
-    let target = luminance(reference(&m, wo, &light, REFERENCE_TOLERANCE));
+    let target = luminance(reference(&m, &sp, &light, REFERENCE_TOLERANCE));
     if !target.is_finite() {
         bail!("the quadrature reference is not finite ({target})");
     }
@@ -351,7 +351,7 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
     );
     let curves = curves(
         &m,
-        wo,
+        &sp,
         &light,
         target,
         &series,

@@ -19,7 +19,7 @@ use lobe::estimator::{Heuristic, Technique};
 use lobe::math::luminance;
 use lobe::sequence::Sequence;
 use lobe::{Light, MaterialDesc, Rgb, Strategy};
-use lobe_render::{Camera, Method, Object, Scene, load_envmap};
+use lobe_render::{Camera, Object, Scene, load_envmap};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -135,14 +135,14 @@ fn tour(plan: &Plan, quiet: bool) -> Result<()> {
             .collect();
         let table = crate::estimate::run_table(
             &m,
-            wo,
+            &lobe::estimator::ShadingPoint::local(wo),
             &light,
             &techniques,
             Sequence::Independent,
             n,
             1,
             quiet,
-        );
+        )?;
         println!(
             "{label}: reference {:.5}",
             luminance(Rgb::from_array(table.reference))
@@ -278,9 +278,9 @@ fn showcase(plan: &Plan, dir: &Path, quiet: bool) -> Result<()> {
     let (scene, labels) = showcase_scene(plan.width, plan.height)?;
     let settings = Settings {
         methods: vec![
-            Method::Bsdf(Strategy::Brdf),
-            Method::Light,
-            Method::Mis(Heuristic::Balance),
+            Technique::Bsdf(Strategy::Brdf),
+            Technique::Light,
+            Technique::mis(Heuristic::Balance),
         ],
         spp: plan.spp,
         reference_spp: plan.reference_spp,

@@ -5,7 +5,7 @@ use crate::common::{LightArgs, ViewArgs, estimate_par, progress};
 use anyhow::{Result, bail};
 use clap::Args;
 use glam::DVec3;
-use lobe::estimator::{Heuristic, Mis, MisForm, Plan, Technique};
+use lobe::estimator::{Heuristic, Mis, MisForm, Plan, ShadingPoint, Technique};
 use lobe::math::luminance;
 use lobe::sequence::Sequence;
 use lobe::{Light, Material, Strategy};
@@ -107,7 +107,7 @@ pub fn parse_techniques(
 ) -> Result<Vec<Technique>> {
     let mis = |h, form| {
         Technique::Mis(Mis {
-            bsdf: mis_bsdf,
+            bsdf: Some(mis_bsdf),
             heuristic: h,
             form,
             n_bsdf,
@@ -175,15 +175,15 @@ pub fn parse_sequence(spec: &str) -> Result<Sequence> {
 /// variance reduction is against `uniform`, run too if not in the list.
 pub fn run_table(
     m: &Material,
-    wo: DVec3,
+    sp: &ShadingPoint,
     light: &Light,
     techniques: &[Technique],
     sequence: Sequence,
     samples: usize,
     seed: u64,
     quiet: bool,
-) -> Table {
-    let reference = crate::common::reference_par(m, wo, light, REFERENCE_TOLERANCE);
+) -> Result<Table> {
+    let reference = crate::common::reference_par(m, sp, light, REFERENCE_TOLERANCE);
     let r_lum = luminance(reference);
     let uniform = Technique::Bsdf(Strategy::Uniform);
     let mut todo: Vec<Technique> = techniques.to_vec();
@@ -200,7 +200,7 @@ pub fn run_table(
             seed,
         };
         let t0 = Instant::now();
-        let acc = estimate_par(m, wo, light, &plan, &pb);
+        let acc = estimate_par(m, sp, light, &plan, &pb)?;
         let time_s = t0.elapsed().as_secs_f64();
         let mean = acc.mean();
         let variance = acc.lum.variance();
@@ -238,16 +238,16 @@ pub fn run_table(
         row.variance_reduction = (row.variance > 0.0).then(|| uniform / row.variance);
         out.push(row);
     }
-    Table {
+    Ok(Table {
         reference: reference.to_array(),
-        reference_method: if matches!(light, Light::Env { .. }) {
+        reference_method: if matches!(light, Light::Env(_)) {
             "a sum over the map's texels of radiance × ∫ f cos dω (4×4 Gauss-Legendre per texel, refined to 1e-9 relative, f64)"
         } else {
             "deterministic adaptive quadrature (Gauss-Kronrod, f64, relative tolerance 1e-9)"
         },
         sequence: sequence.name().to_string(),
         strategies: out,
-    }
+    })
 }
 
 pub fn run(args: &EstimateArgs) -> Result<()> {
@@ -276,16 +276,17 @@ pub fn run(args: &EstimateArgs) -> Result<()> {
     let (n_bsdf, n_light) = parse_mis_samples(&args.mis_samples)?;
     let strategies = parse_techniques(&args.strategy, &m, mis_bsdf, n_bsdf, n_light)?;
     let sequence = parse_sequence(&args.sequence)?;
+    let sp = args.light.shading_point(&light, wo)?;
     let table = run_table(
         &m,
-        wo,
+        &sp,
         &light,
         &strategies,
         sequence,
         args.samples,
         args.seed,
         args.quiet,
-    );
+    )?;
     for row in &table.strategies {
         if !row.mean.iter().chain(&row.stderr).all(|v| v.is_finite()) || !row.variance.is_finite() {
             bail!(

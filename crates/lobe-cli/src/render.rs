@@ -3,7 +3,8 @@
 use crate::common::progress;
 use anyhow::{Result, anyhow, bail};
 use clap::Args;
-use lobe_render::{Method, fallbacks, load_scene, render};
+use lobe::estimator::Technique;
+use lobe_render::{fallbacks, load_scene, render};
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -90,7 +91,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     if args.spp == Some(0) {
         bail!("--spp 0: at least 1 sample per pixel");
     }
-    let method: Option<Method> = match &args.strategy {
+    let method: Option<Technique> = match &args.strategy {
         Some(s) => Some(s.parse().map_err(|m| anyhow!("--strategy: {m}"))?),
         None => None,
     };
@@ -100,7 +101,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         opts.spp = n;
     }
     if let Some(m) = method {
-        opts.method = m;
+        opts.technique = m;
     }
     if let Some(s) = args.seed {
         opts.seed = s;
@@ -111,7 +112,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         eprintln!("lobe: warning: {w}");
     }
     if !args.quiet {
-        for f in fallbacks(&scene, opts.method) {
+        for f in fallbacks(&scene, opts.technique) {
             eprintln!(
                 "lobe: note: object {} ({}): {} does not apply to its material, using {}",
                 f.object, f.model, f.requested, f.used
@@ -140,7 +141,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         exr.display(),
         png.display(),
         opts.spp,
-        opts.method,
+        opts.technique,
         opts.max_depth,
         secs,
         samples / secs.max(1e-9) / 1e6,

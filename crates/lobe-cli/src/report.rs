@@ -324,14 +324,14 @@ pub fn run(args: &ReportArgs) -> Result<()> {
             for &theta in &THETAS {
                 let t = run_table(
                     m,
-                    view(theta),
+                    &lobe::estimator::ShadingPoint::local(view(theta)),
                     &light,
                     &techniques,
                     Sequence::Independent,
                     settings.samples,
                     args.seed,
                     true,
-                );
+                )?;
                 v.push((value, theta, t));
                 pb.inc(1);
             }
@@ -451,7 +451,7 @@ fn run_job(
             let series = convergence_series(m);
             let curves = converge::curves(
                 m,
-                wo,
+                &lobe::estimator::ShadingPoint::local(wo),
                 &light,
                 target,
                 &series,
@@ -625,7 +625,7 @@ fn polar_curves(m: &Material, wo: DVec3) -> Vec<(String, Vec<(f64, f64)>)> {
     let dir = |t: f64| DVec3::new(-t.sin(), 0.0, t.cos()).normalize();
     let albedo = luminance(lobe::estimator::reference(
         m,
-        wo,
+        &lobe::estimator::ShadingPoint::local(wo),
         &Light::Constant(Rgb::ONE),
         1e-6,
     ));

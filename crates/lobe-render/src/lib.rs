@@ -19,13 +19,14 @@
 //! A scene in code:
 //!
 //! ```
-//! use lobe_render::{Camera, Object, RenderOptions, Scene, Method, render};
+//! use lobe_render::{Camera, Object, RenderOptions, Scene, render};
+//! use lobe::estimator::Technique;
 //! use lobe::{envmap::EnvMap, Material, Rgb, Strategy};
 //! use glam::DVec3;
 //! let camera = Camera::new(DVec3::new(0.0, 0.0, 4.0), DVec3::ZERO, DVec3::Y, 40.0, 8, 6)?;
 //! let scene = Scene::new(camera, EnvMap::constant(Rgb::ONE))
 //!     .with(Object::sphere(DVec3::ZERO, 1.0, Material::lambert(Rgb::ONE)?)?);
-//! let opts = RenderOptions { spp: 4, method: Method::Bsdf(Strategy::Cosine), ..Default::default() };
+//! let opts = RenderOptions { spp: 4, technique: Technique::Bsdf(Strategy::Cosine), ..Default::default() };
 //! let img = render(&scene, &opts, |_| {});
 //! assert!((img.get(4, 3).x - 1.0).abs() < 1e-9); // the white furnace
 //! # Ok::<(), Box<dyn std::error::Error>>(())
@@ -35,6 +36,7 @@ pub mod camera;
 pub mod envmap_io;
 pub mod geometry;
 pub mod mesh;
+pub mod options;
 pub mod output;
 pub mod render;
 pub mod scene;
@@ -44,5 +46,6 @@ pub use envmap_io::{LoadError, load_envmap};
 pub use geometry::{Hit, Ray};
 pub use mesh::{Mesh, MeshError};
 pub use output::OutputError;
-pub use render::{Image, Method, RenderOptions, RenderStats, fallbacks, render};
+pub use options::RenderOptions;
+pub use render::{Image, RenderStats, fallbacks, render, technique_for};
 pub use scene::{Object, Scene, SceneDesc, SceneError, Shape, load_scene, parse_scene, showcase};

@@ -49,99 +49,18 @@
 //! from `(seed, y · width + x)`, so the image is the same bit for bit for
 //! any thread count and any order of the rows.
 
+use crate::geometry::{Hit, spawn_ray};
+pub use crate::options::RenderOptions;
 use crate::scene::Scene;
-use glam::DVec2;
-use lobe::envmap::EnvMap;
-use lobe::estimator::Heuristic;
+use glam::{DVec2, DVec3};
+use lobe::estimator::{DrawnBsdf, MisForm, ShadingEstimator, ShadingPoint, Technique, Visibility};
+use lobe::light::Light;
 use lobe::math::Rgb;
 use lobe::sequence::hash64;
-use lobe::{Frame, Material, Strategy};
+use lobe::{BsdfSampler, Frame, Material, Strategy};
 use rand::RngExt;
 use rand_pcg::Pcg64;
 use rayon::prelude::*;
-
-use crate::geometry::spawn_ray;
-
-/// How the reflected radiance is estimated (the scene's `strategy`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum Method {
-    /// BSDF sampling by a strategy (falls back to `brdf` per object).
-    Bsdf(Strategy),
-    /// Light sampling of the environment map alone.
-    Light,
-    /// BSDF and light sampling combined by multi-sample MIS, one sample each.
-    Mis(Heuristic),
-}
-
-impl Method {
-    /// Every accepted name, for help and error messages.
-    pub const NAMES: &'static str =
-        "uniform, cosine, brdf, vndf, spherical-caps, bounded-vndf, light, mis, mis-power";
-
-    #[must_use]
-    pub fn name(&self) -> &'static str {
-        match self {
-            Method::Bsdf(s) => s.name(),
-            Method::Light => "light",
-            Method::Mis(Heuristic::Balance) => "mis",
-            Method::Mis(Heuristic::Power) => "mis-power",
-        }
-    }
-
-    /// Every method, in [`Method::NAMES`] order.
-    #[must_use]
-    pub fn all() -> Vec<Method> {
-        let mut v: Vec<Method> = Strategy::ALL.into_iter().map(Method::Bsdf).collect();
-        v.extend([
-            Method::Light,
-            Method::Mis(Heuristic::Balance),
-            Method::Mis(Heuristic::Power),
-        ]);
-        v
-    }
-}
-
-impl std::fmt::Display for Method {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-impl std::str::FromStr for Method {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        Method::all()
-            .into_iter()
-            .find(|m| m.name() == s)
-            .ok_or_else(|| format!("unknown strategy `{s}`, expected one of: {}", Method::NAMES))
-    }
-}
-
-/// What to render: samples per pixel, the method, the seed, the path
-/// depth, and the thread count.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct RenderOptions {
-    /// Samples (camera rays) per pixel, at least 1.
-    pub spp: u32,
-    pub method: Method,
-    pub seed: u64,
-    /// 1 = direct lighting; more adds bounces. At least 1.
-    pub max_depth: u32,
-    /// Threads of a local pool; `None` runs on rayon's current pool.
-    pub threads: Option<usize>,
-}
-
-impl Default for RenderOptions {
-    fn default() -> Self {
-        RenderOptions {
-            spp: 64,
-            method: Method::Mis(Heuristic::Balance),
-            seed: 1,
-            max_depth: 1,
-            threads: None,
-        }
-    }
-}
 
 /// Counters of one render.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -184,52 +103,37 @@ impl Image {
     }
 }
 
-/// How one object is shaded under a [`Method`].
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ObjectPlan {
-    /// The strategy that draws BSDF samples (for MIS, and for continuing
-    /// paths).
-    pub bsdf: Strategy,
-    /// Whether light samples (next-event estimation) are taken.
-    pub light: bool,
-    /// How a BSDF-sampled ray that escapes to the environment counts.
-    pub escape: Escape,
+/// How one object is shaded: the technique validated for its material, and
+/// the BSDF sampler that continues its paths.
+#[derive(Debug, Clone, Copy)]
+struct ObjectShading<'m> {
+    estimator: ShadingEstimator<'m>,
+    /// The technique's own BSDF sampler, or for `light` the material's best.
+    continuation: BsdfSampler<'m>,
 }
 
-/// The weight of the environment seen by a BSDF-sampled ray.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Escape {
-    /// In full (BSDF sampling alone).
-    Full,
-    /// Not at all (light sampling alone gives the direct light).
-    None,
-    /// MIS-weighted against light sampling.
-    Mis(Heuristic),
-}
-
-/// The plan for a material under `method` (with the `brdf` fallback).
+/// The technique `technique` becomes on material `m`: a BSDF strategy that
+/// does not apply falls back to `brdf`, which applies to every material.
 #[must_use]
-pub fn plan(method: Method, m: &Material) -> ObjectPlan {
-    match method {
-        Method::Bsdf(s) => ObjectPlan {
-            bsdf: if m.check(s).is_ok() {
-                s
-            } else {
-                Strategy::Brdf
-            },
-            light: false,
-            escape: Escape::Full,
-        },
-        Method::Light => ObjectPlan {
-            bsdf: m.best_bsdf_strategy(),
-            light: true,
-            escape: Escape::None,
-        },
-        Method::Mis(h) => ObjectPlan {
-            bsdf: m.best_bsdf_strategy(),
-            light: true,
-            escape: Escape::Mis(h),
-        },
+pub fn technique_for(technique: Technique, m: &Material) -> Technique {
+    match technique {
+        Technique::Bsdf(s) if m.check(s).is_err() => Technique::Bsdf(Strategy::Brdf),
+        t => t,
+    }
+}
+
+fn object_shading(technique: Technique, m: &Material) -> ObjectShading<'_> {
+    let estimator = technique_for(technique, m)
+        .for_material(m)
+        .or_else(|_| Technique::Bsdf(Strategy::Brdf).for_material(m))
+        .expect("brdf applies to every material");
+    let continuation = estimator.sampler().unwrap_or_else(|| {
+        m.sampler(m.best_bsdf_strategy())
+            .expect("the best BSDF strategy applies")
+    });
+    ObjectShading {
+        estimator,
+        continuation,
     }
 }
 
@@ -242,10 +146,10 @@ pub struct Fallback {
     pub used: Strategy,
 }
 
-/// The objects on which `method`'s BSDF strategy falls back to `brdf`.
+/// The objects on which `technique`'s BSDF strategy falls back to `brdf`.
 #[must_use]
-pub fn fallbacks(scene: &Scene, method: Method) -> Vec<Fallback> {
-    let Method::Bsdf(s) = method else {
+pub fn fallbacks(scene: &Scene, technique: Technique) -> Vec<Fallback> {
+    let Technique::Bsdf(s) = technique else {
         return Vec::new();
     };
     scene
@@ -253,7 +157,9 @@ pub fn fallbacks(scene: &Scene, method: Method) -> Vec<Fallback> {
         .iter()
         .enumerate()
         .filter_map(|(i, o)| {
-            let used = plan(method, &o.material).bsdf;
+            let Technique::Bsdf(used) = technique_for(technique, &o.material) else {
+                return None;
+            };
             (used != s).then(|| Fallback {
                 object: i,
                 model: o.material.model_name(),
@@ -280,15 +186,16 @@ pub fn render(scene: &Scene, opts: &RenderOptions, progress: impl Fn(u64) + Sync
 
 fn render_on_pool(scene: &Scene, opts: &RenderOptions, progress: &(impl Fn(u64) + Sync)) -> Image {
     let (w, h) = (scene.camera.width as usize, scene.camera.height as usize);
-    let plans: Vec<ObjectPlan> = scene
+    let shading: Vec<ObjectShading> = scene
         .objects
         .iter()
-        .map(|o| plan(opts.method, &o.material))
+        .map(|o| object_shading(opts.technique, &o.material))
         .collect();
+    let light = Light::Env(scene.environment.clone());
     let ctx = Context {
         scene,
-        env: &scene.environment,
-        plans: &plans,
+        light: &light,
+        shading: &shading,
         spp: opts.spp.max(1),
         max_depth: opts.max_depth.max(1),
         seed: opts.seed,
@@ -335,12 +242,38 @@ pub fn pixel_rng(seed: u64, index: u64) -> Pcg64 {
 
 struct Context<'a> {
     scene: &'a Scene,
-    env: &'a EnvMap,
-    plans: &'a [ObjectPlan],
+    light: &'a Light,
+    shading: &'a [ObjectShading<'a>],
     spp: u32,
     max_depth: u32,
     seed: u64,
     width: usize,
+}
+
+/// What the scene lets through from a shading point at `p` (geometric
+/// normal `ng`): shadow rays for light samples; a BSDF-sampled ray keeps its
+/// hit, to continue the path.
+struct SceneVisibility<'a> {
+    scene: &'a Scene,
+    p: DVec3,
+    ng: DVec3,
+    rays: u64,
+    hit: Option<(Hit, usize)>,
+}
+
+impl Visibility for SceneVisibility<'_> {
+    fn unoccluded(&mut self, dir: DVec3) -> bool {
+        self.rays += 1;
+        !self.scene.occluded(&spawn_ray(self.p, self.ng, dir))
+    }
+
+    fn escapes(&mut self, dir: DVec3) -> bool {
+        self.rays += 1;
+        self.hit = self
+            .scene
+            .intersect(&spawn_ray(self.p, self.ng, dir), f64::INFINITY);
+        self.hit.is_none()
+    }
 }
 
 impl Context<'_> {
@@ -365,15 +298,16 @@ impl Context<'_> {
     fn radiance(&self, ray: crate::geometry::Ray, rng: &mut Pcg64, stats: &mut RenderStats) -> Rgb {
         stats.rays += 1;
         let Some((mut hit, mut obj)) = self.scene.intersect(&ray, f64::INFINITY) else {
-            return self.env.eval(ray.dir);
+            return self.light.radiance(ray.dir);
         };
         let mut wo_world = -ray.dir;
         let mut beta = Rgb::ONE;
         let mut l = Rgb::ZERO;
         let mut depth = 1u32;
+        let mut points = [[0.0; 3]; 2];
         loop {
-            let m = &self.scene.objects[obj].material;
-            let plan = &self.plans[obj];
+            let shading = &self.shading[obj];
+            let est = &shading.estimator;
             // Normals turned toward the viewer; the shading normal on the
             // geometric normal's side, and the geometric one where the
             // interpolated normal would put the viewer below the horizon.
@@ -395,74 +329,70 @@ impl Context<'_> {
             if wo.z <= 0.0 {
                 break;
             }
-            if plan.light {
-                let u = DVec2::new(rng.random(), rng.random());
-                // MIS draws from the compensated distribution, as lobe's
-                // estimator does (`Light::sample_mis`).
-                let drawn = match plan.escape {
-                    Escape::Mis(_) => self.env.sample_compensated(u),
-                    _ => self.env.sample(u),
-                };
-                if let Some((d, pl)) = drawn {
-                    let wi = frame.to_local(d);
-                    if wi.z > 0.0 {
-                        let f = m.eval(wo, wi);
-                        if f != Rgb::ZERO {
-                            stats.rays += 1;
-                            if !self.scene.occluded(&spawn_ray(hit.p, ng, d)) {
-                                let w = match plan.escape {
-                                    Escape::Mis(h) => h.weight(pl, m.pdf(plan.bsdf, wo, wi)),
-                                    _ => 1.0,
-                                };
-                                l += beta * f * self.env.eval(d) * (wi.z * w / pl);
-                            }
-                        }
-                    }
-                }
-            }
+            let sp = ShadingPoint { frame, wo };
             let go_on = depth < self.max_depth;
-            if plan.escape == Escape::None && !go_on {
+            let technique = est.technique();
+            // The random numbers, light samples' first, then the BSDF
+            // sample's (lobe choice, direction).
+            let k = technique.points_per_sample();
+            debug_assert!(k <= points.len());
+            match technique {
+                Technique::Light => {
+                    points[0] = [0.0, rng.random(), rng.random()];
+                }
+                Technique::Mis(m) if m.form == MisForm::MultiSample => {
+                    points[1] = [0.0, rng.random(), rng.random()];
+                    points[0] = [rng.random(), rng.random(), rng.random()];
+                }
+                _ => points[0] = [rng.random(), rng.random(), rng.random()],
+            }
+            let mut vis = SceneVisibility {
+                scene: self.scene,
+                p: hit.p,
+                ng,
+                rays: 0,
+                hit: None,
+            };
+            let e = est.estimate(&sp, self.light, &points[..k], &mut vis);
+            l += beta * e.value;
+            if !go_on {
+                stats.rays += vis.rays;
                 break;
             }
-            let uc: f64 = rng.random();
-            let u = DVec2::new(rng.random(), rng.random());
-            let Some(s) = m.sample(plan.bsdf, wo, uc, u) else {
+            // Continue with the estimate's BSDF sample, or draw one (light
+            // sampling alone, or one-sample MIS that chose the light).
+            let drawn = e.bsdf.or_else(|| {
+                let uc: f64 = rng.random();
+                let u = DVec2::new(rng.random(), rng.random());
+                let s = shading.continuation.sample(wo, uc, u)?;
+                let dir = frame.to_world(s.wi);
+                let escaped = vis.escapes(dir);
+                Some(DrawnBsdf {
+                    sample: s,
+                    dir,
+                    escaped,
+                })
+            });
+            stats.rays += vis.rays;
+            let Some(d) = drawn else {
                 break;
             };
-            let d = frame.to_world(s.wi).normalize();
-            let next = spawn_ray(hit.p, ng, d);
-            stats.rays += 1;
-            match self.scene.intersect(&next, f64::INFINITY) {
-                None => {
-                    let w = match plan.escape {
-                        Escape::Full => 1.0,
-                        Escape::None => 0.0,
-                        Escape::Mis(h) => h.weight(s.pdf, self.env.pdf_compensated(d)),
-                    };
-                    if w > 0.0 {
-                        l += beta * s.weight * self.env.eval(d) * w;
-                    }
+            let Some((h2, o2)) = vis.hit.filter(|_| !d.escaped) else {
+                break;
+            };
+            beta *= d.sample.weight;
+            depth += 1;
+            if depth > 3 {
+                // Russian roulette after the third bounce.
+                let q = beta.max_element().min(0.95);
+                if q <= 0.0 || rng.random::<f64>() >= q {
                     break;
                 }
-                Some((h2, o2)) => {
-                    if !go_on {
-                        break;
-                    }
-                    beta *= s.weight;
-                    depth += 1;
-                    if depth > 3 {
-                        // Russian roulette after the third bounce.
-                        let q = beta.max_element().min(0.95);
-                        if q <= 0.0 || rng.random::<f64>() >= q {
-                            break;
-                        }
-                        beta /= q;
-                    }
-                    hit = h2;
-                    obj = o2;
-                    wo_world = -d;
-                }
+                beta /= q;
             }
+            hit = h2;
+            obj = o2;
+            wo_world = -d.dir;
         }
         l
     }

@@ -34,7 +34,8 @@ use crate::camera::{Camera, CameraError};
 use crate::envmap_io::load_envmap;
 use crate::geometry::{Hit, Plane, Ray, Sphere};
 use crate::mesh::Mesh;
-use crate::render::{Method, RenderOptions};
+use crate::options::RenderOptions;
+use lobe::estimator::Technique;
 use glam::DVec3;
 use lobe::envmap::EnvMap;
 use lobe::{Material, MaterialDesc};
@@ -617,15 +618,15 @@ fn build(desc: &SceneDesc, base: &Path) -> FieldResult<Scene> {
             ),
         ));
     }
-    let method: Method = r
+    let technique: Technique = r
         .strategy
         .parse()
-        .map_err(|m: String| (render_field("strategy"), m))?;
+        .map_err(|e: lobe::Error| (render_field("strategy"), e.to_string()))?;
 
     let mut scene = Scene::new(camera, map);
     scene.options = RenderOptions {
         spp: r.spp,
-        method,
+        technique,
         seed: r.seed,
         max_depth: r.max_depth,
         threads: None,
@@ -796,7 +797,7 @@ strategy = "vndf"
         let s = parse_scene(GOOD, Path::new("scene.toml")).unwrap();
         assert_eq!(s.objects.len(), 2);
         assert_eq!(s.options.spp, 4);
-        assert_eq!(s.options.method, Method::Bsdf(lobe::Strategy::Vndf));
+        assert_eq!(s.options.technique, Technique::Bsdf(lobe::Strategy::Vndf));
         assert_eq!(s.camera.width, 32);
     }
 

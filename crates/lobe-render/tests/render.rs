@@ -4,9 +4,9 @@
 
 use glam::DVec3;
 use lobe::envmap::EnvMap;
-use lobe::estimator::Heuristic;
+use lobe::estimator::{Heuristic, Technique};
 use lobe::{Material, MaterialDesc, Rgb, Strategy};
-use lobe_render::{Camera, Image, Mesh, Method, Object, RenderOptions, Scene, load_scene, render};
+use lobe_render::{Camera, Image, Mesh, Object, RenderOptions, Scene, load_scene, render};
 use std::path::PathBuf;
 use std::sync::Arc;
 
@@ -14,10 +14,10 @@ fn lambert(a: f64) -> Material {
     Material::lambert(Rgb::splat(a)).unwrap()
 }
 
-fn opts(method: Method, spp: u32) -> RenderOptions {
+fn opts(method: Technique, spp: u32) -> RenderOptions {
     RenderOptions {
         spp,
-        method,
+        technique: method,
         seed: 3,
         max_depth: 1,
         threads: None,
@@ -75,7 +75,7 @@ fn white_furnace_every_method() {
     let scene = furnace_scene(32, 24);
     let px = covered(&scene, 0);
     assert!(px.len() > 150, "{} covered pixels", px.len());
-    for method in Method::all() {
+    for method in Technique::all() {
         let img = render(&scene, &opts(method, 16), |_| {});
         assert_eq!(img.stats.nonfinite, 0);
         // The background is the environment, 1.
@@ -83,7 +83,7 @@ fn white_furnace_every_method() {
         // Cosine and brdf sampling of a Lambertian (and the strategies that
         // fall back to brdf) have weight f cos / p = 1 exactly, and nothing
         // shadows a lone convex sphere.
-        let exact = matches!(method, Method::Bsdf(s) if s != Strategy::Uniform);
+        let exact = matches!(method, Technique::Bsdf(s) if s != Strategy::Uniform);
         for c in 0..3 {
             let (m, se) = mean_se(&img, &px, |p| p[c]);
             if exact {
@@ -122,7 +122,7 @@ fn white_furnace_convex_mesh_is_exact() {
         Scene::new(camera, EnvMap::constant(Rgb::ONE)).with(Object::mesh(mesh, lambert(1.0)));
     let px = covered(&scene, 0);
     assert!(px.len() > 100);
-    let img = render(&scene, &opts(Method::Bsdf(Strategy::Cosine), 8), |_| {});
+    let img = render(&scene, &opts(Technique::Bsdf(Strategy::Cosine), 8), |_| {});
     for &(x, y) in &px {
         let v = img.get(x, y);
         assert!(
@@ -151,10 +151,10 @@ fn white_furnace_with_bounces() {
     let mut px = covered(&scene, 0);
     px.extend(covered(&scene, 1));
     for method in [
-        Method::Bsdf(Strategy::Cosine),
-        Method::Light,
-        Method::Mis(Heuristic::Balance),
-        Method::Mis(Heuristic::Power),
+        Technique::Bsdf(Strategy::Cosine),
+        Technique::Light,
+        Technique::mis(Heuristic::Balance),
+        Technique::mis(Heuristic::Power),
     ] {
         let o = RenderOptions {
             max_depth: 32,
@@ -217,8 +217,8 @@ fn techniques_agree_pixel_by_pixel() {
         .with(Object::plane(DVec3::ZERO, DVec3::Y, lambert(0.5)).unwrap());
     let mut px = covered(&scene, 0);
     px.extend(covered(&scene, 1));
-    let reference = render(&scene, &opts(Method::Mis(Heuristic::Balance), 64), |_| {});
-    for method in Method::all() {
+    let reference = render(&scene, &opts(Technique::mis(Heuristic::Balance), 64), |_| {});
+    for method in Technique::all() {
         let mut o = opts(method, 32);
         o.seed = 11;
         let img = render(&scene, &o, |_| {});
@@ -260,9 +260,9 @@ fn the_same_image_for_any_thread_count() {
         .with(Object::sphere(DVec3::new(-0.9, 0.4, 0.0), 0.4, ggx).unwrap())
         .with(Object::plane(DVec3::ZERO, DVec3::Y, lambert(0.5)).unwrap());
     for method in [
-        Method::Mis(Heuristic::Power),
-        Method::Bsdf(Strategy::Vndf),
-        Method::Light,
+        Technique::mis(Heuristic::Power),
+        Technique::Bsdf(Strategy::Vndf),
+        Technique::Light,
     ] {
         let mut o = opts(method, 4);
         o.max_depth = 6;
@@ -315,7 +315,7 @@ fn right_and_top_of_the_scene_are_right_and_top_of_the_image() {
     let center = DVec3::new(0.9, 0.6, 0.0);
     let scene = Scene::new(camera, EnvMap::constant(Rgb::ONE))
         .with(Object::sphere(center, 0.3, lambert(0.0)).unwrap());
-    let img = render(&scene, &opts(Method::Bsdf(Strategy::Cosine), 4), |_| {});
+    let img = render(&scene, &opts(Technique::Bsdf(Strategy::Cosine), 4), |_| {});
     let (mut sx, mut sy, mut n) = (0.0, 0.0, 0.0);
     for y in 0..img.height {
         for x in 0..img.width {
@@ -380,7 +380,7 @@ fn scene_files_load_and_their_errors_name_file_line_and_field() {
     assert_eq!(scene.objects.len(), 2);
     // vndf does not apply to Phong or Lambert: both fall back to brdf.
     assert_eq!(
-        lobe_render::fallbacks(&scene, scene.options.method).len(),
+        lobe_render::fallbacks(&scene, scene.options.technique).len(),
         2
     );
     let img = render(&scene, &scene.options, |_| {});
@@ -438,7 +438,7 @@ fn the_shipped_scenes_and_the_showcase_render() {
     for (a, b) in file.objects.iter().zip(&built.objects) {
         assert_eq!(a.material, b.material);
     }
-    let img = render(&built, &opts(Method::Mis(Heuristic::Power), 2), |_| {});
+    let img = render(&built, &opts(Technique::mis(Heuristic::Power), 2), |_| {});
     assert!(
         img.pixels
             .iter()

@@ -16,6 +16,10 @@ pub enum Error {
         value: String,
         expected: String,
     },
+    /// A strategy name (a BSDF strategy, `light` or a form of MIS) that lobe
+    /// does not know.
+    #[error("unknown strategy `{value}`, expected one of: {expected}")]
+    UnknownStrategy { value: String, expected: String },
     /// A strategy that does not apply to the material.
     #[error("strategy `{strategy}` does not apply to this material ({reason})")]
     Unsupported { strategy: String, reason: String },

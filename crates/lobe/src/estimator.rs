@@ -1,6 +1,13 @@
-//! Monte Carlo estimation of reflected radiance
-//! `L_o(wo) = ∫ f_r(wo, wi) L_i(wi) cos θi dωi` with a chosen strategy, and
-//! its deterministic quadrature reference.
+//! Monte Carlo estimation of reflected radiance at one shading point,
+//! `L_o(wo) = ∫ f_r(wo, wi) L_i(wi) cos θi dωi`, by BSDF sampling, light
+//! sampling or multiple importance sampling, and its deterministic
+//! quadrature reference.
+//!
+//! One estimator serves `lobe estimate` and the renderer: a [`Light`] that is
+//! a function of world direction, a [`Material`] in the local frame of a
+//! [`ShadingPoint`], and a [`Visibility`] that says whether a direction
+//! reaches the light ([`Unoccluded`] at one shading point; shadow rays in the
+//! renderer). MIS lives here and nowhere else ([`ShadingEstimator::estimate`]).
 //!
 //! The `N` samples are cut into chunks of [`CHUNK`] samples; chunk `k` draws
 //! its random numbers from its own stream, so the result depends only on the
@@ -8,17 +15,15 @@
 //! merged in order ([`Accumulator::merge`]).
 
 use crate::envmap::EnvMap;
-use crate::light::Light;
+use crate::light::{Light, LightDistribution};
+use crate::material::BsdfSampler;
 use crate::math::{Rgb, luminance};
+pub use crate::sequence::CHUNK;
 use crate::sequence::{self, Sequence};
 use crate::stats::quadrature::{Tolerance, integrate_hemisphere};
 use crate::stats::ttest::Moments;
-use crate::{Frame, Material, Strategy};
+use crate::{BsdfSample, Error, Frame, Material, Strategy};
 use glam::{DVec2, DVec3};
-use rand_pcg::Pcg64;
-
-/// Samples per chunk: the unit of work and of random streams.
-pub const CHUNK: usize = 4096;
 
 /// Running sums of the sample values `f L cos / p` (zero for a failed sample).
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -68,16 +73,6 @@ impl Accumulator {
     }
 }
 
-/// The random stream of chunk `chunk` for `seed`.
-#[must_use]
-pub fn chunk_rng(seed: u64, chunk: usize) -> Pcg64 {
-    // Distinct PCG streams per chunk (the increment selects the stream).
-    Pcg64::new(
-        0xcafe_f00d_d15e_a5e5u128 ^ (u128::from(seed) << 64),
-        0x0a02_bdbf_7bb3_c0a7_ac28_fa16_a64a_bf96u128 ^ (chunk as u128),
-    )
-}
-
 /// How Multiple Importance Sampling weights its techniques (Veach 1997).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Heuristic {
@@ -85,6 +80,19 @@ pub enum Heuristic {
     Balance,
     /// `w_t = (n_t p_t)² / Σ (n p)²`.
     Power,
+}
+
+impl Heuristic {
+    /// The weight of a technique whose (count-scaled) density is `a`
+    /// against another's `b`.
+    #[inline]
+    #[must_use]
+    pub fn weight(self, a: f64, b: f64) -> f64 {
+        match self {
+            Heuristic::Balance => a / (a + b),
+            Heuristic::Power => a * a / (a * a + b * b),
+        }
+    }
 }
 
 /// Multi-sample MIS draws `n_bsdf` and `n_light` samples for every estimate;
@@ -99,8 +107,9 @@ pub enum MisForm {
 /// BSDF sampling combined with light sampling.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub struct Mis {
-    /// The BSDF strategy (the material's best by default).
-    pub bsdf: Strategy,
+    /// The BSDF strategy; `None`: the material's best
+    /// ([`Material::best_bsdf_strategy`]), chosen per material.
+    pub bsdf: Option<Strategy>,
     pub heuristic: Heuristic,
     pub form: MisForm,
     pub n_bsdf: u32,
@@ -130,13 +139,16 @@ impl From<Strategy> for Technique {
     }
 }
 
+/// The names of the techniques that are not BSDF strategies.
+pub const NON_BSDF_NAMES: [&str; 5] = ["light", "mis", "mis-power", "mis-one", "mis-power-one"];
+
 impl Technique {
-    /// `mis` and `mis-power` with one sample of each technique, multi-sample,
-    /// on the BSDF strategy `bsdf`.
+    /// `mis` or `mis-power`: one sample of each technique, multi-sample, on
+    /// the material's best BSDF strategy.
     #[must_use]
-    pub fn mis(bsdf: Strategy, heuristic: Heuristic) -> Self {
+    pub const fn mis(heuristic: Heuristic) -> Self {
         Technique::Mis(Mis {
-            bsdf,
+            bsdf: None,
             heuristic,
             form: MisForm::MultiSample,
             n_bsdf: 1,
@@ -144,7 +156,34 @@ impl Technique {
         })
     }
 
-    /// The name used on the command line and in tables.
+    /// Every technique by name: the BSDF strategies, `light`, `mis`,
+    /// `mis-power`, `mis-one`, `mis-power-one` (MIS on the material's best
+    /// BSDF strategy, one sample of each technique).
+    #[must_use]
+    pub fn all() -> Vec<Technique> {
+        let mut v: Vec<Technique> = Strategy::ALL.into_iter().map(Technique::Bsdf).collect();
+        v.push(Technique::Light);
+        for form in [MisForm::MultiSample, MisForm::OneSample] {
+            for heuristic in [Heuristic::Balance, Heuristic::Power] {
+                v.push(Technique::Mis(Mis {
+                    bsdf: None,
+                    heuristic,
+                    form,
+                    n_bsdf: 1,
+                    n_light: 1,
+                }));
+            }
+        }
+        v
+    }
+
+    /// Every accepted name, comma separated, for help and error messages.
+    #[must_use]
+    pub fn names() -> String {
+        format!("{}, {}", Strategy::names(), NON_BSDF_NAMES.join(", "))
+    }
+
+    /// The name used on the command line, in scene files and in tables.
     #[must_use]
     pub fn name(&self) -> String {
         match self {
@@ -173,99 +212,295 @@ impl Technique {
             _ => 1,
         }
     }
-}
 
-/// One sample value `f(wo, wi) L(wi) cos θi / p(wi)`, zero for a failed sample.
-#[inline]
-#[must_use]
-pub fn sample_value(m: &Material, s: Strategy, wo: DVec3, light: &Light, uc: f64, u: DVec2) -> Rgb {
-    match m.sample(s, wo, uc, u) {
-        Some(x) => x.weight * light.radiance(x.wi),
-        None => Rgb::ZERO,
-    }
-}
-
-impl Heuristic {
-    /// The weight of a technique whose (count-scaled) density is `a`
-    /// against another's `b`.
-    #[inline]
+    /// The light distribution this technique draws light samples from: the
+    /// plain one for light sampling alone, the MIS-compensated one inside
+    /// MIS. The one place where that choice is made.
     #[must_use]
-    pub fn weight(self, a: f64, b: f64) -> f64 {
+    pub fn light_distribution(&self) -> LightDistribution {
         match self {
-            Heuristic::Balance => a / (a + b),
-            Heuristic::Power => a * a / (a * a + b * b),
+            Technique::Mis(_) => LightDistribution::Compensated,
+            _ => LightDistribution::Plain,
+        }
+    }
+
+    /// The BSDF strategy this technique samples `m` by, if any: its own for
+    /// a BSDF technique, the given or the material's best for MIS, none for
+    /// light sampling.
+    #[must_use]
+    pub fn bsdf_strategy(&self, m: &Material) -> Option<Strategy> {
+        match self {
+            Technique::Bsdf(s) => Some(*s),
+            Technique::Light => None,
+            Technique::Mis(mis) => Some(mis.bsdf.unwrap_or_else(|| m.best_bsdf_strategy())),
+        }
+    }
+
+    /// Validate this technique for `m` once, into an estimator of one
+    /// shading point; the error says why a BSDF strategy does not apply.
+    pub fn for_material<'m>(&self, m: &'m Material) -> Result<ShadingEstimator<'m>, Error> {
+        let sampler = match self.bsdf_strategy(m) {
+            Some(s) => Some(m.sampler(s)?),
+            None => None,
+        };
+        let technique = match *self {
+            Technique::Mis(mis) => Technique::Mis(Mis {
+                bsdf: sampler.map(|s| s.strategy()),
+                ..mis
+            }),
+            t => t,
+        };
+        Ok(ShadingEstimator {
+            technique,
+            material: m,
+            sampler,
+        })
+    }
+}
+
+impl std::str::FromStr for Technique {
+    type Err = Error;
+    /// Any name of [`Technique::names`].
+    fn from_str(s: &str) -> Result<Self, Error> {
+        Technique::all()
+            .into_iter()
+            .find(|t| t.name() == s)
+            .ok_or_else(|| Error::UnknownStrategy {
+                value: s.into(),
+                expected: Technique::names(),
+            })
+    }
+}
+
+/// One shading point: its local frame (`+z` the normal) and the view
+/// direction `wo` in that frame.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ShadingPoint {
+    pub frame: Frame,
+    /// Toward the viewer, unit, local frame.
+    pub wo: DVec3,
+}
+
+impl ShadingPoint {
+    /// A point whose local frame is the world (`+z` the normal): the world
+    /// directions of lights are local directions.
+    #[must_use]
+    pub fn local(wo: DVec3) -> Self {
+        ShadingPoint {
+            frame: Frame {
+                s: DVec3::X,
+                t: DVec3::Y,
+                n: DVec3::Z,
+            },
+            wo,
         }
     }
 }
 
-/// One estimate of `technique` from its `points` (`points_per_sample` of them).
-#[must_use]
-pub fn technique_value(
+/// Whether a direction from the shading point reaches the light.
+pub trait Visibility {
+    /// A light sample toward world direction `dir`: is it unoccluded (a
+    /// shadow ray in a renderer)?
+    fn unoccluded(&mut self, dir: DVec3) -> bool;
+    /// A BSDF-sampled ray toward world direction `dir`: does it escape to
+    /// the light, with nothing in the way? (A renderer traces it and keeps
+    /// the hit to continue the path.)
+    fn escapes(&mut self, dir: DVec3) -> bool;
+}
+
+/// Nothing is in the way: one shading point alone under its light.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Unoccluded;
+
+impl Visibility for Unoccluded {
+    #[inline]
+    fn unoccluded(&mut self, _dir: DVec3) -> bool {
+        true
+    }
+    #[inline]
+    fn escapes(&mut self, _dir: DVec3) -> bool {
+        true
+    }
+}
+
+/// A BSDF sample that an estimate drew, for a renderer to continue its path.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DrawnBsdf {
+    pub sample: BsdfSample,
+    /// Its direction in the world.
+    pub dir: DVec3,
+    /// Whether it escaped to the light ([`Visibility::escapes`]).
+    pub escaped: bool,
+}
+
+/// One estimate at a shading point.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ShadingEstimate {
+    /// `f L cos / p`, MIS-weighted where MIS is used (cosine included);
+    /// zero for failed samples.
+    pub value: Rgb,
+    /// The first BSDF sample drawn, if the technique drew one.
+    pub bsdf: Option<DrawnBsdf>,
+}
+
+/// A [`Technique`] validated for one material ([`Technique::for_material`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ShadingEstimator<'m> {
+    technique: Technique,
+    material: &'m Material,
+    sampler: Option<BsdfSampler<'m>>,
+}
+
+impl<'m> ShadingEstimator<'m> {
+    /// The technique, with its MIS BSDF strategy resolved.
+    #[must_use]
+    pub fn technique(&self) -> Technique {
+        self.technique
+    }
+
+    /// The BSDF sampler the technique uses (none for light sampling).
+    #[must_use]
+    pub fn sampler(&self) -> Option<BsdfSampler<'m>> {
+        self.sampler
+    }
+
+    /// One estimate from `points`, [`Technique::points_per_sample`] of them,
+    /// each `[uc, u₁, u₂]`. Multi-sample MIS takes its `n_bsdf` BSDF points
+    /// first, then its `n_light` light points (which use `u` only);
+    /// one-sample MIS chooses the technique with the point's `uc`.
+    #[must_use]
+    pub fn estimate(
+        &self,
+        sp: &ShadingPoint,
+        light: &Light,
+        points: &[[f64; 3]],
+        vis: &mut impl Visibility,
+    ) -> ShadingEstimate {
+        let m = self.material;
+        let dist = self.technique.light_distribution();
+        let mut first: Option<DrawnBsdf> = None;
+        let value = match (self.technique, self.sampler) {
+            (Technique::Bsdf(_), Some(s)) => {
+                let p = points[0];
+                match draw_bsdf(&s, sp, p, 1.0, vis, &mut first) {
+                    Some((x, dir)) => x.weight * light.radiance(dir),
+                    None => Rgb::ZERO,
+                }
+            }
+            (Technique::Light, _) => {
+                let p = points[0];
+                light_value(m, None, sp, light, dist, p, vis, |_, _| (1.0, 1.0))
+            }
+            (Technique::Mis(mis), Some(s)) => {
+                let (nb, nl) = (f64::from(mis.n_bsdf), f64::from(mis.n_light));
+                let h = mis.heuristic;
+                match mis.form {
+                    MisForm::MultiSample => {
+                        let mut sum = Rgb::ZERO;
+                        for p in &points[..mis.n_bsdf as usize] {
+                            if let Some((x, dir)) = draw_bsdf(&s, sp, *p, 1.0, vis, &mut first) {
+                                let w = h.weight(nb * x.pdf, nl * light.pdf(dist, dir));
+                                sum += x.weight * light.radiance(dir) * (w / nb);
+                            }
+                        }
+                        for p in &points[mis.n_bsdf as usize..] {
+                            sum += light_value(m, Some(&s), sp, light, dist, *p, vis, |pl, pb| {
+                                (h.weight(nl * pl, nb * pb), nl)
+                            });
+                        }
+                        sum
+                    }
+                    MisForm::OneSample => {
+                        let p = points[0];
+                        let cb = nb / (nb + nl);
+                        let cl = 1.0 - cb;
+                        if p[0] < cb {
+                            // Reuse the choice number for the lobe choice, rescaled.
+                            match draw_bsdf(&s, sp, p, cb, vis, &mut first) {
+                                Some((x, dir)) => {
+                                    let w = h.weight(cb * x.pdf, cl * light.pdf(dist, dir));
+                                    x.weight * light.radiance(dir) * (w / cb)
+                                }
+                                None => Rgb::ZERO,
+                            }
+                        } else {
+                            light_value(m, Some(&s), sp, light, dist, p, vis, |pl, pb| {
+                                (h.weight(cl * pl, cb * pb), cl)
+                            })
+                        }
+                    }
+                }
+            }
+            (_, None) => unreachable!("a BSDF or MIS technique always has a sampler"),
+        };
+        ShadingEstimate {
+            value,
+            bsdf: first,
+        }
+    }
+}
+
+/// Draw a BSDF sample from point `p` (`uc = p[0] / uc_scale`), record the
+/// first one drawn, and return it with its world direction if it escapes.
+#[inline]
+fn draw_bsdf(
+    s: &BsdfSampler,
+    sp: &ShadingPoint,
+    p: [f64; 3],
+    uc_scale: f64,
+    vis: &mut impl Visibility,
+    first: &mut Option<DrawnBsdf>,
+) -> Option<(BsdfSample, DVec3)> {
+    let uc = if uc_scale == 1.0 { p[0] } else { p[0] / uc_scale };
+    let x = s.sample(sp.wo, uc, DVec2::new(p[1], p[2]))?;
+    let dir = sp.frame.to_world(x.wi);
+    let escaped = vis.escapes(dir);
+    if first.is_none() {
+        *first = Some(DrawnBsdf {
+            sample: x,
+            dir,
+            escaped,
+        });
+    }
+    escaped.then_some((x, dir))
+}
+
+/// One light sample's value `f L cos · w / (n p_light)` from point `p`
+/// (its `u` only): zero for a failed sample (no sample, below the horizon,
+/// `f = 0`, occluded). `weight(p_light, p_bsdf)` gives the MIS weight `w`
+/// and the technique's count `n` (`p_bsdf` is 0 without `bsdf`); `f` and
+/// `p_bsdf` come from one [`BsdfSampler::eval_pdf`].
+#[inline]
+#[allow(clippy::too_many_arguments)]
+fn light_value(
     m: &Material,
-    t: &Technique,
-    wo: DVec3,
+    bsdf: Option<&BsdfSampler>,
+    sp: &ShadingPoint,
     light: &Light,
-    points: &[[f64; 3]],
+    dist: LightDistribution,
+    p: [f64; 3],
+    vis: &mut impl Visibility,
+    weight: impl FnOnce(f64, f64) -> (f64, f64),
 ) -> Rgb {
-    match t {
-        Technique::Bsdf(s) => {
-            let p = points[0];
-            sample_value(m, *s, wo, light, p[0], DVec2::new(p[1], p[2]))
-        }
-        Technique::Light => {
-            let p = points[0];
-            match light.sample(DVec2::new(p[1], p[2])) {
-                Some((wi, pdf)) if wi.z > 0.0 => m.eval(wo, wi) * light.radiance(wi) * (wi.z / pdf),
-                _ => Rgb::ZERO,
-            }
-        }
-        Technique::Mis(mis) => {
-            let (nb, nl) = (f64::from(mis.n_bsdf), f64::from(mis.n_light));
-            match mis.form {
-                MisForm::MultiSample => {
-                    let mut sum = Rgb::ZERO;
-                    for p in &points[..mis.n_bsdf as usize] {
-                        if let Some(x) = m.sample(mis.bsdf, wo, p[0], DVec2::new(p[1], p[2])) {
-                            let w = mis.heuristic.weight(nb * x.pdf, nl * light.pdf_mis(x.wi));
-                            sum += x.weight * light.radiance(x.wi) * (w / nb);
-                        }
-                    }
-                    for p in &points[mis.n_bsdf as usize..] {
-                        if let Some((wi, pl)) = light.sample_mis(DVec2::new(p[1], p[2]))
-                            && wi.z > 0.0
-                        {
-                            let w = mis.heuristic.weight(nl * pl, nb * m.pdf(mis.bsdf, wo, wi));
-                            sum += m.eval(wo, wi) * light.radiance(wi) * (wi.z * w / (nl * pl));
-                        }
-                    }
-                    sum
-                }
-                MisForm::OneSample => {
-                    let p = points[0];
-                    let cb = nb / (nb + nl);
-                    let cl = 1.0 - cb;
-                    if p[0] < cb {
-                        // Reuse the choice number for the lobe choice, rescaled.
-                        let uc = p[0] / cb;
-                        match m.sample(mis.bsdf, wo, uc, DVec2::new(p[1], p[2])) {
-                            Some(x) => {
-                                let w = mis.heuristic.weight(cb * x.pdf, cl * light.pdf_mis(x.wi));
-                                x.weight * light.radiance(x.wi) * (w / cb)
-                            }
-                            None => Rgb::ZERO,
-                        }
-                    } else {
-                        match light.sample_mis(DVec2::new(p[1], p[2])) {
-                            Some((wi, pl)) if wi.z > 0.0 => {
-                                let w = mis.heuristic.weight(cl * pl, cb * m.pdf(mis.bsdf, wo, wi));
-                                m.eval(wo, wi) * light.radiance(wi) * (wi.z * w / (cl * pl))
-                            }
-                            _ => Rgb::ZERO,
-                        }
-                    }
-                }
-            }
-        }
+    let Some(ls) = light.sample(dist, DVec2::new(p[1], p[2])) else {
+        return Rgb::ZERO;
+    };
+    let wi = sp.frame.to_local(ls.dir);
+    if wi.z <= 0.0 {
+        return Rgb::ZERO;
+    }
+    let (f, pb) = match bsdf {
+        Some(s) => s.eval_pdf(sp.wo, wi),
+        None => (m.eval(sp.wo, wi), 0.0),
+    };
+    if f == Rgb::ZERO || !vis.unoccluded(ls.dir) {
+        return Rgb::ZERO;
+    }
+    let (w, n) = weight(ls.pdf, pb);
+    if n == 1.0 {
+        f * light.radiance(ls.dir) * (wi.z * w / ls.pdf)
+    } else {
+        f * light.radiance(ls.dir) * (wi.z * w / (n * ls.pdf))
     }
 }
 
@@ -309,21 +544,28 @@ impl Plan {
 
 /// Estimate chunk by chunk, in order, on this thread. A caller with threads
 /// runs [`estimate_chunk`] for every chunk and merges them in chunk order,
-/// which gives the same numbers.
-#[must_use]
-pub fn estimate(m: &Material, wo: DVec3, light: &Light, plan: &Plan) -> Accumulator {
+/// which gives the same numbers. The error says why the plan's technique
+/// does not apply to `m`.
+pub fn estimate(
+    m: &Material,
+    sp: &ShadingPoint,
+    light: &Light,
+    plan: &Plan,
+) -> Result<Accumulator, Error> {
+    let est = plan.technique.for_material(m)?;
     let mut acc = Accumulator::default();
     for chunk in 0..plan.chunks() {
-        acc.merge(&estimate_chunk(m, wo, light, plan, chunk));
+        acc.merge(&estimate_chunk(&est, sp, light, plan, chunk));
     }
-    acc
+    Ok(acc)
 }
 
-/// The estimates of chunk `chunk`.
+/// The estimates of chunk `chunk` of `plan`, by `est` (the plan's technique
+/// validated for the material).
 #[must_use]
 pub fn estimate_chunk(
-    m: &Material,
-    wo: DVec3,
+    est: &ShadingEstimator,
+    sp: &ShadingPoint,
     light: &Light,
     plan: &Plan,
     chunk: usize,
@@ -342,7 +584,7 @@ pub fn estimate_chunk(
     );
     let mut acc = Accumulator::default();
     for p in points.chunks_exact(k) {
-        acc.push(technique_value(m, &plan.technique, wo, light, p));
+        acc.push(est.estimate(sp, light, p, &mut Unoccluded).value);
     }
     acc
 }
@@ -353,17 +595,18 @@ pub fn estimate_chunk(
 /// texels of the texel's radiance times `∫ f cos dω` over the texel
 /// ([`reference_env_row`]).
 #[must_use]
-pub fn reference(m: &Material, wo: DVec3, light: &Light, rel: f64) -> Rgb {
-    if let Light::Env { map, frame } = light {
+pub fn reference(m: &Material, sp: &ShadingPoint, light: &Light, rel: f64) -> Rgb {
+    let wo = sp.wo;
+    if let Light::Env(map) = light {
         let mut sum = Rgb::ZERO;
         for j in 0..map.size().1 {
-            sum += reference_env_row(m, wo, map, frame, j, rel);
+            sum += reference_env_row(m, sp, map, j, rel);
         }
         return sum;
     }
     let channel = |c: usize| {
         integrate_hemisphere(
-            |wi| (m.eval(wo, wi) * light.radiance(wi))[c] * wi.z,
+            |wi| (m.eval(wo, wi) * light.radiance(sp.frame.to_world(wi)))[c] * wi.z,
             Tolerance::relative(rel),
         )
         .value
@@ -376,14 +619,8 @@ pub fn reference(m: &Material, wo: DVec3, light: &Light, rel: f64) -> Rgb {
 /// compared with the same rule on the texel's four quarters and refined
 /// where they differ by more than `rel` (up to 6 levels).
 #[must_use]
-pub fn reference_env_row(
-    m: &Material,
-    wo: DVec3,
-    map: &EnvMap,
-    frame: &Frame,
-    j: usize,
-    rel: f64,
-) -> Rgb {
+pub fn reference_env_row(m: &Material, sp: &ShadingPoint, map: &EnvMap, j: usize, rel: f64) -> Rgb {
+    let (wo, frame) = (sp.wo, &sp.frame);
     let (w, _) = map.size();
     let mut sum = Rgb::ZERO;
     for i in 0..w {

@@ -56,7 +56,7 @@ pub use frame::Frame;
 pub use fresnel::Fresnel;
 pub use glam;
 pub use light::Light;
-pub use material::{Glossy, Material};
+pub use material::{BsdfSampler, Glossy, Material};
 pub use math::Rgb;
 pub use microfacet::{Microfacet, Ndf, Shadowing};
 pub use sample::{BsdfSample, LobeKind};

@@ -1,13 +1,19 @@
-//! Incident lighting at one shading point, in the local frame, with light
-//! sampling.
+//! Incident lighting as a function of **world** direction, with light
+//! sampling. A light knows nothing of shading frames: the shading-point
+//! estimator ([`crate::estimator::ShadingPoint`]) takes directions between
+//! its local frame and the world, so the same light serves one shading point
+//! (`lobe estimate`) and every hit of the renderer.
 //!
-//! | light | radiance `L(wi)` | light sampling |
+//! | light | radiance `L(d)` | light sampling |
 //! |---|---|---|
 //! | `Constant(c)` | `c` everywhere: the furnace; the estimate is the directional albedo times `c` | uniform sphere, `1/(4π)` |
-//! | `Lobe { dir, exponent, radiance }` | `radiance · max(0, wi·dir)^exponent`: a smooth analytic light toward `dir` | `(k+1)/(2π) max(0, cos)^k` around `dir` |
-//! | `Env { map, frame }` | the environment map seen through the shading frame | ∝ the map's luminance ([`EnvMap::sample`]) |
+//! | `Beam { dir, exponent, radiance }` | `radiance · max(0, d·dir)^exponent`: a smooth analytic light toward `dir` | `(k+1)/(2π) max(0, cos)^k` around `dir` |
+//! | `Env(map)` | the environment map | ∝ the map's luminance ([`EnvMap::sample`]), or MIS-compensated ([`EnvMap::sample_compensated`]) |
 //!
-//! Light samples below the horizon are failed samples (they count, with value 0).
+//! Which of a light's two distributions a technique draws from is decided in
+//! one place, [`crate::estimator::Technique::light_distribution`]. Light
+//! samples below a shading point's horizon are failed samples (they count,
+//! with value 0).
 
 use crate::envmap::EnvMap;
 use crate::math::Rgb;
@@ -15,94 +21,102 @@ use crate::{Frame, warp};
 use glam::{DVec2, DVec3};
 use std::sync::Arc;
 
+/// An incident light, in world coordinates.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Light {
+    /// The same radiance from every direction (the furnace).
     Constant(Rgb),
-    Lobe {
+    /// `radiance · max(0, d·dir)^exponent` toward the unit world direction `dir`.
+    Beam {
         dir: DVec3,
         exponent: f64,
         radiance: Rgb,
     },
-    /// An environment map; `frame` is the shading frame (local ↔ world).
-    Env {
-        map: Arc<EnvMap>,
-        frame: Frame,
-    },
+    /// An environment map (world +Y up, Mitsuba's convention).
+    Env(Arc<EnvMap>),
+}
+
+/// Which density light sampling draws from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum LightDistribution {
+    /// The light's own density (∝ luminance for a map): for light sampling alone.
+    Plain,
+    /// For MIS: an environment map's compensated density, ∝
+    /// `max(0, lum − mean lum)` (Karlík et al. 2019), which leaves the dim
+    /// part to BSDF sampling; the plain density for the other lights.
+    Compensated,
+}
+
+/// A light sample: a world direction and its solid-angle density.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LightSample {
+    /// Unit world direction toward the light.
+    pub dir: DVec3,
+    /// Density of `dir` in solid angle.
+    pub pdf: f64,
 }
 
 impl Light {
-    /// Incident radiance from direction `wi` (local frame, unit).
+    /// Incident radiance from world direction `d` (unit).
     #[inline]
     #[must_use]
-    pub fn radiance(&self, wi: DVec3) -> Rgb {
+    pub fn radiance(&self, d: DVec3) -> Rgb {
         match self {
             Light::Constant(c) => *c,
-            Light::Lobe {
+            Light::Beam {
                 dir,
                 exponent,
                 radiance,
-            } => *radiance * wi.dot(*dir).max(0.0).powf(*exponent),
-            Light::Env { map, frame } => map.eval(frame.to_world(wi)),
+            } => *radiance * d.dot(*dir).max(0.0).powf(*exponent),
+            Light::Env(map) => map.eval(d),
         }
     }
 
-    /// Draw a direction (local frame) by light sampling: `(wi, pdf)`.
-    /// `None` when the light cannot be sampled (a black map).
+    /// Draw a world direction from `dist`. `None` when the light cannot be
+    /// sampled (a black map).
     #[inline]
     #[must_use]
-    pub fn sample(&self, u: DVec2) -> Option<(DVec3, f64)> {
-        match self {
-            Light::Constant(_) => Some((
+    pub fn sample(&self, dist: LightDistribution, u: DVec2) -> Option<LightSample> {
+        let (dir, pdf) = match self {
+            Light::Constant(_) => (
                 warp::square_to_uniform_sphere(u),
                 warp::square_to_uniform_sphere_pdf(DVec3::Z),
-            )),
-            Light::Lobe { dir, exponent, .. } => {
+            ),
+            Light::Beam { dir, exponent, .. } => {
                 let w = Frame::from_normal(*dir).to_world(warp::square_to_cos_power(u, *exponent));
-                let p = self.pdf(w);
-                (p > 0.0).then_some((w, p))
+                let p = self.pdf(dist, w);
+                if p <= 0.0 {
+                    return None;
+                }
+                (w, p)
             }
-            Light::Env { map, frame } => map.sample(u).map(|(d, p)| (frame.to_local(d), p)),
-        }
+            Light::Env(map) => match dist {
+                LightDistribution::Plain => map.sample(u)?,
+                LightDistribution::Compensated => map.sample_compensated(u)?,
+            },
+        };
+        Some(LightSample { dir, pdf })
     }
 
-    /// The light sampler MIS uses: for an environment map, MIS compensation
-    /// ([`EnvMap::sample_compensated`]); otherwise [`Light::sample`].
+    /// Density in solid angle of [`Light::sample`] from `dist` at world
+    /// direction `d`.
     #[inline]
     #[must_use]
-    pub fn sample_mis(&self, u: DVec2) -> Option<(DVec3, f64)> {
+    pub fn pdf(&self, dist: LightDistribution, d: DVec3) -> f64 {
         match self {
-            Light::Env { map, frame } => map
-                .sample_compensated(u)
-                .map(|(d, p)| (frame.to_local(d), p)),
-            _ => self.sample(u),
-        }
-    }
-
-    /// Density of [`Light::sample_mis`] at `wi` (local frame).
-    #[inline]
-    #[must_use]
-    pub fn pdf_mis(&self, wi: DVec3) -> f64 {
-        match self {
-            Light::Env { map, frame } => map.pdf_compensated(frame.to_world(wi)),
-            _ => self.pdf(wi),
-        }
-    }
-
-    /// Density in solid angle of [`Light::sample`] at `wi` (local frame).
-    #[inline]
-    #[must_use]
-    pub fn pdf(&self, wi: DVec3) -> f64 {
-        match self {
-            Light::Constant(_) => warp::square_to_uniform_sphere_pdf(wi),
-            Light::Lobe { dir, exponent, .. } => {
-                let c = wi.dot(*dir);
+            Light::Constant(_) => warp::square_to_uniform_sphere_pdf(d),
+            Light::Beam { dir, exponent, .. } => {
+                let c = d.dot(*dir);
                 if c > 0.0 {
                     (exponent + 1.0) * crate::math::INV_TWO_PI * c.powf(*exponent)
                 } else {
                     0.0
                 }
             }
-            Light::Env { map, frame } => map.pdf(frame.to_world(wi)),
+            Light::Env(map) => match dist {
+                LightDistribution::Plain => map.pdf(d),
+                LightDistribution::Compensated => map.pdf_compensated(d),
+            },
         }
     }
 }

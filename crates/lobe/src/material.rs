@@ -136,12 +136,24 @@ impl Material {
         g + self.diffuse.eval(wo, wi)
     }
 
+    /// Validate `strategy` for this material once, into a handle that
+    /// samples and gives pdfs by it: the error says why a strategy does not
+    /// apply (see [`Material::check`]).
+    pub fn sampler(&self, strategy: Strategy) -> crate::error::Result<BsdfSampler<'_>> {
+        self.check(strategy)?;
+        Ok(BsdfSampler {
+            material: self,
+            strategy,
+        })
+    }
+
     /// Density in solid angle with which `sample(strategy, wo, ..)` returns
-    /// `wi`; zero below the horizon. For a strategy that does not apply
-    /// (see [`Material::check`]) the result is meaningless.
+    /// `wi`; zero below the horizon. `strategy` must apply to the material
+    /// (checked in debug builds); [`Material::sampler`] validates it once.
     #[inline]
     #[must_use]
     pub fn pdf(&self, strategy: Strategy, wo: DVec3, wi: DVec3) -> f64 {
+        debug_assert!(self.check(strategy).is_ok(), "{strategy} does not apply");
         if wo.z <= 0.0 || wi.z <= 0.0 {
             return 0.0;
         }
@@ -165,12 +177,54 @@ impl Material {
         }
     }
 
+    /// `(eval(wo, wi), pdf(strategy, wo, wi))` in one call: the lobe-choice
+    /// probability (which evaluates Fresnel) and each lobe's shared terms
+    /// are computed once. `f` is without the cosine; the pdf is in solid
+    /// angle. Bit for bit the same numbers as the two calls.
+    #[inline]
+    #[must_use]
+    pub fn eval_pdf(&self, strategy: Strategy, wo: DVec3, wi: DVec3) -> (Rgb, f64) {
+        debug_assert!(self.check(strategy).is_ok(), "{strategy} does not apply");
+        if wo.z <= 0.0 || wi.z <= 0.0 {
+            return (Rgb::ZERO, 0.0);
+        }
+        let fd = self.diffuse.eval(wo, wi);
+        match strategy {
+            Strategy::Uniform | Strategy::Cosine => {
+                let f = dispatch!(&self.glossy, l => l.eval(wo, wi), Rgb::ZERO) + fd;
+                let pdf = if strategy == Strategy::Uniform {
+                    INV_TWO_PI
+                } else {
+                    warp::square_to_cosine_hemisphere_pdf(wi)
+                };
+                (f, pdf)
+            }
+            _ => {
+                let p = self.glossy_probability(wo);
+                let (fg, pg) = if p > 0.0 {
+                    dispatch!(&self.glossy, l => l.eval_pdf(strategy, wo, wi), (Rgb::ZERO, 0.0))
+                } else {
+                    (dispatch!(&self.glossy, l => l.eval(wo, wi), Rgb::ZERO), 0.0)
+                };
+                let pd = if p < 1.0 {
+                    self.diffuse.pdf(strategy, wo, wi)
+                } else {
+                    0.0
+                };
+                (fg + fd, p * pg + (1.0 - p) * pd)
+            }
+        }
+    }
+
     /// Draw `wi` for `wo` with `strategy`. `uc` chooses the lobe, `u` the
     /// direction. `None` is a failed sample (below the horizon, or `wo`
-    /// below it), which an estimator counts with weight zero.
+    /// below it), which an estimator counts with weight zero. `strategy`
+    /// must apply to the material (checked in debug builds);
+    /// [`Material::sampler`] validates it once.
     #[inline]
     #[must_use]
     pub fn sample(&self, strategy: Strategy, wo: DVec3, uc: f64, u: DVec2) -> Option<BsdfSample> {
+        debug_assert!(self.check(strategy).is_ok(), "{strategy} does not apply");
         if wo.z <= 0.0 {
             return None;
         }
@@ -213,5 +267,51 @@ impl Material {
             weight: f * (wi.z / pdf),
             lobe,
         })
+    }
+}
+
+/// A strategy validated for one material ([`Material::sampler`]): it can
+/// only be asked for what that strategy has, so there is no meaningless pdf.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BsdfSampler<'m> {
+    material: &'m Material,
+    strategy: Strategy,
+}
+
+impl<'m> BsdfSampler<'m> {
+    /// The strategy this handle samples by.
+    #[inline]
+    #[must_use]
+    pub fn strategy(&self) -> Strategy {
+        self.strategy
+    }
+
+    /// The material it samples.
+    #[inline]
+    #[must_use]
+    pub fn material(&self) -> &'m Material {
+        self.material
+    }
+
+    /// [`Material::sample`]: `uc` chooses the lobe, `u` the direction;
+    /// `None` is a failed sample. The weight includes the cosine.
+    #[inline]
+    #[must_use]
+    pub fn sample(&self, wo: DVec3, uc: f64, u: DVec2) -> Option<BsdfSample> {
+        self.material.sample(self.strategy, wo, uc, u)
+    }
+
+    /// [`Material::pdf`]: the solid-angle density of `sample` at `wi`.
+    #[inline]
+    #[must_use]
+    pub fn pdf(&self, wo: DVec3, wi: DVec3) -> f64 {
+        self.material.pdf(self.strategy, wo, wi)
+    }
+
+    /// [`Material::eval_pdf`]: `f` (no cosine) and the pdf at `wi`.
+    #[inline]
+    #[must_use]
+    pub fn eval_pdf(&self, wo: DVec3, wi: DVec3) -> (Rgb, f64) {
+        self.material.eval_pdf(self.strategy, wo, wi)
     }
 }

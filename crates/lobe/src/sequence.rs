@@ -11,8 +11,21 @@
 //! the scrambling is Burley's hash-based nested uniform (Owen) scramble
 //! (Burley 2020, "Practical Hash-based Owen Scrambling").
 
-use crate::estimator::chunk_rng;
 use rand::RngExt;
+use rand_pcg::Pcg64;
+
+/// Samples per chunk: the unit of work and of random streams.
+pub const CHUNK: usize = 4096;
+
+/// The random stream of chunk `chunk` for `seed`.
+#[must_use]
+pub fn chunk_rng(seed: u64, chunk: usize) -> Pcg64 {
+    // Distinct PCG streams per chunk (the increment selects the stream).
+    Pcg64::new(
+        0xcafe_f00d_d15e_a5e5u128 ^ (u128::from(seed) << 64),
+        0x0a02_bdbf_7bb3_c0a7_ac28_fa16_a64a_bf96u128 ^ (chunk as u128),
+    )
+}
 
 /// How the samples of an estimate are placed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]

@@ -5,7 +5,7 @@
 mod common;
 
 use glam::DVec3;
-use lobe::estimator::{Plan, estimate, reference};
+use lobe::estimator::{Plan, ShadingPoint, estimate, reference};
 use lobe::math::luminance;
 use lobe::sequence::Sequence;
 use lobe::{Light, Rgb, Strategy};
@@ -13,7 +13,7 @@ use lobe::{Light, Rgb, Strategy};
 fn lights() -> [Light; 2] {
     [
         Light::Constant(Rgb::new(1.0, 0.8, 0.6)),
-        Light::Lobe {
+        Light::Beam {
             dir: DVec3::new(-0.5, 0.2, 0.8).normalize(),
             exponent: 8.0,
             radiance: Rgb::splat(2.0),
@@ -47,13 +47,13 @@ fn every_estimate_is_within_four_standard_errors() {
         for theta in [0.0, 45.0, 75.0] {
             let wo = common::wo(theta);
             for light in lights() {
-                let r = luminance(reference(&c.material, wo, &light, 1e-9));
+                let r = luminance(reference(&c.material, &ShadingPoint::local(wo), &light, 1e-9));
                 for s in c.material.strategies() {
                     for seq in Sequence::ALL {
                         count += 1;
                         let acc = estimate(
                             &c.material,
-                            wo,
+                            &ShadingPoint::local(wo),
                             &light,
                             &Plan {
                                 technique: s.into(),
@@ -61,7 +61,8 @@ fn every_estimate_is_within_four_standard_errors() {
                                 samples: 1 << 16,
                                 seed: count,
                             },
-                        );
+                        )
+                        .unwrap();
                         let (m, se) = (acc.lum.mean(), acc.lum.std_error());
                         // A floor of 1e-7 relative: where the weights are nearly constant
                         // (Beckmann vndf at normal incidence loses 2e-8 of the light in
@@ -93,10 +94,11 @@ fn variance(json: &str, theta: f64, s: Strategy) -> f64 {
     let wo = DVec3::new(theta.to_radians().sin(), 0.0, theta.to_radians().cos());
     let acc = estimate(
         &c.material,
-        wo,
+        &ShadingPoint::local(wo),
         &Light::Constant(Rgb::ONE),
         &Plan::independent(s, 1 << 18, 3),
-    );
+    )
+    .unwrap();
     acc.lum.variance()
 }
 

@@ -6,7 +6,8 @@ mod common;
 
 use glam::DVec3;
 use lobe::envmap::EnvMap;
-use lobe::estimator::{Heuristic, MisForm, Plan, Technique, estimate, reference};
+use lobe::estimator::{Heuristic, MisForm, Plan, ShadingPoint, Technique, estimate, reference};
+use lobe::light::LightDistribution;
 use lobe::math::luminance;
 use lobe::sequence::Sequence;
 use lobe::stats::chi2::{Chi2Config, chi2_test, chi2_test_cells};
@@ -103,7 +104,7 @@ fn light_samplers_of_analytic_lights_match_their_pdfs() {
     let cfg = Chi2Config::default();
     for light in [
         Light::Constant(Rgb::ONE),
-        Light::Lobe {
+        Light::Beam {
             dir: DVec3::new(0.3, 0.1, 0.9).normalize(),
             exponent: 20.0,
             radiance: Rgb::ONE,
@@ -111,8 +112,8 @@ fn light_samplers_of_analytic_lights_match_their_pdfs() {
     ] {
         let r = chi2_test(
             &cfg,
-            |_, u| light.sample(u).map(|(d, _)| d),
-            |d| light.pdf(d),
+            |_, u| light.sample(LightDistribution::Plain, u).map(|s| s.dir),
+            |d| light.pdf(LightDistribution::Plain, d),
         );
         assert!(r.passes(0.01 / 4.0), "{light:?}: p = {}", r.p_value);
         assert!((r.pdf_integral - 1.0).abs() < 1e-3);
@@ -121,7 +122,7 @@ fn light_samplers_of_analytic_lights_match_their_pdfs() {
 
 fn rmse(
     m: &lobe::Material,
-    wo: DVec3,
+    sp: &ShadingPoint,
     light: &Light,
     t: Technique,
     reference: f64,
@@ -134,7 +135,7 @@ fn rmse(
         let e = luminance(
             estimate(
                 m,
-                wo,
+                sp,
                 light,
                 &Plan {
                     technique: t,
@@ -143,6 +144,7 @@ fn rmse(
                     seed: 100 + r,
                 },
             )
+            .unwrap()
             .mean(),
         );
         sq += (e - reference) * (e - reference);
@@ -162,10 +164,8 @@ fn rmse(
 #[test]
 fn mis_is_as_good_as_the_better_technique_on_a_sunny_sky() {
     let map = Arc::new(EnvMap::sky(256, 128, 35.0, 40.0));
-    let light = Light::Env {
-        map,
-        frame: Frame::from_normal_tangent(DVec3::Y, DVec3::X).unwrap(),
-    };
+    let light = Light::Env(map);
+    let frame = Frame::from_normal_tangent(DVec3::Y, DVec3::X).unwrap();
     let mut failures = Vec::new();
     for json in [
         r#"{"type":"cook-torrance","alpha":0.5}"#,
@@ -180,24 +180,23 @@ fn mis_is_as_good_as_the_better_technique_on_a_sunny_sky() {
             Strategy::Brdf
         };
         // View from the side the sun shines on, so that the highlight is in play.
-        let wo = Frame::from_normal_tangent(DVec3::Y, DVec3::X)
-            .unwrap()
-            .to_local(DVec3::new(0.0, 0.6, 0.8).normalize());
-        let r = luminance(reference(&m, wo, &light, 1e-7));
+        let wo = frame.to_local(DVec3::new(0.0, 0.6, 0.8).normalize());
+        let sp = ShadingPoint { frame, wo };
+        let r = luminance(reference(&m, &sp, &light, 1e-7));
         let n = 4096;
         let runs = 64;
-        let (e_b, m_b, se_b) = rmse(&m, wo, &light, Technique::Bsdf(bsdf), r, n, runs);
-        let (e_l, m_l, se_l) = rmse(&m, wo, &light, Technique::Light, r, n, runs);
+        let (e_b, m_b, se_b) = rmse(&m, &sp, &light, Technique::Bsdf(bsdf), r, n, runs);
+        let (e_l, m_l, se_l) = rmse(&m, &sp, &light, Technique::Light, r, n, runs);
         for h in [Heuristic::Balance, Heuristic::Power] {
             for form in [MisForm::MultiSample, MisForm::OneSample] {
                 let t = Technique::Mis(lobe::estimator::Mis {
-                    bsdf,
+                    bsdf: Some(bsdf),
                     heuristic: h,
                     form,
                     n_bsdf: 1,
                     n_light: 1,
                 });
-                let (e_m, m_m, se_m) = rmse(&m, wo, &light, t, r, n, runs);
+                let (e_m, m_m, se_m) = rmse(&m, &sp, &light, t, r, n, runs);
                 // Agreement of the means (over all runs) within 4 combined standard errors.
                 for (name, mm, se) in [("bsdf", m_b, se_b), ("light", m_l, se_l)] {
                     assert!(

@@ -35,6 +35,13 @@ pub trait Lobe {
         let wi = self.sample(strategy, wo, u)?;
         Some((wi, self.eval(wo, wi), self.pdf(strategy, wo, wi)))
     }
+    /// `(eval, pdf)` at one `wi`, sharing what they have in common (a model
+    /// may override it for speed; the numbers must be the same as the two
+    /// calls).
+    #[inline]
+    fn eval_pdf(&self, strategy: Strategy, wo: DVec3, wi: DVec3) -> (Rgb, f64) {
+        (self.eval(wo, wi), self.pdf(strategy, wo, wi))
+    }
     /// An estimate of the lobe's directional albedo (luminance), used to
     /// choose between lobes.
     fn albedo_hint(&self, wo: DVec3) -> f64;
