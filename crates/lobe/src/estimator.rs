@@ -574,14 +574,35 @@ pub fn estimate_chunk(
     let first = chunk * CHUNK;
     let len = CHUNK.min(plan.estimates().saturating_sub(first));
     let mut points = vec![[0.0; 3]; len * k];
-    sequence::fill(
-        plan.sequence,
-        plan.seed,
-        plan.estimates() * k,
-        chunk,
-        first * k,
-        &mut points,
-    );
+    if k == 1 || plan.sequence == Sequence::Independent {
+        // Independent numbers: the points of one sample are consecutive.
+        sequence::fill(
+            plan.sequence,
+            plan.seed,
+            plan.estimates() * k,
+            chunk,
+            first * k,
+            &mut points,
+        );
+    } else {
+        // Stratified or Sobol: point `t` of every sample comes from stream
+        // `t`, an independently randomized sequence of `N` points, so each
+        // technique of MIS is as well distributed as it is alone.
+        let mut stream = vec![[0.0; 3]; len];
+        for t in 0..k {
+            sequence::fill(
+                plan.sequence,
+                sequence::stream_seed(plan.seed, t),
+                plan.estimates(),
+                chunk,
+                first,
+                &mut stream,
+            );
+            for (i, p) in stream.iter().enumerate() {
+                points[i * k + t] = *p;
+            }
+        }
+    }
     let mut acc = Accumulator::default();
     for p in points.chunks_exact(k) {
         acc.push(est.estimate(sp, light, p, &mut Unoccluded).value);

@@ -75,6 +75,20 @@ impl std::str::FromStr for Sequence {
     }
 }
 
+/// The seed of stream `stream` of an estimate seeded with `seed`: stream 0
+/// is `seed` itself; every other stream is an independent randomization
+/// (its own scramble, permutation and jitter). Each technique of
+/// multi-sample MIS draws from its own stream, so that each is as well
+/// distributed as a sequence alone.
+#[must_use]
+pub fn stream_seed(seed: u64, stream: usize) -> u64 {
+    if stream == 0 {
+        seed
+    } else {
+        hash64(seed ^ hash64(0x4d49_535f_5354_524d ^ stream as u64))
+    }
+}
+
 /// Fill `out` with the points `first .. first + out.len()` of an `n`-point
 /// sequence; `chunk` names the chunk (for the independent streams).
 pub fn fill(seq: Sequence, seed: u64, n: usize, chunk: usize, first: usize, out: &mut [[f64; 3]]) {
