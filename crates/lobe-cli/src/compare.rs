@@ -996,7 +996,7 @@ pub fn write_grid(path: &Path, spec: &FigureSpec) -> Result<FigureInfo> {
         None,
     )?;
     let top = ry + g.caption_h();
-    blit(&root, show(reference.to_srgb8()), (rx, top), (g.dw, g.dh))?;
+    blit(&root, show(reference.to_srgb8(&lobe_render::ToneMap::default())), (rx, top), (g.dw, g.dh))?;
     let k = g.dw as f64 / w as f64;
     let label_size = (f64::from(g.dh) / 15.0).clamp(9.0, 13.0);
     for l in &spec.labels {
@@ -1018,7 +1018,7 @@ pub fn write_grid(path: &Path, spec: &FigureSpec) -> Result<FigureInfo> {
             let (head, tail) = shot_caption(s);
             caption(x, y, &head, tail.as_deref())?;
             let top = y + g.caption_h();
-            blit(&root, show(s.image.to_srgb8()), (x, top), (g.dw, g.dh))?;
+            blit(&root, show(s.image.to_srgb8(&lobe_render::ToneMap::default())), (x, top), (g.dw, g.dh))?;
             blit(
                 &root,
                 show(error_rgb(&maps[c][i], &scale)),

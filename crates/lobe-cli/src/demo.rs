@@ -322,10 +322,10 @@ fn showcase(plan: &Plan, dir: &Path, quiet: bool) -> Result<()> {
         &summary("built-in showcase", &settings, &cmp, figure),
     )?;
     let mut renders = vec![dir.join("reference.png")];
-    cmp.reference.image.write_png(&renders[0])?;
+    cmp.reference.image.write_png(&renders[0], &lobe_render::ToneMap::default())?;
     for s in &cmp.equal_samples {
         let p = dir.join(format!("{}.png", s.method.name()));
-        s.image.write_png(&p)?;
+        s.image.write_png(&p, &lobe_render::ToneMap::default())?;
         renders.push(p);
     }
     print_table(&cmp);

@@ -20,9 +20,10 @@ use std::time::Instant;
                   vndf where the material has it else brdf, and one light sample). A BSDF strategy that \
                   does not apply to an object's material (vndf on a Phong sphere, say) falls back to \
                   brdf for that object, with a note. max_depth > 1 in the scene adds path tracing.\n\n\
-                  Writes NAME.exr (linear RGB, 32-bit float) and NAME.png (exposure 1, Reinhard \
-                  x/(1+x) per channel, sRGB-encoded, 8 bits). Every pixel has its own random stream, \
-                  so the image is the same for any --threads.",
+                  Writes NAME.exr (linear RGB, 32-bit float) and NAME.png (scaled by 2^--exposure, \
+                  a filmic curve (ACES fit) on luminance that keeps each pixel's hue, sRGB-encoded, \
+                  8 bits). Every pixel has its own random stream, so the image is the same for any \
+                  --threads.",
     after_help = "Example:\n  lobe render scene.toml --spp 16 --strategy mis-power --out preview",
     after_long_help = SCENE_HELP
 )]
@@ -42,10 +43,14 @@ pub struct RenderArgs {
     /// Worker threads (default: one per core)
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=4096))]
     pub threads: Option<u32>,
-    /// Output name: writes NAME.exr (linear) and NAME.png (Reinhard x/(1+x),
+    /// Output name: writes NAME.exr (linear) and NAME.png (tone-mapped,
     /// sRGB) (default: the scene file's stem, in the current directory)
     #[arg(long, value_name = "NAME")]
     pub out: Option<PathBuf>,
+    /// Exposure of the PNG in stops: the linear image times 2^EV before the
+    /// tone curve (the EXR stays linear)
+    #[arg(long, value_name = "EV", default_value_t = 0.0, allow_hyphen_values = true)]
+    pub exposure: f64,
     /// No progress bar and no notes
     #[arg(long, short)]
     pub quiet: bool,
@@ -88,6 +93,9 @@ Examples:
 /// Run `lobe render`.
 pub fn run(args: &RenderArgs) -> Result<()> {
     let base = crate::common::output_base(args.out.as_deref(), &args.scene, &["exr", "png"], "")?;
+    if !args.exposure.is_finite() || args.exposure.abs() > 64.0 {
+        bail!("--exposure {}: must be a number of stops in [-64, 64]", args.exposure);
+    }
     if args.spp == Some(0) {
         bail!("--spp 0: at least 1 sample per pixel");
     }
@@ -134,7 +142,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let exr = crate::common::with_ext(&base, "exr");
     let png = crate::common::with_ext(&base, "png");
     image.write_exr(&exr)?;
-    image.write_png(&png)?;
+    image.write_png(&png, &lobe_render::ToneMap { exposure: args.exposure })?;
     let samples = image.stats.camera_rays as f64;
     println!(
         "wrote {} and {} ({w}x{h}, {} spp, {}, max_depth {}): {:.2} s, {:.2} M samples/s, {:.2} M rays/s",

@@ -12,7 +12,7 @@
 //! let scene = load_scene(std::path::Path::new("scene.toml"))?;
 //! let image = render(&scene, &scene.options, |_| {});
 //! image.write_exr(std::path::Path::new("scene.exr"))?;
-//! image.write_png(std::path::Path::new("scene.png"))?;
+//! image.write_png(std::path::Path::new("scene.png"), &lobe_render::ToneMap::default())?;
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 //!
@@ -45,7 +45,7 @@ pub use camera::{Camera, CameraError};
 pub use envmap_io::{LoadError, load_envmap};
 pub use geometry::{Hit, Ray};
 pub use mesh::{Mesh, MeshError};
-pub use output::OutputError;
+pub use output::{OutputError, ToneMap};
 pub use options::RenderOptions;
 pub use render::{Image, RenderStats, fallbacks, render, technique_for};
 pub use scene::{Object, Scene, SceneDesc, SceneError, Shape, load_scene, parse_scene, showcase};

@@ -1,10 +1,14 @@
 //! Writing images: linear OpenEXR (RGB, 32-bit float) and a tone-mapped,
 //! sRGB-encoded PNG.
 //!
-//! The PNG's tone curve: exposure 1 (the linear value as is), then
-//! Reinhard's `x / (1 + x)` on each channel, then the sRGB transfer
-//! function, rounded to 8 bits. A radiance of 1 shows as 0.5 before the
-//! sRGB encoding (188 of 255).
+//! The PNG's tone curve ([`ToneMap`]): the linear value times `2^exposure`
+//! (exposure in stops, 0 by default), then a filmic curve on the pixel's
+//! **luminance** (Narkowicz's fit of the ACES reference curve,
+//! `x(2.51x + 0.03) / (x(2.43x + 0.59) + 0.14)`), the colour scaled by the
+//! ratio of the mapped to the linear luminance so that hue and saturation
+//! stay as rendered, each channel clipped to [0, 1], then the sRGB transfer
+//! function, rounded to 8 bits. A grey radiance of 1 shows as 0.80 before
+//! the sRGB encoding (232 of 255), 0.18 (middle grey) as 0.27.
 
 use crate::render::Image;
 use std::path::{Path, PathBuf};
@@ -17,14 +21,63 @@ pub struct OutputError {
     pub message: String,
 }
 
-/// Reinhard's curve `x / (1 + x)`, with NaN and negative values as 0.
+/// Narkowicz's fit of the ACES filmic curve, from linear `[0, ∞)` to
+/// `[0, 1]`; NaN and negative values as 0, infinity as 1.
 #[inline]
 #[must_use]
-pub fn reinhard(x: f64) -> f64 {
+pub fn filmic(x: f64) -> f64 {
     if x > 0.0 {
-        if x.is_finite() { x / (1.0 + x) } else { 1.0 }
+        if x.is_finite() {
+            (x * (2.51 * x + 0.03) / (x * (2.43 * x + 0.59) + 0.14)).min(1.0)
+        } else {
+            1.0
+        }
     } else {
         0.0
+    }
+}
+
+/// How linear radiance becomes display values in a PNG.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ToneMap {
+    /// Exposure in stops: the linear value is scaled by `2^exposure`.
+    pub exposure: f64,
+}
+
+impl Default for ToneMap {
+    fn default() -> Self {
+        ToneMap { exposure: 0.0 }
+    }
+}
+
+impl ToneMap {
+    /// The display values in [0, 1] (before the sRGB encoding) of a linear
+    /// RGB value: the filmic curve on luminance, the colour scaled along.
+    #[must_use]
+    pub fn display(&self, rgb: [f64; 3]) -> [f64; 3] {
+        let k = self.exposure.exp2();
+        // NaN and negative values as 0; infinity as a radiance far past white.
+        let c = rgb.map(|v| {
+            if v == f64::INFINITY {
+                1e30
+            } else if v > 0.0 {
+                (v * k).min(1e30)
+            } else {
+                0.0
+            }
+        });
+        let lum = 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
+        if !(lum > 0.0) {
+            return [0.0; 3];
+        }
+        let ratio = filmic(lum) / lum;
+        c.map(|v| (v * ratio).clamp(0.0, 1.0))
+    }
+
+    /// The 8-bit sRGB values of a linear RGB value.
+    #[must_use]
+    pub fn srgb8(&self, rgb: [f64; 3]) -> [u8; 3] {
+        self.display(rgb).map(|v| (srgb_encode(v) * 255.0).round() as u8)
     }
 }
 
@@ -40,20 +93,13 @@ pub fn srgb_encode(x: f64) -> f64 {
     }
 }
 
-/// One linear channel value to an 8-bit tone-mapped sRGB value.
-#[inline]
-#[must_use]
-pub fn tonemap_channel(x: f64) -> u8 {
-    (srgb_encode(reinhard(x)) * 255.0).round() as u8
-}
-
 impl Image {
-    /// The tone-mapped sRGB bytes, `RGB RGB ...`, row 0 at the top.
+    /// The sRGB bytes tone-mapped by `tone`, `RGB RGB ...`, row 0 at the top.
     #[must_use]
-    pub fn to_srgb8(&self) -> Vec<u8> {
+    pub fn to_srgb8(&self, tone: &ToneMap) -> Vec<u8> {
         self.pixels
             .iter()
-            .flat_map(|p| p.to_array().map(tonemap_channel))
+            .flat_map(|p| tone.srgb8(p.to_array()))
             .collect()
     }
 
@@ -83,13 +129,13 @@ impl Image {
             .map_err(|e| err(e.to_string()))
     }
 
-    /// Write the tone-mapped image as an 8-bit sRGB PNG.
-    pub fn write_png(&self, path: &Path) -> Result<(), OutputError> {
+    /// Write the image tone-mapped by `tone` as an 8-bit sRGB PNG.
+    pub fn write_png(&self, path: &Path, tone: &ToneMap) -> Result<(), OutputError> {
         let err = |message: String| OutputError {
             path: path.to_path_buf(),
             message,
         };
-        let img = image::RgbImage::from_raw(self.width as u32, self.height as u32, self.to_srgb8())
+        let img = image::RgbImage::from_raw(self.width as u32, self.height as u32, self.to_srgb8(tone))
             .ok_or_else(|| err("the pixel buffer does not match the size".into()))?;
         img.save_with_format(path, image::ImageFormat::Png)
             .map_err(|e| err(e.to_string()))
@@ -102,10 +148,31 @@ mod tests {
 
     #[test]
     fn tone_curve() {
-        assert_eq!(tonemap_channel(0.0), 0);
-        assert_eq!(tonemap_channel(f64::NAN), 0);
-        assert_eq!(tonemap_channel(f64::INFINITY), 255);
-        assert_eq!(tonemap_channel(1.0), 188);
-        assert!(tonemap_channel(1e9) == 255);
+        let t = ToneMap::default();
+        assert_eq!(t.srgb8([0.0; 3]), [0; 3]);
+        assert_eq!(t.srgb8([f64::NAN; 3]), [0; 3]);
+        assert_eq!(t.srgb8([f64::INFINITY; 3]), [255; 3]);
+        assert_eq!(t.srgb8([-1.0; 3]), [0; 3]);
+        assert_eq!(t.srgb8([1.0; 3]), [232; 3]);
+        assert!((t.display([0.18; 3])[0] - 0.2669).abs() < 1e-3);
+        assert_eq!(t.srgb8([1e9; 3]), [255; 3]);
+        // Monotone in luminance.
+        let mut last = 0.0;
+        for i in 1..1000 {
+            let v = t.display([f64::from(i) * 0.01; 3])[0];
+            assert!(v >= last);
+            last = v;
+        }
+    }
+
+    #[test]
+    fn the_curve_keeps_the_hue_and_exposure_scales() {
+        let t = ToneMap::default();
+        let d = t.display([0.2, 0.1, 0.05]);
+        // The channel ratios are kept (per-channel curves would change them).
+        assert!((d[0] / d[1] - 2.0).abs() < 1e-12 && (d[1] / d[2] - 2.0).abs() < 1e-12);
+        // One stop up is the same as twice the radiance.
+        let up = ToneMap { exposure: 1.0 }.display([0.2, 0.1, 0.05]);
+        assert_eq!(up, t.display([0.4, 0.2, 0.1]));
     }
 }
