@@ -199,7 +199,7 @@ fn render_one(
     what: &str,
 ) -> (Image, f64) {
     let opts = RenderOptions {
-        spp,
+        spp: spp.into(),
         technique: method,
         seed,
         max_depth: s.max_depth,
@@ -212,7 +212,7 @@ fn render_one(
         "reference" => format!("reference {spp} spp"),
         _ => format!("{method} {spp} spp, {what}"),
     };
-    let pb = progress(pixels, &message, s.quiet);
+    let pb = progress(pixels * u64::from(spp), &message, s.quiet);
     let t0 = Instant::now();
     let image = render(scene, &opts, |n| pb.inc(n));
     let time = t0.elapsed().as_secs_f64();
@@ -1176,7 +1176,10 @@ pub fn run(args: &CompareArgs) -> Result<()> {
     )?;
     let scene = load_scene(&args.scene)?;
     let methods = methods.unwrap_or_else(|| default_methods(&scene));
-    let spp = args.spp.unwrap_or(scene.options.spp).max(1);
+    let spp = args
+        .spp
+        .unwrap_or(u32::try_from(scene.options.spp).unwrap_or(u32::MAX))
+        .max(1);
     let settings = Settings {
         methods,
         spp,

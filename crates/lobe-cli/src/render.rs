@@ -30,9 +30,9 @@ use std::time::Instant;
 pub struct RenderArgs {
     /// The scene file (TOML; `lobe render --help` shows the format)
     pub scene: PathBuf,
-    /// Samples per pixel (overrides the scene's render.spp)
+    /// Samples per pixel, 1 to 2^64 − 1 (overrides the scene's render.spp)
     #[arg(long)]
-    pub spp: Option<u32>,
+    pub spp: Option<u64>,
     /// uniform, cosine, brdf, vndf, spherical-caps, bounded-vndf, light, mis or
     /// mis-power (overrides the scene's render.strategy)
     #[arg(long)]
@@ -128,7 +128,23 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         }
     }
     let (w, h) = (scene.camera.width, scene.camera.height);
-    let pb = progress(u64::from(w) * u64::from(h), "rendering", args.quiet);
+    let total = (u64::from(w) * u64::from(h))
+        .checked_mul(opts.spp)
+        .ok_or_else(|| {
+            anyhow!(
+                "--spp {}: {w}×{h} pixels × {} spp is more samples than fit in 64 bits",
+                opts.spp,
+                opts.spp
+            )
+        })?;
+    let pb = progress(total, "rendering", args.quiet);
+    pb.set_style(
+        indicatif::ProgressStyle::with_template(
+            "{msg:>12} [{wide_bar}] {human_pos}/{human_len} samples, {per_sec}, {elapsed}<{eta}",
+        )
+        .expect("progress template is valid")
+        .progress_chars("=> "),
+    );
     let t0 = Instant::now();
     let image = render(&scene, &opts, |n| pb.inc(n));
     let secs = t0.elapsed().as_secs_f64();

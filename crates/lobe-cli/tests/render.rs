@@ -199,3 +199,19 @@ fn errors_are_one_line_and_name_file_line_and_field() {
     ));
     assert!(e.contains("none.toml"), "{e}");
 }
+
+/// `--spp` takes any u64; more samples than fit in 64 bits in all, or a
+/// number past u64, is a clear one-line error (issue 8, item 7).
+#[test]
+fn huge_spp_is_accepted_or_refused_clearly() {
+    let d = dir("huge-spp");
+    let scene = d.join("scene.toml");
+    std::fs::write(&scene, SCENE).unwrap();
+    let s = scene.to_str().unwrap();
+    let e = one_line_error(&lobe(&["render", s, "--spp", "18446744073709551615"], None));
+    assert!(e.contains("--spp 18446744073709551615") && e.contains("64 bits"), "{e}");
+    let out = lobe(&["render", s, "--spp", "18446744073709551616"], None);
+    assert!(!out.status.success());
+    let e = String::from_utf8_lossy(&out.stderr);
+    assert!(e.contains("--spp") && e.contains("too large"), "{e}");
+}

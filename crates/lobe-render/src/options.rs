@@ -8,7 +8,7 @@ use lobe::estimator::{Heuristic, Technique};
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RenderOptions {
     /// Samples (camera rays) per pixel, at least 1.
-    pub spp: u32,
+    pub spp: u64,
     /// How each hit estimates its reflected light: a BSDF strategy (falling
     /// back to `brdf` on a material it does not apply to), `light`, or MIS
     /// on the material's best BSDF strategy.

@@ -172,8 +172,9 @@ pub fn fallbacks(scene: &Scene, technique: Technique) -> Vec<Fallback> {
 
 /// Render `scene` with `opts`. Rows are rendered in parallel (on a local
 /// pool of `opts.threads` threads, else on rayon's current pool), each
-/// written in place; `progress` is called after each row with the number of
-/// pixels it finished (they add up to `width × height`).
+/// written in place; `progress` is called with the number of samples
+/// (camera rays) finished, every few thousand samples of a pixel and at its
+/// end (they add up to `width × height × spp`).
 #[must_use]
 pub fn render(scene: &Scene, opts: &RenderOptions, progress: impl Fn(u64) + Sync) -> Image {
     if let Some(n) = opts.threads
@@ -184,7 +185,7 @@ pub fn render(scene: &Scene, opts: &RenderOptions, progress: impl Fn(u64) + Sync
     render_on_pool(scene, opts, &progress)
 }
 
-fn render_on_pool(scene: &Scene, opts: &RenderOptions, progress: &(impl Fn(u64) + Sync)) -> Image {
+fn render_on_pool(scene: &Scene, opts: &RenderOptions, progress: &(dyn Fn(u64) + Sync)) -> Image {
     let (w, h) = (scene.camera.width as usize, scene.camera.height as usize);
     let shading: Vec<ObjectShading> = scene
         .objects
@@ -193,6 +194,7 @@ fn render_on_pool(scene: &Scene, opts: &RenderOptions, progress: &(impl Fn(u64) 
         .collect();
     let light = Light::Env(scene.environment.clone());
     let ctx = Context {
+        progress,
         scene,
         light: &light,
         shading: &shading,
@@ -214,7 +216,6 @@ fn render_on_pool(scene: &Scene, opts: &RenderOptions, progress: &(impl Fn(u64) 
             for (x, px) in row.iter_mut().enumerate() {
                 *px = ctx.pixel(x, y, &mut stats);
             }
-            progress(row.len() as u64);
             stats
         })
         .reduce(RenderStats::default, |a, b| RenderStats {
@@ -240,11 +241,15 @@ pub fn pixel_rng(seed: u64, index: u64) -> Pcg64 {
     )
 }
 
+/// Progress is reported every this many samples of a pixel (and at its end).
+const PROGRESS_STEP: u64 = 4096;
+
 struct Context<'a> {
+    progress: &'a (dyn Fn(u64) + Sync),
     scene: &'a Scene,
     light: &'a Light,
     shading: &'a [ObjectShading<'a>],
-    spp: u32,
+    spp: u64,
     max_depth: u32,
     seed: u64,
     width: usize,
@@ -280,6 +285,7 @@ impl Context<'_> {
     fn pixel(&self, x: usize, y: usize, stats: &mut RenderStats) -> Rgb {
         let mut rng = pixel_rng(self.seed, (y * self.width + x) as u64);
         let mut sum = Rgb::ZERO;
+        let mut pending = 0u64;
         for _ in 0..self.spp {
             let (jx, jy): (f64, f64) = (rng.random(), rng.random());
             let ray = self.scene.camera.ray(x as f64 + jx, y as f64 + jy);
@@ -290,8 +296,16 @@ impl Context<'_> {
             } else {
                 stats.nonfinite += 1;
             }
+            pending += 1;
+            if pending == PROGRESS_STEP {
+                (self.progress)(pending);
+                pending = 0;
+            }
         }
-        sum / f64::from(self.spp)
+        if pending > 0 {
+            (self.progress)(pending);
+        }
+        sum / self.spp as f64
     }
 
     /// Radiance arriving along a camera ray.

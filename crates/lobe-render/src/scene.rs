@@ -323,7 +323,7 @@ pub struct ObjectDesc {
 #[serde(deny_unknown_fields)]
 pub struct RenderDesc {
     #[serde(default = "default_spp")]
-    pub spp: u32,
+    pub spp: u64,
     #[serde(default = "default_strategy")]
     pub strategy: String,
     #[serde(default = "default_seed")]
@@ -332,7 +332,7 @@ pub struct RenderDesc {
     pub max_depth: u32,
 }
 
-fn default_spp() -> u32 {
+fn default_spp() -> u64 {
     64
 }
 fn default_strategy() -> String {

@@ -14,7 +14,7 @@ fn lambert(a: f64) -> Material {
     Material::lambert(Rgb::splat(a)).unwrap()
 }
 
-fn opts(method: Technique, spp: u32) -> RenderOptions {
+fn opts(method: Technique, spp: u64) -> RenderOptions {
     RenderOptions {
         spp,
         technique: method,
@@ -445,4 +445,19 @@ fn the_shipped_scenes_and_the_showcase_render() {
             .all(|p| p.is_finite() && p.min_element() >= 0.0)
     );
     assert_eq!(img.stats.camera_rays, 32 * 24 * 2);
+}
+
+/// Progress comes in samples, several times within a pixel with many
+/// samples, and adds up to width × height × spp (issue 8, item 7).
+#[test]
+fn progress_counts_samples_within_a_pixel() {
+    use std::sync::atomic::{AtomicU64, Ordering};
+    let scene = furnace_scene(2, 1);
+    let (calls, total) = (AtomicU64::new(0), AtomicU64::new(0));
+    let _ = render(&scene, &opts(Technique::Bsdf(Strategy::Cosine), 10_000), |n| {
+        calls.fetch_add(1, Ordering::Relaxed);
+        total.fetch_add(n, Ordering::Relaxed);
+    });
+    assert_eq!(total.load(Ordering::Relaxed), 2 * 10_000);
+    assert!(calls.load(Ordering::Relaxed) >= 6, "{calls:?}");
 }
