@@ -529,7 +529,7 @@ fn material_files_json_and_toml() {
 fn help_shows_examples_and_material_defaults() {
     let run = lobe(&["eval", "--help"], "");
     assert_eq!(run.code, Some(0));
-    assert!(run.stdout.contains(lobe::desc::DEFAULTS), "{}", run.stdout);
+    assert!(run.stdout.contains(lobe::desc::defaults()), "{}", run.stdout);
     assert!(
         run.stdout.contains("Examples:") && run.stdout.contains("lobe eval"),
         "{}",

@@ -94,14 +94,7 @@ impl Light {
     pub fn pdf(&self, wi: DVec3) -> f64 {
         match self {
             Light::Constant(_) => warp::square_to_uniform_sphere_pdf(wi),
-            Light::Lobe { dir, exponent, .. } => {
-                let c = wi.dot(*dir);
-                if c > 0.0 {
-                    (exponent + 1.0) * crate::math::INV_TWO_PI * c.powf(*exponent)
-                } else {
-                    0.0
-                }
-            }
+            Light::Lobe { dir, exponent, .. } => warp::cos_power_pdf(wi.dot(*dir), *exponent),
             Light::Env { map, frame } => map.pdf(frame.to_world(wi)),
         }
     }

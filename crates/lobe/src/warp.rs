@@ -104,8 +104,18 @@ pub fn square_to_cos_power(u: DVec2, n: f64) -> DVec3 {
 #[inline]
 #[must_use]
 pub fn square_to_cos_power_pdf(w: DVec3, n: f64) -> f64 {
-    if w.z > 0.0 {
-        (n + 1.0) * INV_TWO_PI * w.z.powf(n)
+    cos_power_pdf(w.z, n)
+}
+
+/// The cos-power density `(n+1)/(2π) cosⁿθ` in solid angle, as a function
+/// of `cos θ` (the angle to the lobe's axis), zero for `cos θ ≤ 0`: the
+/// density of [`square_to_cos_power`] in a frame around any axis. The
+/// Phong and Blinn-Phong samplers and the analytic lobe light use it.
+#[inline]
+#[must_use]
+pub fn cos_power_pdf(cos_theta: f64, n: f64) -> f64 {
+    if cos_theta > 0.0 {
+        (n + 1.0) * INV_TWO_PI * cos_theta.powf(n)
     } else {
         0.0
     }
