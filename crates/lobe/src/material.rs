@@ -7,7 +7,7 @@
 //! and `pdf` is the mixture `P p_g + (1 − P) p_d` (one-sample MIS with the
 //! balance heuristic), so `pdf` is always the density that `sample` draws from.
 
-use crate::math::{INV_TWO_PI, Rgb};
+use crate::math::Rgb;
 pub use crate::models::Glossy;
 use crate::models::{Lambert, Lobe};
 use crate::sample::{BsdfSample, LobeKind};
@@ -125,7 +125,7 @@ impl Material {
             return 0.0;
         }
         match strategy {
-            Strategy::Uniform => INV_TWO_PI,
+            Strategy::Uniform => warp::square_to_uniform_hemisphere_pdf(wi),
             Strategy::Cosine => warp::square_to_cosine_hemisphere_pdf(wi),
             _ => {
                 let p = self.glossy_probability(wo);
@@ -164,10 +164,7 @@ impl Material {
                     return Self::finish(wi, f, pdf, LobeKind::Glossy);
                 }
                 if uc < p {
-                    (
-                        self.glossy.sample(strategy, wo, u)?,
-                        LobeKind::Glossy,
-                    )
+                    (self.glossy.sample(strategy, wo, u)?, LobeKind::Glossy)
                 } else {
                     (self.diffuse.sample(strategy, wo, u)?, LobeKind::Diffuse)
                 }

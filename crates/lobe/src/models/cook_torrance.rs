@@ -263,11 +263,7 @@ impl Lobe for CookTorrance {
         let cos_oh = wo.dot(wm);
         let d = mf.d(wm);
         let lo = mf.lambda(wo);
-        let g = match self.shadowing {
-            Shadowing::SmithCorrelated => 1.0 / (1.0 + lo + mf.lambda(wi)),
-            Shadowing::SmithSeparable => mf.g1(wi) / (1.0 + lo),
-            Shadowing::VCavity => mf.g(Shadowing::VCavity, wo, wi, wm),
-        };
+        let g = mf.g_with_lambda_o(self.shadowing, lo, wo, wi, wm);
         let inv4o = 0.25 / wo.z;
         let dg = d * g * inv4o / wi.z;
         let pdf = match strategy {

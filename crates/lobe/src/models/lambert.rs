@@ -37,7 +37,10 @@ pub const INFO: ModelInfo = ModelInfo {
 
 #[cfg(feature = "desc")]
 fn from_desc(d: &crate::desc::MaterialDesc) -> crate::error::Result<crate::Material> {
-    crate::Material::lambert(d.albedo.map_or(Rgb::splat(DEFAULT_ALBEDO), crate::desc::Color::rgb))
+    crate::Material::lambert(
+        d.albedo
+            .map_or(Rgb::splat(DEFAULT_ALBEDO), crate::desc::Color::rgb),
+    )
 }
 
 #[derive(Debug, Clone, Copy, PartialEq)]
