@@ -32,7 +32,7 @@ fn defaults_text() -> String {
         for p in m.params {
             let _ = writeln!(
                 s,
-                "  {:<13} {}, default {}: {}",
+                "  {:<13} {}; default {}; {}",
                 p.name,
                 plain(&p.range_text()),
                 plain(&p.default.to_string()),
@@ -41,16 +41,28 @@ fn defaults_text() -> String {
         }
     }
     let rgb = |c: [f64; 3]| format!("[{},{},{}]", c[0], c[1], c[2]);
-    let _ = write!(
-        s,
-        "fresnel (cook-torrance), one of:\n  \
-         {{\"type\":\"none\"}}                     F = 1\n  \
-         {{\"type\":\"schlick\",\"f0\":c}}            default f0 {DEFAULT_F0}\n  \
-         {{\"type\":\"dielectric\",\"eta\":c}}        default eta {DEFAULT_DIELECTRIC_ETA}\n  \
-         {{\"type\":\"conductor\",\"eta\":c,\"k\":c}}   default gold, eta {} k {}",
-        rgb(DEFAULT_CONDUCTOR_ETA),
-        rgb(DEFAULT_CONDUCTOR_K)
-    );
+    s.push_str("fresnel (cook-torrance), one of:");
+    for (object, says) in [
+        (r#"{"type":"none"}"#, "F = 1".to_string()),
+        (
+            r#"{"type":"schlick","f0":c}"#,
+            format!("default f0 {DEFAULT_F0}"),
+        ),
+        (
+            r#"{"type":"dielectric","eta":c}"#,
+            format!("default eta {DEFAULT_DIELECTRIC_ETA}"),
+        ),
+        (
+            r#"{"type":"conductor","eta":c,"k":c}"#,
+            format!(
+                "default gold, eta {} k {}",
+                rgb(DEFAULT_CONDUCTOR_ETA),
+                rgb(DEFAULT_CONDUCTOR_K)
+            ),
+        ),
+    ] {
+        let _ = write!(s, "\n  {object:<35} {says}");
+    }
     s
 }
 
@@ -306,6 +318,23 @@ mod tests {
             Ok(m) => panic!("{json} was accepted: {m:?}"),
             Err(e) => e.to_string(),
         }
+    }
+
+    #[test]
+    fn the_help_text_is_made_from_the_tables() {
+        let text = defaults();
+        for m in models::MODELS {
+            assert!(text.contains(&format!("type {}:", m.name)), "{text}");
+            for p in m.params {
+                let line = format!(
+                    "  {:<13} {}; default",
+                    p.name,
+                    p.range_text().replace('`', "")
+                );
+                assert!(text.contains(&line), "{line:?} not in\n{text}");
+            }
+        }
+        assert!(text.contains("default eta 1.5") && text.contains("default f0 0.04"));
     }
 
     #[test]

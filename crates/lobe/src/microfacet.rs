@@ -340,6 +340,17 @@ impl Microfacet {
         self.g1(wo) * wo.dot(wm).max(0.0) * self.d(wm) / wo.z
     }
 
+    /// Density over the reflected direction `wi` of visible-normal sampling
+    /// (Heitz 2018, [`Microfacet::sample_visible`] and the spherical caps),
+    /// given `d = D(wm)` at the half vector and `lambda_o = Λ(wo)`:
+    /// `pdf_visible / (4 wo·wm)`, which simplifies to
+    /// `G1(wo) D(wm) / (4 cos θo)`.
+    #[inline]
+    #[must_use]
+    pub fn pdf_visible_reflect(d: f64, lambda_o: f64, wo: DVec3) -> f64 {
+        d * (0.25 / wo.z) / (1.0 + lambda_o)
+    }
+
     /// Draw a visible normal for `wo` (upper hemisphere). GGX: Heitz 2018's
     /// projected-hemisphere construction. Beckmann: Heitz and d'Eon 2014's
     /// slope sampling with a numerical inversion of the slope CDF. Blinn-Phong

@@ -267,7 +267,7 @@ impl Lobe for CookTorrance {
         let inv4o = 0.25 / wo.z;
         let dg = d * g * inv4o / wi.z;
         let pdf = match strategy {
-            Strategy::Vndf | Strategy::SphericalCaps => d * inv4o / (1.0 + lo),
+            Strategy::Vndf | Strategy::SphericalCaps => Microfacet::pdf_visible_reflect(d, lo, wo),
             Strategy::BoundedVndf => mf.pdf_reflect_bounded(wo, wi),
             _ => mf.pdf_wm(wm) * 0.25 / cos_oh,
         };
@@ -291,8 +291,9 @@ impl Lobe for CookTorrance {
             return 0.0;
         }
         let p = match strategy {
-            // pdf_visible / (4 wo·h) simplifies to G1(wo) D(h) / (4 cos θo).
-            Strategy::Vndf | Strategy::SphericalCaps => mf.g1(wo) * mf.d(h) / (4.0 * wo.z),
+            Strategy::Vndf | Strategy::SphericalCaps => {
+                Microfacet::pdf_visible_reflect(mf.d(h), mf.lambda(wo), wo)
+            }
             _ => mf.pdf_wm(h) / (4.0 * cos_oh),
         };
         if p.is_finite() { p } else { 0.0 }
