@@ -44,8 +44,7 @@ pub fn theta_to_wo(theta: f64) -> Result<DVec3> {
     if !theta.is_finite() || !(0.0..90.0).contains(&theta) {
         bail!("--theta {theta}: the view angle must be in [0, 90) degrees");
     }
-    let t = theta.to_radians();
-    Ok(DVec3::new(t.sin(), 0.0, t.cos()))
+    Ok(lobe::frame::wo_from_theta(theta, 0.0))
 }
 
 /// Parse `x,y,z` into a non-zero finite vector.

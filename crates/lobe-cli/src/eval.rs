@@ -71,7 +71,7 @@ fn after_long_help() -> String {
          fresnel = {{ type = \"conductor\" }}\n\
          \n\
          {}",
-        lobe::desc::DEFAULTS
+        lobe::desc::defaults()
     )
 }
 

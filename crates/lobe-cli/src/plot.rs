@@ -232,8 +232,7 @@ fn polar_curves(m: &Material) -> Vec<(String, Vec<(f64, f64)>)> {
     POLAR_VIEWS
         .iter()
         .map(|&deg| {
-            let t = deg.to_radians();
-            let wo = DVec3::new(t.sin(), 0.0, t.cos());
+            let wo = lobe::frame::wo_from_theta(deg, 0.0);
             let pts = (-359..=359)
                 .map(|k| {
                     let ti = (f64::from(k) * 0.25).to_radians();

@@ -215,8 +215,7 @@ fn build(model: &Model, value: f64) -> Result<Material> {
 }
 
 fn view(theta: f64) -> DVec3 {
-    let t = theta.to_radians();
-    DVec3::new(t.sin(), 0.0, t.cos())
+    lobe::frame::wo_from_theta(theta, 0.0)
 }
 
 /// One shading point of a model: its table and lost-sample fractions.

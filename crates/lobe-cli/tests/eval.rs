@@ -92,11 +92,7 @@ fn close(a: f64, b: f64, rel: f64) -> bool {
 }
 
 fn dir(theta: f64, phi: f64) -> DVec3 {
-    DVec3::new(
-        theta.sin() * phi.cos(),
-        theta.sin() * phi.sin(),
-        theta.cos(),
-    )
+    lobe::frame::spherical_direction(theta, phi)
 }
 
 fn tmp(name: &str, text: &str) -> PathBuf {
@@ -529,7 +525,11 @@ fn material_files_json_and_toml() {
 fn help_shows_examples_and_material_defaults() {
     let run = lobe(&["eval", "--help"], "");
     assert_eq!(run.code, Some(0));
-    assert!(run.stdout.contains(lobe::desc::DEFAULTS), "{}", run.stdout);
+    assert!(
+        run.stdout.contains(lobe::desc::defaults()),
+        "{}",
+        run.stdout
+    );
     assert!(
         run.stdout.contains("Examples:") && run.stdout.contains("lobe eval"),
         "{}",

@@ -1,39 +1,71 @@
-//! Material descriptions: what a user writes in JSON or TOML, with every
-//! default in one place ([`DEFAULTS`]) and errors that name the field.
+//! Material descriptions: what a user writes in JSON or TOML, checked by
+//! each model's own file ([`crate::models`]: its keys, ranges and defaults,
+//! listed by [`defaults`]), with errors that name the field.
 
 use crate::Error;
 use crate::fresnel::Fresnel;
-use crate::material::{Glossy, Material};
+use crate::material::Material;
 use crate::math::Rgb;
-use crate::microfacet::{Microfacet, Ndf, Shadowing};
-use crate::models::{BlinnPhong, CookTorrance, Phong};
+use crate::models;
 use serde::de::{self, Deserializer, SeqAccess, Visitor};
 use serde::{Deserialize, Serialize};
 
-/// The material keys, their values and defaults, printed by `lobe eval --help`.
-pub const DEFAULTS: &str = "\
-Material keys (JSON or TOML); colours are a number or [r, g, b]:
-  type          lambert | phong | blinn-phong | cook-torrance      (required)
-  albedo        lambert colour in [0,1]                               default 0.8
-  ks            specular colour >= 0 (<= 1 when normalized)           default 1
-  kd            diffuse colour in [0,1], added as kd/pi (not lambert) default 0
-  exponent      phong, blinn-phong shininess in [0, 1e7]              default 32
-  normalized    phong, blinn-phong: energy-normalized form            default true
-  distribution  cook-torrance: ggx | beckmann | blinn-phong           default ggx
-  alpha         cook-torrance width in [1e-4, 2] ([1e-4, 1] for       default 0.3
-                blinn-phong); or alpha_u and alpha_v (anisotropic);
-                or roughness r, with alpha = r^2
-  shadowing     cook-torrance: smith-separable | smith-correlated |   default smith-correlated
-                v-cavity
-  fresnel       cook-torrance:                                        default {\"type\":\"none\"}
-                {\"type\":\"none\"}                 F = 1
-                {\"type\":\"schlick\",\"f0\":c}        default f0 0.04
-                {\"type\":\"dielectric\",\"eta\":c}    default eta 1.5
-                {\"type\":\"conductor\",\"eta\":c,\"k\":c} default gold, eta [0.143,0.374,1.442] k [3.983,2.385,1.603]";
+/// The material keys, their values and defaults, printed by `lobe eval --help`:
+/// made from each model's parameter table ([`crate::models::MODELS`]).
+#[must_use]
+pub fn defaults() -> &'static str {
+    static TEXT: std::sync::OnceLock<String> = std::sync::OnceLock::new();
+    TEXT.get_or_init(defaults_text)
+}
 
-pub const DEFAULT_ALBEDO: f64 = 0.8;
-pub const DEFAULT_EXPONENT: f64 = 32.0;
-pub const DEFAULT_ALPHA: f64 = 0.3;
+fn defaults_text() -> String {
+    use std::fmt::Write as _;
+    let plain = |s: &str| s.replace('`', "");
+    let mut s = format!(
+        "Material keys (JSON or TOML); colours are a number or [r, g, b]:\n  \
+         {:<13} {}      (required)\n",
+        "type",
+        models::names(" | ")
+    );
+    for m in models::MODELS {
+        let _ = writeln!(s, "type {}:", m.name);
+        for p in m.params {
+            let _ = writeln!(
+                s,
+                "  {:<13} {}; default {}; {}",
+                p.name,
+                plain(&p.range_text()),
+                plain(&p.default.to_string()),
+                plain(p.meaning)
+            );
+        }
+    }
+    let rgb = |c: [f64; 3]| format!("[{},{},{}]", c[0], c[1], c[2]);
+    s.push_str("fresnel (cook-torrance), one of:");
+    for (object, says) in [
+        (r#"{"type":"none"}"#, "F = 1".to_string()),
+        (
+            r#"{"type":"schlick","f0":c}"#,
+            format!("default f0 {DEFAULT_F0}"),
+        ),
+        (
+            r#"{"type":"dielectric","eta":c}"#,
+            format!("default eta {DEFAULT_DIELECTRIC_ETA}"),
+        ),
+        (
+            r#"{"type":"conductor","eta":c,"k":c}"#,
+            format!(
+                "default gold, eta {} k {}",
+                rgb(DEFAULT_CONDUCTOR_ETA),
+                rgb(DEFAULT_CONDUCTOR_K)
+            ),
+        ),
+    ] {
+        let _ = write!(s, "\n  {object:<35} {says}");
+    }
+    s
+}
+
 pub const DEFAULT_F0: f64 = 0.04;
 pub const DEFAULT_DIELECTRIC_ETA: f64 = 1.5;
 pub const DEFAULT_CONDUCTOR_ETA: [f64; 3] = [0.143, 0.374, 1.442];
@@ -138,8 +170,6 @@ pub struct MaterialDesc {
     pub fresnel: Option<FresnelDesc>,
 }
 
-pub const MODEL_NAMES: &str = "lambert, phong, blinn-phong, cook-torrance";
-
 impl MaterialDesc {
     /// Parse a JSON object; the error names the line, column and field.
     pub fn from_json(text: &str) -> Result<Self, Error> {
@@ -163,82 +193,30 @@ impl MaterialDesc {
         }
     }
 
-    /// Check every field and build the material.
+    /// Check every field and build the material: the model's own
+    /// [`crate::models::ModelInfo::from_desc`], once every key given is
+    /// known to belong to the model.
     pub fn build(&self) -> Result<Material, Error> {
         let kind = self.kind.as_str();
-        let used: &[&str] = match kind {
-            "lambert" => &["albedo"],
-            "phong" | "blinn-phong" => &["ks", "kd", "exponent", "normalized"],
-            "cook-torrance" => &[
-                "ks",
-                "kd",
-                "distribution",
-                "alpha",
-                "alpha_u",
-                "alpha_v",
-                "roughness",
-                "shadowing",
-                "fresnel",
-            ],
-            _ => {
-                return Err(Error::UnknownName {
-                    field: "type".into(),
-                    value: self.kind.clone(),
-                    expected: MODEL_NAMES.into(),
-                });
-            }
+        let Some(model) = models::find(kind) else {
+            return Err(Error::UnknownName {
+                field: "type".into(),
+                value: self.kind.clone(),
+                expected: models::names(", "),
+            });
         };
         for (name, present) in self.present_fields() {
-            if present && !used.contains(&name) {
+            if present && !model.keys().any(|k| k == name) {
                 return Err(Error::param(
                     name,
                     format!(
                         "does not apply to type {kind} (its keys: {})",
-                        used.join(", ")
+                        model.keys().collect::<Vec<_>>().join(", ")
                     ),
                 ));
             }
         }
-        let ks = self.ks.map_or(Rgb::ONE, Color::rgb);
-        let kd = self.kd.map_or(Rgb::ZERO, Color::rgb);
-        let exponent = self.exponent.unwrap_or(DEFAULT_EXPONENT);
-        let normalized = self.normalized.unwrap_or(true);
-        let glossy = match kind {
-            "lambert" => {
-                return Material::lambert(
-                    self.albedo.map_or(Rgb::splat(DEFAULT_ALBEDO), Color::rgb),
-                );
-            }
-            "phong" => Glossy::Phong(Phong::new(ks, exponent, normalized)?),
-            "blinn-phong" => Glossy::BlinnPhong(BlinnPhong::new(ks, exponent, normalized)?),
-            _ => {
-                let ndf: Ndf = self.distribution.as_deref().unwrap_or("ggx").parse()?;
-                let (ax, ay) = self.alphas()?;
-                let mf = Microfacet::new(ndf, ax, ay).map_err(|e| match e {
-                    // Name the key the user wrote.
-                    Error::Param { message, .. } if self.alpha.is_some() => Error::Param {
-                        field: "alpha".into(),
-                        message,
-                    },
-                    Error::Param { message, .. } if self.roughness.is_some() => Error::Param {
-                        field: "roughness".into(),
-                        message: format!("gives {message} (alpha = roughness²)"),
-                    },
-                    e => e,
-                })?;
-                let shadowing: Shadowing = self
-                    .shadowing
-                    .as_deref()
-                    .unwrap_or("smith-correlated")
-                    .parse()?;
-                let fresnel = self
-                    .fresnel
-                    .as_ref()
-                    .map_or(Ok(Fresnel::None), FresnelDesc::build)?;
-                Glossy::CookTorrance(CookTorrance::new(ks, mf, shadowing, fresnel)?)
-            }
-        };
-        Material::with_diffuse(kd, glossy)
+        (model.from_desc)(self)
     }
 
     fn present_fields(&self) -> [(&'static str, bool); 12] {
@@ -256,39 +234,6 @@ impl MaterialDesc {
             ("shadowing", self.shadowing.is_some()),
             ("fresnel", self.fresnel.is_some()),
         ]
-    }
-
-    /// `(alpha_u, alpha_v)` from `alpha`, `alpha_u`/`alpha_v` or `roughness`.
-    fn alphas(&self) -> Result<(f64, f64), Error> {
-        let given = [
-            self.alpha.is_some(),
-            self.alpha_u.is_some() || self.alpha_v.is_some(),
-            self.roughness.is_some(),
-        ];
-        if given.iter().filter(|&&g| g).count() > 1 {
-            return Err(Error::param(
-                "alpha",
-                "give only one of alpha, alpha_u/alpha_v, roughness",
-            ));
-        }
-        if let Some(r) = self.roughness {
-            if !r.is_finite() || r < 0.0 {
-                return Err(Error::param(
-                    "roughness",
-                    format!("{r} is out of range: roughness must be a number >= 0"),
-                ));
-            }
-            return Ok((r * r, r * r));
-        }
-        if let Some(a) = self.alpha {
-            return Ok((a, a));
-        }
-        match (self.alpha_u, self.alpha_v) {
-            (Some(u), Some(v)) => Ok((u, v)),
-            (None, None) => Ok((DEFAULT_ALPHA, DEFAULT_ALPHA)),
-            (None, _) => Err(Error::param("alpha_u", "missing: alpha_v needs alpha_u")),
-            (_, None) => Err(Error::param("alpha_v", "missing: alpha_u needs alpha_v")),
-        }
     }
 }
 
@@ -332,7 +277,7 @@ impl FresnelDesc {
         Ok(match self.kind.as_str() {
             "none" => Fresnel::None,
             "schlick" => Fresnel::Schlick {
-                f0: crate::models::check_rgb(
+                f0: models::check_rgb(
                     "fresnel.f0",
                     self.f0.map_or(Rgb::splat(DEFAULT_F0), Color::rgb),
                     1.0,
@@ -351,7 +296,7 @@ impl FresnelDesc {
                     self.eta
                         .map_or(Rgb::from_array(DEFAULT_CONDUCTOR_ETA), Color::rgb),
                 )?,
-                k: crate::models::check_rgb(
+                k: models::check_rgb(
                     "fresnel.k",
                     self.k
                         .map_or(Rgb::from_array(DEFAULT_CONDUCTOR_K), Color::rgb),
@@ -365,12 +310,31 @@ impl FresnelDesc {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::material::Glossy;
+    use crate::microfacet::Shadowing;
 
     fn err(json: &str) -> String {
         match MaterialDesc::from_json(json).and_then(|d| d.build()) {
             Ok(m) => panic!("{json} was accepted: {m:?}"),
             Err(e) => e.to_string(),
         }
+    }
+
+    #[test]
+    fn the_help_text_is_made_from_the_tables() {
+        let text = defaults();
+        for m in models::MODELS {
+            assert!(text.contains(&format!("type {}:", m.name)), "{text}");
+            for p in m.params {
+                let line = format!(
+                    "  {:<13} {}; default",
+                    p.name,
+                    p.range_text().replace('`', "")
+                );
+                assert!(text.contains(&line), "{line:?} not in\n{text}");
+            }
+        }
+        assert!(text.contains("default eta 1.5") && text.contains("default f0 0.04"));
     }
 
     #[test]

@@ -148,21 +148,39 @@ impl TexelSampler {
 }
 
 /// What went wrong building a map.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[derive(Debug, Clone, PartialEq)]
 pub enum EnvMapError {
-    #[error("the map is empty ({width}×{height})")]
-    Empty { width: usize, height: usize },
-    #[error("the map has {got} texels, expected {width}×{height} = {}", width * height)]
+    Empty {
+        width: usize,
+        height: usize,
+    },
     Size {
         width: usize,
         height: usize,
         got: usize,
     },
-    #[error("scale {0} must be a finite number >= 0")]
     Scale(f64),
-    #[error("rotation_y {0} must be a finite number")]
     Rotation(f64),
 }
+
+impl std::fmt::Display for EnvMapError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match *self {
+            EnvMapError::Empty { width, height } => {
+                write!(f, "the map is empty ({width}×{height})")
+            }
+            EnvMapError::Size { width, height, got } => write!(
+                f,
+                "the map has {got} texels, expected {width}×{height} = {}",
+                width * height
+            ),
+            EnvMapError::Scale(v) => write!(f, "scale {v} must be a finite number >= 0"),
+            EnvMapError::Rotation(v) => write!(f, "rotation_y {v} must be a finite number"),
+        }
+    }
+}
+
+impl std::error::Error for EnvMapError {}
 
 impl EnvMap {
     /// A map from row-major texels, row 0 at the top. Negative or NaN

@@ -4,13 +4,11 @@
 ///
 /// Every variant names the field (or the input) at fault so that the command
 /// line can print a one-line message.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[derive(Debug, Clone, PartialEq)]
 pub enum Error {
     /// A parameter is out of its range or not a finite number.
-    #[error("field `{field}`: {message}")]
     Param { field: String, message: String },
     /// A name (strategy, distribution, ...) that lobe does not know.
-    #[error("field `{field}`: unknown value `{value}`, expected one of: {expected}")]
     UnknownName {
         field: String,
         value: String,
@@ -18,15 +16,39 @@ pub enum Error {
     },
     /// A strategy name (a BSDF strategy, `light` or a form of MIS) that lobe
     /// does not know.
-    #[error("unknown strategy `{value}`, expected one of: {expected}")]
     UnknownStrategy { value: String, expected: String },
     /// A strategy that does not apply to the material.
-    #[error("strategy `{strategy}` does not apply to this material ({reason})")]
     Unsupported { strategy: String, reason: String },
     /// A material description that cannot be parsed.
-    #[error("{0}")]
     Parse(String),
 }
+
+impl std::fmt::Display for Error {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Error::Param { field, message } => write!(f, "field `{field}`: {message}"),
+            Error::UnknownName {
+                field,
+                value,
+                expected,
+            } => write!(
+                f,
+                "field `{field}`: unknown value `{value}`, expected one of: {expected}"
+            ),
+            Error::UnknownStrategy { value, expected } => write!(
+                f,
+                "unknown strategy `{value}`, expected one of: {expected}"
+            ),
+            Error::Unsupported { strategy, reason } => write!(
+                f,
+                "strategy `{strategy}` does not apply to this material ({reason})"
+            ),
+            Error::Parse(message) => f.write_str(message),
+        }
+    }
+}
+
+impl std::error::Error for Error {}
 
 impl Error {
     pub(crate) fn param(field: &str, message: impl Into<String>) -> Self {

@@ -20,7 +20,7 @@ use crate::material::BsdfSampler;
 use crate::math::{Rgb, luminance};
 pub use crate::sequence::CHUNK;
 use crate::sequence::{self, Sequence};
-use crate::stats::quadrature::{Tolerance, integrate_hemisphere};
+use crate::stats::quadrature::{Tolerance, gauss_legendre_4x4, integrate_hemisphere};
 use crate::stats::ttest::Moments;
 use crate::{BsdfSample, Error, Frame, Material, Strategy};
 use glam::{DVec2, DVec3};
@@ -671,12 +671,12 @@ pub fn reference_env_row(m: &Material, sp: &ShadingPoint, map: &EnvMap, j: usize
         // Refine on luminance, integrate RGB on the accepted cells.
         let mut stack = vec![(t0.cos(), t1.cos(), p0, p1, 0u32)];
         while let Some((c0, c1, a, b, depth)) = stack.pop() {
-            let whole = gauss4(&g, c0, c1, a, b);
+            let whole = gauss_legendre_4x4(g, c0, c1, a, b);
             let (cm, pm) = (0.5 * (c0 + c1), 0.5 * (a + b));
-            let parts = gauss4(&g, c0, cm, a, pm)
-                + gauss4(&g, cm, c1, a, pm)
-                + gauss4(&g, c0, cm, pm, b)
-                + gauss4(&g, cm, c1, pm, b);
+            let parts = gauss_legendre_4x4(g, c0, cm, a, pm)
+                + gauss_legendre_4x4(g, cm, c1, a, pm)
+                + gauss_legendre_4x4(g, c0, cm, pm, b)
+                + gauss_legendre_4x4(g, cm, c1, pm, b);
             if depth < 6
                 && (whole - parts).abs() > rel * parts.abs().max(1e-300)
                 && (whole - parts).abs() > 1e-15
@@ -694,42 +694,10 @@ pub fn reference_env_row(m: &Material, sp: &ShadingPoint, map: &EnvMap, j: usize
                     (c0, cm, pm, b),
                     (cm, c1, pm, b),
                 ] {
-                    sum += l * gauss4_rgb(&gc, x0, x1, y0, y1);
+                    sum += l * gauss_legendre_4x4(gc, x0, x1, y0, y1);
                 }
             }
         }
     }
     sum
-}
-
-const GL4: [(f64, f64); 4] = [
-    (-0.861_136_311_594_052_6, 0.347_854_845_137_453_9),
-    (-0.339_981_043_584_856_3, 0.652_145_154_862_546_1),
-    (0.339_981_043_584_856_3, 0.652_145_154_862_546_1),
-    (0.861_136_311_594_052_6, 0.347_854_845_137_453_9),
-];
-
-/// 4 × 4 Gauss–Legendre rule over `[x0, x1] × [y0, y1]` (signed widths).
-fn gauss4(f: &impl Fn(f64, f64) -> f64, x0: f64, x1: f64, y0: f64, y1: f64) -> f64 {
-    let (hx, hy) = (0.5 * (x1 - x0), 0.5 * (y1 - y0));
-    let (mx, my) = (0.5 * (x1 + x0), 0.5 * (y1 + y0));
-    let mut s = 0.0;
-    for (xi, wx) in GL4 {
-        for (yi, wy) in GL4 {
-            s += wx * wy * f(mx + hx * xi, my + hy * yi);
-        }
-    }
-    (s * hx * hy).abs()
-}
-
-fn gauss4_rgb(f: &impl Fn(f64, f64) -> Rgb, x0: f64, x1: f64, y0: f64, y1: f64) -> Rgb {
-    let (hx, hy) = (0.5 * (x1 - x0), 0.5 * (y1 - y0));
-    let (mx, my) = (0.5 * (x1 + x0), 0.5 * (y1 + y0));
-    let mut s = Rgb::ZERO;
-    for (xi, wx) in GL4 {
-        for (yi, wy) in GL4 {
-            s += wx * wy * f(mx + hx * xi, my + hy * yi);
-        }
-    }
-    s * (hx * hy).abs()
 }

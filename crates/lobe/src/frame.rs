@@ -53,6 +53,26 @@ impl Frame {
     }
 }
 
+/// The view direction `wo` in the local frame at polar angle `theta_deg`
+/// from the normal and azimuth `phi_deg`, both in degrees:
+/// `(sin θ cos φ, sin θ sin φ, cos θ)`. With `phi_deg = 0` it is
+/// `(sin θ, 0, cos θ)`, in the xz plane.
+#[inline]
+#[must_use]
+pub fn wo_from_theta(theta_deg: f64, phi_deg: f64) -> DVec3 {
+    spherical_direction(theta_deg.to_radians(), phi_deg.to_radians())
+}
+
+/// The unit direction with polar angle `theta` (from `+z`) and azimuth
+/// `phi`, in radians: `(sin θ cos φ, sin θ sin φ, cos θ)`.
+#[inline]
+#[must_use]
+pub fn spherical_direction(theta: f64, phi: f64) -> DVec3 {
+    let (st, ct) = theta.sin_cos();
+    let (sp, cp) = phi.sin_cos();
+    DVec3::new(st * cp, st * sp, ct)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -82,5 +102,13 @@ mod tests {
         assert!((f.to_local(DVec3::Y) - DVec3::Z).length() < 1e-12);
         assert!((f.to_world(DVec3::Y) - DVec3::Y.cross(DVec3::X)).length() < 1e-12);
         assert!(Frame::from_normal_tangent(DVec3::Y, DVec3::Y).is_none());
+    }
+
+    #[test]
+    fn wo_from_theta_in_the_xz_plane() {
+        let t = 30f64.to_radians();
+        assert_eq!(wo_from_theta(30.0, 0.0), DVec3::new(t.sin(), 0.0, t.cos()));
+        assert_eq!(wo_from_theta(0.0, 0.0), DVec3::Z);
+        assert!((wo_from_theta(90.0, 90.0) - DVec3::Y).length() < 1e-15);
     }
 }

@@ -21,7 +21,19 @@
 //! * `alpha` is the microfacet width parameter. Where "roughness" is
 //!   accepted, `alpha = roughness²` (not pbrt-v4's square root).
 //!
+//! ## Cargo features
+//!
+//! Both on by default; without them the core needs only glam, libm and
+//! rand/rand_pcg (`cargo build -p lobe --no-default-features`).
+//!
+//! * `desc`: material descriptions in JSON and TOML ([`desc`], serde).
+//! * `stats`: the statistical tests, chi-square ([`stats::chi2`]) and
+//!   Student's t ([`stats::t_test`], statrs). The deterministic quadrature
+//!   ([`stats::quadrature`]) and [`stats::Moments`] are always there: the
+//!   estimator's references and sums use them.
+//!
 //! ```
+//! # #[cfg(feature = "desc")] {
 //! use lobe::{Material, MaterialDesc, Strategy};
 //! use glam::{DVec2, DVec3};
 //! let m = MaterialDesc::from_json(r#"{"type":"cook-torrance","alpha":0.2}"#)?.build()?;
@@ -30,9 +42,11 @@
 //!     // s.weight == f * cos / pdf
 //!     assert!((s.pdf - m.pdf(Strategy::Vndf, wo, s.wi)).abs() < 1e-9 * s.pdf);
 //! }
+//! # }
 //! # Ok::<(), lobe::Error>(())
 //! ```
 
+#[cfg(feature = "desc")]
 pub mod desc;
 pub mod envmap;
 pub mod error;
@@ -50,6 +64,7 @@ pub mod stats;
 pub mod strategy;
 pub mod warp;
 
+#[cfg(feature = "desc")]
 pub use desc::MaterialDesc;
 pub use error::Error;
 pub use frame::Frame;

@@ -105,14 +105,7 @@ impl Light {
     pub fn pdf(&self, dist: LightDistribution, d: DVec3) -> f64 {
         match self {
             Light::Constant(_) => warp::square_to_uniform_sphere_pdf(d),
-            Light::Beam { dir, exponent, .. } => {
-                let c = d.dot(*dir);
-                if c > 0.0 {
-                    (exponent + 1.0) * crate::math::INV_TWO_PI * c.powf(*exponent)
-                } else {
-                    0.0
-                }
-            }
+            Light::Beam { dir, exponent, .. } => warp::cos_power_pdf(d.dot(*dir), *exponent),
             Light::Env(map) => match dist {
                 LightDistribution::Plain => map.pdf(d),
                 LightDistribution::Compensated => map.pdf_compensated(d),

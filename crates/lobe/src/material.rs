@@ -7,31 +7,12 @@
 //! and `pdf` is the mixture `P p_g + (1 − P) p_d` (one-sample MIS with the
 //! balance heuristic), so `pdf` is always the density that `sample` draws from.
 
-use crate::math::{INV_TWO_PI, Rgb};
-use crate::models::{BlinnPhong, CookTorrance, Lambert, Lobe, Phong};
+use crate::math::Rgb;
+pub use crate::models::Glossy;
+use crate::models::{Lambert, Lobe};
 use crate::sample::{BsdfSample, LobeKind};
 use crate::{Error, Strategy, warp};
 use glam::{DVec2, DVec3};
-
-/// The glossy lobe of a material (static dispatch).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Glossy {
-    None,
-    Phong(Phong),
-    BlinnPhong(BlinnPhong),
-    CookTorrance(CookTorrance),
-}
-
-macro_rules! dispatch {
-    ($self:expr, $l:ident => $e:expr, $none:expr) => {
-        match $self {
-            Glossy::None => $none,
-            Glossy::Phong($l) => $e,
-            Glossy::BlinnPhong($l) => $e,
-            Glossy::CookTorrance($l) => $e,
-        }
-    };
-}
 
 /// A material: `f = diffuse.albedo/π + glossy`.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -63,12 +44,7 @@ impl Material {
     /// A short name of the model, for tables.
     #[must_use]
     pub fn model_name(&self) -> &'static str {
-        match self.glossy {
-            Glossy::None => "lambert",
-            Glossy::Phong(_) => "phong",
-            Glossy::BlinnPhong(_) => "blinn-phong",
-            Glossy::CookTorrance(_) => "cook-torrance",
-        }
+        self.glossy.model_name()
     }
 
     fn has_diffuse(&self) -> bool {
@@ -78,7 +54,10 @@ impl Material {
     /// `Ok` when `strategy` applies to this material, otherwise an error
     /// that says why.
     pub fn check(&self, strategy: Strategy) -> crate::error::Result<()> {
-        let r = dispatch!(&self.glossy, l => l.supports(strategy), self.diffuse.supports(strategy));
+        let r = match self.glossy {
+            Glossy::None => self.diffuse.supports(strategy),
+            g => g.supports(strategy),
+        };
         r.map_err(|reason| Error::Unsupported {
             strategy: strategy.name().into(),
             reason,
@@ -115,7 +94,7 @@ impl Material {
         if !self.has_diffuse() {
             return 1.0;
         }
-        let g = dispatch!(&self.glossy, l => l.albedo_hint(wo), return 0.0);
+        let g = self.glossy.albedo_hint(wo);
         let d = self.diffuse.albedo_hint(wo);
         if g + d > 0.0 { g / (g + d) } else { 0.5 }
     }
@@ -132,7 +111,7 @@ impl Material {
         if wo.z <= 0.0 || wi.z <= 0.0 {
             return Rgb::ZERO;
         }
-        let g = dispatch!(&self.glossy, l => l.eval(wo, wi), Rgb::ZERO);
+        let g = self.glossy.eval(wo, wi);
         g + self.diffuse.eval(wo, wi)
     }
 
@@ -158,12 +137,12 @@ impl Material {
             return 0.0;
         }
         match strategy {
-            Strategy::Uniform => INV_TWO_PI,
+            Strategy::Uniform => warp::square_to_uniform_hemisphere_pdf(wi),
             Strategy::Cosine => warp::square_to_cosine_hemisphere_pdf(wi),
             _ => {
                 let p = self.glossy_probability(wo);
                 let pg = if p > 0.0 {
-                    dispatch!(&self.glossy, l => l.pdf(strategy, wo, wi), 0.0)
+                    self.glossy.pdf(strategy, wo, wi)
                 } else {
                     0.0
                 };
@@ -191,9 +170,9 @@ impl Material {
         let fd = self.diffuse.eval(wo, wi);
         match strategy {
             Strategy::Uniform | Strategy::Cosine => {
-                let f = dispatch!(&self.glossy, l => l.eval(wo, wi), Rgb::ZERO) + fd;
+                let f = self.glossy.eval(wo, wi) + fd;
                 let pdf = if strategy == Strategy::Uniform {
-                    INV_TWO_PI
+                    warp::square_to_uniform_hemisphere_pdf(wi)
                 } else {
                     warp::square_to_cosine_hemisphere_pdf(wi)
                 };
@@ -202,9 +181,9 @@ impl Material {
             _ => {
                 let p = self.glossy_probability(wo);
                 let (fg, pg) = if p > 0.0 {
-                    dispatch!(&self.glossy, l => l.eval_pdf(strategy, wo, wi), (Rgb::ZERO, 0.0))
+                    self.glossy.eval_pdf(strategy, wo, wi)
                 } else {
-                    (dispatch!(&self.glossy, l => l.eval(wo, wi), Rgb::ZERO), 0.0)
+                    (self.glossy.eval(wo, wi), 0.0)
                 };
                 let pd = if p < 1.0 {
                     self.diffuse.pdf(strategy, wo, wi)
@@ -235,15 +214,11 @@ impl Material {
                 let p = self.glossy_probability(wo);
                 if p >= 1.0 {
                     // One lobe: its own f and pdf, computed with the sample.
-                    let (wi, f, pdf) =
-                        dispatch!(&self.glossy, l => l.sample_eval(strategy, wo, u)?, return None);
+                    let (wi, f, pdf) = self.glossy.sample_eval(strategy, wo, u)?;
                     return Self::finish(wi, f, pdf, LobeKind::Glossy);
                 }
                 if uc < p {
-                    (
-                        dispatch!(&self.glossy, l => l.sample(strategy, wo, u)?, return None),
-                        LobeKind::Glossy,
-                    )
+                    (self.glossy.sample(strategy, wo, u)?, LobeKind::Glossy)
                 } else {
                     (self.diffuse.sample(strategy, wo, u)?, LobeKind::Diffuse)
                 }

@@ -260,9 +260,24 @@ impl Microfacet {
     #[inline]
     #[must_use]
     pub fn g(&self, shadowing: Shadowing, wo: DVec3, wi: DVec3, wm: DVec3) -> f64 {
+        self.g_with_lambda_o(shadowing, self.lambda(wo), wo, wi, wm)
+    }
+
+    /// [`Microfacet::g`] given `lambda_o = Λ(wo)`, for a caller that has it
+    /// already (the pdf of visible normals needs it too).
+    #[inline]
+    #[must_use]
+    pub fn g_with_lambda_o(
+        &self,
+        shadowing: Shadowing,
+        lambda_o: f64,
+        wo: DVec3,
+        wi: DVec3,
+        wm: DVec3,
+    ) -> f64 {
         match shadowing {
-            Shadowing::SmithSeparable => self.g1(wo) * self.g1(wi),
-            Shadowing::SmithCorrelated => 1.0 / (1.0 + self.lambda(wo) + self.lambda(wi)),
+            Shadowing::SmithSeparable => 1.0 / (1.0 + lambda_o) * self.g1(wi),
+            Shadowing::SmithCorrelated => 1.0 / (1.0 + lambda_o + self.lambda(wi)),
             Shadowing::VCavity => {
                 let go = 2.0 * wm.z * wo.z / wo.dot(wm);
                 let gi = 2.0 * wm.z * wi.z / wi.dot(wm);
@@ -302,9 +317,7 @@ impl Microfacet {
                 let (sp, cp) = phi.sin_cos();
                 let e = ex * cp * cp + ey * sp * sp;
                 // cos θ = u₁^(1/(e+2)), through logarithms for precision.
-                let l = u.x.ln() / (e + 2.0);
-                let cos_t = l.exp();
-                let sin_t = safe_sqrt(-(2.0 * l).exp_m1());
+                let (cos_t, sin_t) = crate::warp::cos_sin_of_root(u.x, e + 2.0);
                 DVec3::new(sin_t * cp, sin_t * sp, cos_t)
             }
         }
@@ -325,6 +338,17 @@ impl Microfacet {
             return 0.0;
         }
         self.g1(wo) * wo.dot(wm).max(0.0) * self.d(wm) / wo.z
+    }
+
+    /// Density over the reflected direction `wi` of visible-normal sampling
+    /// (Heitz 2018, [`Microfacet::sample_visible`] and the spherical caps),
+    /// given `d = D(wm)` at the half vector and `lambda_o = Λ(wo)`:
+    /// `pdf_visible / (4 wo·wm)`, which simplifies to
+    /// `G1(wo) D(wm) / (4 cos θo)`.
+    #[inline]
+    #[must_use]
+    pub fn pdf_visible_reflect(d: f64, lambda_o: f64, wo: DVec3) -> f64 {
+        d * (0.25 / wo.z) / (1.0 + lambda_o)
     }
 
     /// Draw a visible normal for `wo` (upper hemisphere). GGX: Heitz 2018's
@@ -385,12 +409,7 @@ impl Microfacet {
     #[must_use]
     pub fn sample_visible_caps(&self, wo: DVec3, u: DVec2) -> DVec3 {
         let wh = self.stretch(wo);
-        let phi = 2.0 * PI * u.x;
-        let z = (1.0 - u.y) * (1.0 + wh.z) - wh.z;
-        let sin_t = safe_sqrt(1.0 - z * z);
-        let (s, c) = phi.sin_cos();
-        let h = DVec3::new(sin_t * c, sin_t * s, z) + wh;
-        self.unstretch_normal(h)
+        self.cap_normal(wh, wh.z, u)
     }
 
     /// `k(wo)` of the bounded VNDF: how much of the spherical cap is kept.
@@ -414,6 +433,16 @@ impl Microfacet {
         } else {
             wh.z
         };
+        self.cap_normal(wh, b, u)
+    }
+
+    /// The spherical-cap construction of Dupuy and Benyoub, shared by
+    /// [`Microfacet::sample_visible_caps`] (`b = wh.z`) and the bounded VNDF
+    /// (a smaller `b`): a uniform point on the cap `z ∈ [−b, 1]` of the unit
+    /// sphere plus the stretched view direction `wh`, unstretched into a
+    /// microfacet normal.
+    #[inline]
+    fn cap_normal(&self, wh: DVec3, b: f64, u: DVec2) -> DVec3 {
         let phi = 2.0 * PI * u.x;
         let z = (1.0 - u.y) * (1.0 + b) - b;
         let sin_t = safe_sqrt(1.0 - z * z);

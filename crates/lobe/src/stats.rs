@@ -2,19 +2,23 @@
 //!
 //! * [`quadrature`]: deterministic adaptive cubature on rectangles and on
 //!   regions of the sphere, to integrate pdfs to about `1e-9`.
-//! * [`chi2`]: the chi-square goodness-of-fit harness every sampler goes
+//! * `chi2` (feature `stats`): the chi-square goodness-of-fit harness every sampler goes
 //!   through (equal-area histogram on the sphere, failed samples in a *lost*
 //!   bin).
-//! * [`ttest`]: Student's t-test and running moments, to check the means of
-//!   Monte Carlo estimators.
+//! * [`ttest`]: running moments (always) and Student's t-test (feature
+//!   `stats`), to check the means of Monte Carlo estimators.
 
+#[cfg(feature = "stats")]
 pub mod chi2;
 pub mod quadrature;
 pub mod ttest;
 
+#[cfg(feature = "stats")]
 pub use chi2::{Chi2Config, Chi2Result, chi2_test, sidak, success_probability};
 pub use quadrature::{
     Estimate, Tolerance, integrate_2d, integrate_hemisphere, integrate_sphere,
     integrate_sphere_region,
 };
-pub use ttest::{Moments, TTest, t_test};
+pub use ttest::Moments;
+#[cfg(feature = "stats")]
+pub use ttest::{TTest, t_test};

@@ -1,9 +1,12 @@
 //! Warps from the unit square to directions, in pairs as in Nori:
 //! `square_to_x(u)` draws a direction and `square_to_x_pdf(w)` is its density
-//! in solid angle. Each pair is chi-square tested in `tests/chi2.rs` and can
-//! be drawn with `lobe plot`.
+//! in solid angle (the disk's: in area). Each pair is chi-square tested in
+//! `tests/chi2.rs` (`chi2_warps`; the disk lifted onto the hemisphere), and
+//! the samplers use the `_pdf` partners as their densities: the material's
+//! `uniform` and `cosine` strategies, Lambert's `brdf`, the Phong and
+//! Blinn-Phong lobes ([`cos_power_pdf`]) and the constant and lobe lights.
 
-use crate::math::{INV_FOUR_PI, INV_PI, INV_TWO_PI};
+use crate::math::{INV_FOUR_PI, INV_PI, INV_TWO_PI, safe_sqrt};
 use glam::{DVec2, DVec3};
 use std::f64::consts::{FRAC_PI_4, PI};
 
@@ -92,20 +95,41 @@ pub fn square_to_cosine_hemisphere_pdf(w: DVec3) -> f64 {
 #[inline]
 #[must_use]
 pub fn square_to_cos_power(u: DVec2, n: f64) -> DVec3 {
-    // u.x = 0 gives ln = -inf: cos θ = 0, sin θ = 1, a valid horizon direction.
-    let l = u.x.ln() / (n + 1.0);
-    let cos_t = l.exp();
-    let sin_t = (-(2.0 * l).exp_m1()).max(0.0).sqrt();
+    let (cos_t, sin_t) = cos_sin_of_root(u.x, n + 1.0);
     let (s, c) = (2.0 * PI * u.y).sin_cos();
     DVec3::new(sin_t * c, sin_t * s, cos_t)
+}
+
+/// `(cos θ, sin θ)` for `cos θ = u^(1/m)` (`u` in `[0, 1]`, `m > 0`): the
+/// polar angle of a cos-power lobe `cos^(m−1)θ` drawn by inversion.
+///
+/// Computed through logarithms, `cos θ = e^l` and `sin θ = √(−expm1(2l))`
+/// with `l = ln(u)/m`, so that `sin θ` keeps its precision when `θ` is tiny
+/// (exponents up to 10⁷). `u = 0` gives `cos θ = 0`, `sin θ = 1`: a valid
+/// horizon direction.
+#[inline]
+#[must_use]
+pub fn cos_sin_of_root(u: f64, m: f64) -> (f64, f64) {
+    let l = u.ln() / m;
+    (l.exp(), safe_sqrt(-(2.0 * l).exp_m1()))
 }
 
 /// Density of [`square_to_cos_power`]: `(n+1)/(2π) cosⁿθ` for `z > 0`.
 #[inline]
 #[must_use]
 pub fn square_to_cos_power_pdf(w: DVec3, n: f64) -> f64 {
-    if w.z > 0.0 {
-        (n + 1.0) * INV_TWO_PI * w.z.powf(n)
+    cos_power_pdf(w.z, n)
+}
+
+/// The cos-power density `(n+1)/(2π) cosⁿθ` in solid angle, as a function
+/// of `cos θ` (the angle to the lobe's axis), zero for `cos θ ≤ 0`: the
+/// density of [`square_to_cos_power`] in a frame around any axis. The
+/// Phong and Blinn-Phong samplers and the analytic lobe light use it.
+#[inline]
+#[must_use]
+pub fn cos_power_pdf(cos_theta: f64, n: f64) -> f64 {
+    if cos_theta > 0.0 {
+        (n + 1.0) * INV_TWO_PI * cos_theta.powf(n)
     } else {
         0.0
     }

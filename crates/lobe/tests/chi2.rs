@@ -102,6 +102,69 @@ fn chi2_microfacet_beckmann_and_blinn_ndf() {
         .collect());
 }
 
+/// Every warp of `lobe::warp` against its `_pdf` partner, Nori style. The
+/// disk is tested on the hemisphere: a uniform point `p` of the unit disk
+/// lifted to `(p, √(1 − |p|²))` has the solid-angle density
+/// `pdf_disk(p) · cos θ` (Malley's projection).
+#[test]
+fn chi2_warps() {
+    use glam::DVec3;
+    use lobe::warp;
+    type Sampler = Box<dyn Fn(DVec2) -> DVec3>;
+    type Pdf = Box<dyn Fn(DVec3) -> f64>;
+    let lift = |p: glam::DVec2| DVec3::new(p.x, p.y, (1.0 - p.length_squared()).max(0.0).sqrt());
+    let mut warps: Vec<(String, Sampler, Pdf)> = vec![
+        (
+            "uniform_disk_concentric".into(),
+            Box::new(move |u| lift(warp::square_to_uniform_disk_concentric(u))),
+            Box::new(|w: DVec3| {
+                warp::square_to_uniform_disk_concentric_pdf(w.truncate()) * w.z.max(0.0)
+            }),
+        ),
+        (
+            "uniform_sphere".into(),
+            Box::new(warp::square_to_uniform_sphere),
+            Box::new(warp::square_to_uniform_sphere_pdf),
+        ),
+        (
+            "uniform_hemisphere".into(),
+            Box::new(warp::square_to_uniform_hemisphere),
+            Box::new(warp::square_to_uniform_hemisphere_pdf),
+        ),
+        (
+            "cosine_hemisphere".into(),
+            Box::new(warp::square_to_cosine_hemisphere),
+            Box::new(warp::square_to_cosine_hemisphere_pdf),
+        ),
+    ];
+    for n in [0.0, 1.0, 10.0, 100.0, 1e4] {
+        warps.push((
+            format!("cos_power_n{n}"),
+            Box::new(move |u| warp::square_to_cos_power(u, n)),
+            Box::new(move |w| warp::square_to_cos_power_pdf(w, n)),
+        ));
+    }
+    let alpha = sidak(0.01, warps.len());
+    let cfg = Chi2Config::default();
+    let mut failures = Vec::new();
+    for (name, sample, pdf) in &warps {
+        let r = chi2_test(&cfg, |_, u| Some(sample(u)), pdf);
+        if !r.passes(alpha) || (r.pdf_integral - 1.0).abs() > 1e-3 {
+            let path = common::write_failure(&r, &cfg, &format!("warp_{name}"));
+            failures.push(format!(
+                "{name}: χ²={:.1} dof={} p={:.3e} < {alpha:.2e}, ∫pdf = {:.6} {} (tables: {})",
+                r.statistic,
+                r.dof,
+                r.p_value,
+                r.pdf_integral,
+                r.message.clone().unwrap_or_default(),
+                path.display()
+            ));
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
 /// The harness can fail: a sampler checked against the wrong pdf is caught.
 #[test]
 fn chi2_catches_a_wrong_pdf() {

@@ -91,7 +91,7 @@ fn every_estimate_is_within_four_standard_errors() {
 
 fn variance(json: &str, theta: f64, s: Strategy) -> f64 {
     let c = common::case(json);
-    let wo = DVec3::new(theta.to_radians().sin(), 0.0, theta.to_radians().cos());
+    let wo = lobe::frame::wo_from_theta(theta, 0.0);
     let acc = estimate(
         &c.material,
         &ShadingPoint::local(wo),

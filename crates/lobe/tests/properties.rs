@@ -382,3 +382,49 @@ fn bad_parameters_are_refused_with_the_field_named() {
     let m = common::case(r#"{"type":"cook-torrance","distribution":"beckmann"}"#).material;
     assert!(m.check(Strategy::Vndf).is_ok() && m.check(Strategy::BoundedVndf).is_err());
 }
+
+/// `eval_pdf` is `(eval, pdf)` bit for bit, for every model and strategy,
+/// at random and at degenerate directions (wo = wi, grazing, mirror), and a
+/// validated sampler gives the same numbers.
+#[test]
+fn eval_pdf_is_eval_and_pdf_bit_for_bit() {
+    let mut rng = Pcg64::seed_from_u64(11);
+    let mut checked = 0usize;
+    for c in common::all_cases() {
+        let m = c.material;
+        for s in m.strategies() {
+            let sampler = m.sampler(s).unwrap();
+            for k in 0..3000 {
+                let wo = random_wo(&mut rng);
+                let wi = match k % 4 {
+                    0 => wo,
+                    1 => DVec3::new(-wo.x, -wo.y, wo.z),
+                    2 => DVec3::new(1.0, 0.0, 1e-7).normalize(),
+                    _ => random_wo(&mut rng),
+                };
+                let (f, p) = m.eval_pdf(s, wo, wi);
+                let (f0, p0) = (m.eval(wo, wi), m.pdf(s, wo, wi));
+                assert!(
+                    f.to_array().map(f64::to_bits) == f0.to_array().map(f64::to_bits)
+                        && p.to_bits() == p0.to_bits(),
+                    "{} {s} wo {wo} wi {wi}: eval_pdf ({f}, {p}) vs ({f0}, {p0})",
+                    c.json
+                );
+                assert_eq!(sampler.eval_pdf(wo, wi), (f, p));
+                assert_eq!(sampler.pdf(wo, wi).to_bits(), p.to_bits());
+                checked += 1;
+            }
+        }
+    }
+    assert!(checked > 100_000, "{checked}");
+}
+
+/// A strategy that does not apply to a material has no sampler: the error
+/// says why, so there is no meaningless pdf to ask for.
+#[test]
+fn a_strategy_that_does_not_apply_has_no_sampler() {
+    let m = common::case(r#"{"type":"phong","exponent":10}"#).material;
+    let e = m.sampler(Strategy::Vndf).unwrap_err().to_string();
+    assert!(e.contains("vndf") && e.contains("does not apply"), "{e}");
+    assert!(m.sampler(Strategy::Brdf).is_ok());
+}

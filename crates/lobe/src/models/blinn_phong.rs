@@ -2,9 +2,12 @@
 //!
 //! | parameter | range | default | meaning |
 //! |---|---|---|---|
-//! | `ks` | RGB ≥ 0 (≤ 1 when normalized) | 1 | specular colour |
-//! | `exponent` `n` | [0, 10⁷] | 32 | shininess |
+//! | `ks` | RGB in [0, 1] (any ≥ 0 when not normalized) | 1 | specular colour |
+//! | `kd` | RGB in [0, 1] | 0 | diffuse colour, added as `kd/π` |
+//! | `exponent` | [0, 1e7] | 32 | shininess `n` |
 //! | `normalized` | bool | true | use the exactly normalized form |
+//!
+//! (This table is [`PARAMS`]; a test checks that they agree.)
 //!
 //! With `h = (wo + wi)/‖wo + wi‖` and `θh` its angle to the normal:
 //!
@@ -23,10 +26,38 @@
 //! (Walter et al. 2007, eq. 14). The lecture gives `p_h` alone; used as if it
 //! were the density of `wi`, it makes the estimator biased.
 
-use super::Lobe;
-use crate::math::{INV_TWO_PI, Rgb, luminance, reflect};
+use super::{Lobe, ModelInfo, Param, Value};
+use crate::math::{Rgb, luminance, reflect};
 use crate::{Strategy, warp};
 use glam::{DVec2, DVec3};
+
+pub const KS: Param = super::phong::KS;
+pub const EXPONENT: Param = Param {
+    meaning: "shininess `n`",
+    ..super::phong::EXPONENT
+};
+pub const NORMALIZED: Param = Param {
+    meaning: "use the exactly normalized form",
+    default: Value::Bool(true),
+    ..super::phong::NORMALIZED
+};
+
+/// The keys of a Blinn-Phong material.
+pub const PARAMS: &[Param] = &[KS, super::KD, EXPONENT, NORMALIZED];
+
+pub const INFO: ModelInfo = ModelInfo {
+    name: "blinn-phong",
+    params: PARAMS,
+    #[cfg(feature = "desc")]
+    from_desc,
+};
+
+#[cfg(feature = "desc")]
+fn from_desc(d: &crate::desc::MaterialDesc) -> crate::error::Result<crate::Material> {
+    let (ks, kd, exponent, normalized) = super::lecture_keys(d, KS, EXPONENT, NORMALIZED);
+    let lobe = BlinnPhong::new(ks, exponent, normalized)?;
+    crate::Material::with_diffuse(kd, super::Glossy::BlinnPhong(lobe))
+}
 
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BlinnPhong {
@@ -43,10 +74,10 @@ pub fn normalization(n: f64) -> f64 {
 
 impl BlinnPhong {
     pub fn new(ks: Rgb, exponent: f64, normalized: bool) -> crate::error::Result<Self> {
-        let ks = super::check_rgb("ks", ks, if normalized { 1.0 } else { f64::MAX })?;
+        let ks = KS.check_colour(ks, (!normalized).then_some(f64::MAX))?;
         Ok(BlinnPhong {
             ks,
-            exponent: super::check_exponent(exponent)?,
+            exponent: EXPONENT.check_number(exponent, "the exponent")?,
             normalized,
         })
     }
@@ -86,7 +117,7 @@ impl Lobe for BlinnPhong {
         if cos_oh <= 0.0 || h.z <= 0.0 {
             return 0.0;
         }
-        (self.exponent + 1.0) * INV_TWO_PI * h.z.powf(self.exponent) / (4.0 * cos_oh)
+        warp::square_to_cos_power_pdf(h, self.exponent) / (4.0 * cos_oh)
     }
 
     fn albedo_hint(&self, _wo: DVec3) -> f64 {

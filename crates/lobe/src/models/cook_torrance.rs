@@ -3,10 +3,17 @@
 //! | parameter | range | default | meaning |
 //! |---|---|---|---|
 //! | `ks` | RGB in [0, 1] | 1 | specular tint, multiplies `F` |
+//! | `kd` | RGB in [0, 1] | 0 | diffuse colour, added as `kd/π` |
 //! | `distribution` | `ggx`, `beckmann`, `blinn-phong` | `ggx` | the NDF `D` |
-//! | `alpha` or `alpha_u`, `alpha_v` | [1e-4, 2] (`blinn-phong`: [1e-4, 1]) | 0.3 | widths; `roughness` `r` gives `alpha = r²` |
+//! | `alpha` | [1e-4, 2] (`blinn-phong`: ≤ 1) | 0.3 | width of `D` |
+//! | `alpha_u` | [1e-4, 2] (`blinn-phong`: ≤ 1) | `alpha` | width along the tangent; with `alpha_v`, instead of `alpha` (anisotropic) |
+//! | `alpha_v` | [1e-4, 2] (`blinn-phong`: ≤ 1) | `alpha` | width along the bitangent |
+//! | `roughness` | ≥ 0 | — | instead of `alpha`: `alpha = roughness²` |
 //! | `shadowing` | `smith-separable`, `smith-correlated`, `v-cavity` | `smith-correlated` | the term `G` |
-//! | `fresnel` | `none`, `schlick`, `dielectric`, `conductor` | `none` | the term `F`, see [`crate::Fresnel`] |
+//! | `fresnel` | `none`, `schlick`, `dielectric`, `conductor` | `none` | the term `F`: an object with that `type` and its keys |
+//!
+//! (This table is [`PARAMS`]; a test checks that they agree. The Fresnel
+//! terms and their keys are in [`crate::Fresnel`].)
 //!
 //! `f = ks · D(h) G(wo, wi, h) F(wo·h) / (4 cos θo cos θi)`, `h` the half
 //! vector. With `F = 1` and a Smith term the directional albedo is at most 1
@@ -23,11 +30,162 @@
 //!
 //! The sampling densities use Smith's `G1` whatever `G` term `eval` uses.
 
-use super::Lobe;
+use super::{Lobe, ModelInfo, Param, Range, Value};
 use crate::math::{Rgb, luminance, reflect};
-use crate::microfacet::{Microfacet, Ndf, Shadowing};
+use crate::microfacet::{MAX_ALPHA, MIN_ALPHA, Microfacet, Ndf, Shadowing};
 use crate::{Fresnel, Strategy};
 use glam::{DVec2, DVec3};
+
+pub const KS: Param = Param {
+    name: "ks",
+    range: Range::Colour { max: 1.0 },
+    note: "",
+    default: Value::Number(1.0),
+    meaning: "specular tint, multiplies `F`",
+};
+pub const DISTRIBUTION: Param = Param {
+    name: "distribution",
+    range: Range::Names(Ndf::NAMES),
+    note: "",
+    default: Value::Name("ggx"),
+    meaning: "the NDF `D`",
+};
+pub const ALPHA: Param = Param {
+    name: "alpha",
+    range: Range::Number {
+        min: MIN_ALPHA,
+        max: MAX_ALPHA,
+    },
+    note: "(`blinn-phong`: ≤ 1)",
+    default: Value::Number(0.3),
+    meaning: "width of `D`",
+};
+pub const ALPHA_U: Param = Param {
+    name: "alpha_u",
+    default: Value::Text("`alpha`"),
+    meaning: "width along the tangent; with `alpha_v`, instead of `alpha` (anisotropic)",
+    ..ALPHA
+};
+pub const ALPHA_V: Param = Param {
+    name: "alpha_v",
+    meaning: "width along the bitangent",
+    ..ALPHA_U
+};
+pub const ROUGHNESS: Param = Param {
+    name: "roughness",
+    range: Range::Number {
+        min: 0.0,
+        max: f64::INFINITY,
+    },
+    note: "",
+    default: Value::Text("—"),
+    meaning: "instead of `alpha`: `alpha = roughness²`",
+};
+pub const SHADOWING: Param = Param {
+    name: "shadowing",
+    range: Range::Names(Shadowing::NAMES),
+    note: "",
+    default: Value::Name("smith-correlated"),
+    meaning: "the term `G`",
+};
+pub const FRESNEL: Param = Param {
+    name: "fresnel",
+    range: Range::Names("none, schlick, dielectric, conductor"),
+    note: "",
+    default: Value::Name("none"),
+    meaning: "the term `F`: an object with that `type` and its keys",
+};
+
+/// The keys of a Cook-Torrance material.
+pub const PARAMS: &[Param] = &[
+    KS,
+    super::KD,
+    DISTRIBUTION,
+    ALPHA,
+    ALPHA_U,
+    ALPHA_V,
+    ROUGHNESS,
+    SHADOWING,
+    FRESNEL,
+];
+
+pub const DEFAULT_ALPHA: f64 = ALPHA.default.number();
+
+pub const INFO: ModelInfo = ModelInfo {
+    name: "cook-torrance",
+    params: PARAMS,
+    #[cfg(feature = "desc")]
+    from_desc,
+};
+
+#[cfg(feature = "desc")]
+fn from_desc(d: &crate::desc::MaterialDesc) -> crate::error::Result<crate::Material> {
+    use crate::Error;
+    let ndf: Ndf = d
+        .distribution
+        .as_deref()
+        .unwrap_or(DISTRIBUTION.default.name())
+        .parse()?;
+    let (ax, ay) = alphas(d)?;
+    let mf = Microfacet::new(ndf, ax, ay).map_err(|e| match e {
+        // Name the key the user wrote.
+        Error::Param { message, .. } if d.alpha.is_some() => Error::Param {
+            field: ALPHA.name.into(),
+            message,
+        },
+        Error::Param { message, .. } if d.roughness.is_some() => Error::Param {
+            field: ROUGHNESS.name.into(),
+            message: format!("gives {message} (alpha = roughness²)"),
+        },
+        e => e,
+    })?;
+    let shadowing: Shadowing = d
+        .shadowing
+        .as_deref()
+        .unwrap_or(SHADOWING.default.name())
+        .parse()?;
+    let fresnel = d
+        .fresnel
+        .as_ref()
+        .map_or(Ok(Fresnel::None), crate::desc::FresnelDesc::build)?;
+    let lobe = CookTorrance::new(super::colour(d.ks, KS), mf, shadowing, fresnel)?;
+    crate::Material::with_diffuse(super::colour(d.kd, super::KD), super::Glossy::CookTorrance(lobe))
+}
+
+/// `(alpha_u, alpha_v)` from `alpha`, `alpha_u`/`alpha_v` or `roughness`.
+#[cfg(feature = "desc")]
+fn alphas(d: &crate::desc::MaterialDesc) -> crate::error::Result<(f64, f64)> {
+    use crate::Error;
+    let given = [
+        d.alpha.is_some(),
+        d.alpha_u.is_some() || d.alpha_v.is_some(),
+        d.roughness.is_some(),
+    ];
+    if given.iter().filter(|&&g| g).count() > 1 {
+        return Err(Error::param(
+            "alpha",
+            "give only one of alpha, alpha_u/alpha_v, roughness",
+        ));
+    }
+    if let Some(r) = d.roughness {
+        if !r.is_finite() || r < 0.0 {
+            return Err(Error::param(
+                "roughness",
+                format!("{r} is out of range: roughness must be a number >= 0"),
+            ));
+        }
+        return Ok((r * r, r * r));
+    }
+    if let Some(a) = d.alpha {
+        return Ok((a, a));
+    }
+    match (d.alpha_u, d.alpha_v) {
+        (Some(u), Some(v)) => Ok((u, v)),
+        (None, None) => Ok((DEFAULT_ALPHA, DEFAULT_ALPHA)),
+        (None, _) => Err(Error::param("alpha_u", "missing: alpha_v needs alpha_u")),
+        (_, None) => Err(Error::param("alpha_v", "missing: alpha_u needs alpha_v")),
+    }
+}
 
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CookTorrance {
@@ -45,7 +203,7 @@ impl CookTorrance {
         fresnel: Fresnel,
     ) -> crate::error::Result<Self> {
         Ok(CookTorrance {
-            ks: super::check_rgb("ks", ks, 1.0)?,
+            ks: KS.check_colour(ks, None)?,
             microfacet,
             shadowing,
             fresnel,
@@ -105,15 +263,11 @@ impl Lobe for CookTorrance {
         let cos_oh = wo.dot(wm);
         let d = mf.d(wm);
         let lo = mf.lambda(wo);
-        let g = match self.shadowing {
-            Shadowing::SmithCorrelated => 1.0 / (1.0 + lo + mf.lambda(wi)),
-            Shadowing::SmithSeparable => mf.g1(wi) / (1.0 + lo),
-            Shadowing::VCavity => mf.g(Shadowing::VCavity, wo, wi, wm),
-        };
+        let g = mf.g_with_lambda_o(self.shadowing, lo, wo, wi, wm);
         let inv4o = 0.25 / wo.z;
         let dg = d * g * inv4o / wi.z;
         let pdf = match strategy {
-            Strategy::Vndf | Strategy::SphericalCaps => d * inv4o / (1.0 + lo),
+            Strategy::Vndf | Strategy::SphericalCaps => Microfacet::pdf_visible_reflect(d, lo, wo),
             Strategy::BoundedVndf => mf.pdf_reflect_bounded(wo, wi),
             _ => mf.pdf_wm(wm) * 0.25 / cos_oh,
         };
@@ -137,11 +291,50 @@ impl Lobe for CookTorrance {
             return 0.0;
         }
         let p = match strategy {
-            // pdf_visible / (4 wo·h) simplifies to G1(wo) D(h) / (4 cos θo).
-            Strategy::Vndf | Strategy::SphericalCaps => mf.g1(wo) * mf.d(h) / (4.0 * wo.z),
+            Strategy::Vndf | Strategy::SphericalCaps => {
+                Microfacet::pdf_visible_reflect(mf.d(h), mf.lambda(wo), wo)
+            }
             _ => mf.pdf_wm(h) / (4.0 * cos_oh),
         };
         if p.is_finite() { p } else { 0.0 }
+    }
+
+    /// `eval` and `pdf` sharing the half vector, `D(h)` and `Λ(wo)`; the
+    /// same numbers as the two calls.
+    #[inline]
+    fn eval_pdf(&self, strategy: Strategy, wo: DVec3, wi: DVec3) -> (Rgb, f64) {
+        let mf = &self.microfacet;
+        let Some(h) = (wo + wi).try_normalize() else {
+            let p = if strategy == Strategy::BoundedVndf {
+                mf.pdf_reflect_bounded(wo, wi)
+            } else {
+                0.0
+            };
+            return (Rgb::ZERO, p);
+        };
+        let cos_oh = wo.dot(h);
+        if cos_oh <= 0.0 {
+            let p = if strategy == Strategy::BoundedVndf {
+                mf.pdf_reflect_bounded(wo, wi)
+            } else {
+                0.0
+            };
+            return (Rgb::ZERO, p);
+        }
+        let d = mf.d(h);
+        let lo = mf.lambda(wo);
+        let dg = d * mf.g_with_lambda_o(self.shadowing, lo, wo, wi, h) / (4.0 * wo.z * wi.z);
+        let f = if dg.is_finite() {
+            self.ks * self.fresnel.eval(cos_oh) * dg
+        } else {
+            Rgb::ZERO
+        };
+        let p = match strategy {
+            Strategy::BoundedVndf => mf.pdf_reflect_bounded(wo, wi),
+            Strategy::Vndf | Strategy::SphericalCaps => Microfacet::pdf_visible_reflect(d, lo, wo),
+            _ => mf.pdf_wm(h) / (4.0 * cos_oh),
+        };
+        (f, if p.is_finite() { p } else { 0.0 })
     }
 
     fn albedo_hint(&self, wo: DVec3) -> f64 {

@@ -4,14 +4,44 @@
 //! |---|---|---|---|
 //! | `albedo` | RGB in [0, 1] | 0.8 | fraction of light reflected, from every direction |
 //!
+//! (This table is [`PARAMS`]; a test checks that they agree.)
+//!
 //! `f_r = albedo / π`. Its `brdf` sampler is the cosine-weighted hemisphere,
 //! density `cos θi / π`, so the weight `f cos/pdf = albedo` is constant: a
 //! zero-variance estimator under constant light (the furnace test).
 
-use super::Lobe;
+use super::{Lobe, ModelInfo, Param, Range, Value};
 use crate::math::{INV_PI, Rgb};
 use crate::{Strategy, warp};
 use glam::{DVec2, DVec3};
+
+pub const ALBEDO: Param = Param {
+    name: "albedo",
+    range: Range::Colour { max: 1.0 },
+    note: "",
+    default: Value::Number(0.8),
+    meaning: "fraction of light reflected, from every direction",
+};
+
+/// The keys of a Lambertian material.
+pub const PARAMS: &[Param] = &[ALBEDO];
+
+pub const DEFAULT_ALBEDO: f64 = ALBEDO.default.number();
+
+pub const INFO: ModelInfo = ModelInfo {
+    name: "lambert",
+    params: PARAMS,
+    #[cfg(feature = "desc")]
+    from_desc,
+};
+
+#[cfg(feature = "desc")]
+fn from_desc(d: &crate::desc::MaterialDesc) -> crate::error::Result<crate::Material> {
+    crate::Material::lambert(
+        d.albedo
+            .map_or(Rgb::splat(DEFAULT_ALBEDO), crate::desc::Color::rgb),
+    )
+}
 
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Lambert {
@@ -21,7 +51,7 @@ pub struct Lambert {
 impl Lambert {
     pub fn new(albedo: Rgb) -> crate::error::Result<Self> {
         Ok(Lambert {
-            albedo: super::check_rgb("albedo", albedo, 1.0)?,
+            albedo: ALBEDO.check_colour(albedo, None)?,
         })
     }
 }

@@ -1,19 +1,22 @@
 //! The reflection models, one file each. Each is a *lobe*: a material
 //! ([`crate::Material`]) is a Lambertian term plus at most one glossy lobe.
+//!
+//! A model file holds everything about its model: the type, its
+//! [`Lobe`] implementation, its parameter table ([`Param`]s, with ranges and
+//! defaults, from which its doc table and the text of `lobe eval --help`
+//! are made), its range checks, and how it is built from a
+//! [`crate::MaterialDesc`]. It publishes all of that as one [`ModelInfo`]
+//! named `INFO`. Adding a model is one new file and one line in the list at
+//! the end of this file ([`MODELS`], and the [`Glossy`] variant that the same
+//! line declares).
 
 use crate::Strategy;
 use crate::math::Rgb;
 use glam::{DVec2, DVec3};
+use std::fmt::{self, Write as _};
 
-pub mod blinn_phong;
-pub mod cook_torrance;
 pub mod lambert;
-pub mod phong;
-
-pub use blinn_phong::BlinnPhong;
-pub use cook_torrance::CookTorrance;
 pub use lambert::Lambert;
-pub use phong::Phong;
 
 /// One lobe of a material, evaluated and sampled by its own strategy
 /// (`Strategy::Brdf` and the microfacet strategies). `uniform` and `cosine`
@@ -49,6 +52,218 @@ pub trait Lobe {
     fn supports(&self, strategy: Strategy) -> Result<(), String>;
 }
 
+/// What a key of a material description accepts.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Range {
+    /// A colour (one number or `[r, g, b]`), each channel in `[0, max]`
+    /// (`max` infinite: any number `≥ 0`).
+    Colour { max: f64 },
+    /// A number in `[min, max]`.
+    Number { min: f64, max: f64 },
+    /// `true` or `false`.
+    Bool,
+    /// One of these names (comma separated).
+    Names(&'static str),
+}
+
+/// The default of a key of a material description.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Value {
+    /// A number (for a colour: grey).
+    Number(f64),
+    Bool(bool),
+    Name(&'static str),
+    /// No value of its own: the text says what applies.
+    Text(&'static str),
+}
+
+impl Value {
+    /// The number; panics (at compile time when used in a `const`) otherwise.
+    #[must_use]
+    pub const fn number(self) -> f64 {
+        match self {
+            Value::Number(v) => v,
+            _ => panic!("not a number"),
+        }
+    }
+
+    /// The flag; panics (at compile time when used in a `const`) otherwise.
+    #[must_use]
+    pub const fn flag(self) -> bool {
+        match self {
+            Value::Bool(b) => b,
+            _ => panic!("not a bool"),
+        }
+    }
+
+    /// The name; panics (at compile time when used in a `const`) otherwise.
+    #[must_use]
+    pub const fn name(self) -> &'static str {
+        match self {
+            Value::Name(s) => s,
+            _ => panic!("not a name"),
+        }
+    }
+}
+
+/// One key of a material description: its name, what it accepts, its
+/// default and what it means. The one place these facts are written.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Param {
+    /// The key as written in JSON or TOML.
+    pub name: &'static str,
+    pub range: Range,
+    /// Said after the range, for what the range alone does not say.
+    pub note: &'static str,
+    pub default: Value,
+    pub meaning: &'static str,
+}
+
+/// A number as people write it: `1e7`, `1e-4`, `0.3`.
+struct Num(f64);
+
+impl fmt::Display for Num {
+    fn fmt(&self, f: &mut fmt::Formatter) -> fmt::Result {
+        let v = self.0;
+        if v != 0.0 && (v.abs() >= 1e5 || v.abs() < 1e-3) {
+            write!(f, "{v:e}")
+        } else {
+            write!(f, "{v}")
+        }
+    }
+}
+
+impl fmt::Display for Range {
+    fn fmt(&self, f: &mut fmt::Formatter) -> fmt::Result {
+        match *self {
+            Range::Colour { max } if max.is_infinite() => f.write_str("RGB ≥ 0"),
+            Range::Colour { max } => write!(f, "RGB in [0, {}]", Num(max)),
+            Range::Number { min, max } if max.is_infinite() => write!(f, "≥ {}", Num(min)),
+            Range::Number { min, max } => write!(f, "[{}, {}]", Num(min), Num(max)),
+            Range::Bool => f.write_str("bool"),
+            Range::Names(names) => {
+                let mut first = true;
+                for n in names.split(',') {
+                    if !first {
+                        f.write_str(", ")?;
+                    }
+                    first = false;
+                    write!(f, "`{}`", n.trim())?;
+                }
+                Ok(())
+            }
+        }
+    }
+}
+
+impl fmt::Display for Value {
+    fn fmt(&self, f: &mut fmt::Formatter) -> fmt::Result {
+        match *self {
+            Value::Number(v) => write!(f, "{}", Num(v)),
+            Value::Bool(b) => write!(f, "{b}"),
+            Value::Name(s) => write!(f, "`{s}`"),
+            Value::Text(s) => f.write_str(s),
+        }
+    }
+}
+
+impl Param {
+    /// The range and its note, as the doc table and the help text show it.
+    #[must_use]
+    pub fn range_text(&self) -> String {
+        if self.note.is_empty() {
+            self.range.to_string()
+        } else {
+            format!("{} {}", self.range, self.note)
+        }
+    }
+
+    /// Check a colour against `[0, max]`, `max` the range's unless the
+    /// model relaxes it (`max` given).
+    pub fn check_colour(&self, c: Rgb, max: Option<f64>) -> crate::error::Result<Rgb> {
+        let max = match (max, self.range) {
+            (Some(m), _) => m,
+            (None, Range::Colour { max }) => max,
+            (None, _) => f64::MAX,
+        };
+        check_rgb(self.name, c, if max.is_infinite() { f64::MAX } else { max })
+    }
+
+    /// Check a number against the range: `what` names it in the message
+    /// ("the exponent must be a number in ...").
+    pub fn check_number(&self, v: f64, what: &str) -> crate::error::Result<f64> {
+        let Range::Number { min, max } = self.range else {
+            return Ok(v);
+        };
+        if !v.is_finite() || !(min..=max).contains(&v) {
+            return Err(crate::Error::param(
+                self.name,
+                format!("{v} is out of range: {what} must be a number in [{min}, {max}]"),
+            ));
+        }
+        Ok(v)
+    }
+}
+
+/// Everything about one model: its `type` name, its keys and how it is
+/// built from a description.
+#[derive(Debug, Clone, Copy)]
+pub struct ModelInfo {
+    /// The value of `type` in a description.
+    pub name: &'static str,
+    /// Its keys, in the order the docs show them.
+    pub params: &'static [Param],
+    /// Build the material from a description whose keys all belong to
+    /// `params` (checked by [`crate::MaterialDesc::build`]).
+    #[cfg(feature = "desc")]
+    pub from_desc: fn(&crate::desc::MaterialDesc) -> crate::error::Result<crate::Material>,
+}
+
+impl ModelInfo {
+    /// The parameter table in Markdown, as the model's doc comment shows it.
+    #[must_use]
+    pub fn doc_table(&self) -> String {
+        let mut s = String::from("| parameter | range | default | meaning |\n|---|---|---|---|\n");
+        for p in self.params {
+            let _ = writeln!(
+                s,
+                "| `{}` | {} | {} | {} |",
+                p.name,
+                p.range_text(),
+                p.default,
+                p.meaning
+            );
+        }
+        s
+    }
+
+    /// The keys of this model.
+    pub fn keys(&self) -> impl Iterator<Item = &'static str> + '_ {
+        self.params.iter().map(|p| p.name)
+    }
+}
+
+/// The model of `type` name `name`.
+#[must_use]
+pub fn find(name: &str) -> Option<&'static ModelInfo> {
+    MODELS.iter().copied().find(|m| m.name == name)
+}
+
+/// The model names, `sep` between them.
+#[must_use]
+pub fn names(sep: &str) -> String {
+    MODELS.iter().map(|m| m.name).collect::<Vec<_>>().join(sep)
+}
+
+/// The key `kd` of every glossy model: the diffuse term the material adds.
+pub const KD: Param = Param {
+    name: "kd",
+    range: Range::Colour { max: 1.0 },
+    note: "",
+    default: Value::Number(0.0),
+    meaning: "diffuse colour, added as `kd/π`",
+};
+
 /// Check an RGB parameter: every channel finite and in `[0, max]`.
 pub(crate) fn check_rgb(field: &str, c: Rgb, max: f64) -> crate::error::Result<Rgb> {
     for v in c.to_array() {
@@ -62,15 +277,155 @@ pub(crate) fn check_rgb(field: &str, c: Rgb, max: f64) -> crate::error::Result<R
     Ok(c)
 }
 
+/// A colour key of a description, or its default.
+#[cfg(feature = "desc")]
+pub(crate) fn colour(c: Option<crate::desc::Color>, p: Param) -> Rgb {
+    c.map_or(Rgb::splat(p.default.number()), crate::desc::Color::rgb)
+}
+
+/// `(ks, kd, exponent, normalized)` of a lecture model (Phong, Blinn-Phong)
+/// from a description, each at its default when absent.
+#[cfg(feature = "desc")]
+fn lecture_keys(
+    d: &crate::desc::MaterialDesc,
+    ks: Param,
+    exponent: Param,
+    normalized: Param,
+) -> (Rgb, Rgb, f64, bool) {
+    (
+        colour(d.ks, ks),
+        colour(d.kd, KD),
+        d.exponent.unwrap_or(exponent.default.number()),
+        d.normalized.unwrap_or(normalized.default.flag()),
+    )
+}
+
 /// Largest accepted Phong and Blinn-Phong exponent.
 pub const MAX_EXPONENT: f64 = 1e7;
 
-pub(crate) fn check_exponent(n: f64) -> crate::error::Result<f64> {
-    if !n.is_finite() || !(0.0..=MAX_EXPONENT).contains(&n) {
-        return Err(crate::Error::param(
-            "exponent",
-            format!("{n} is out of range: the exponent must be a number in [0, {MAX_EXPONENT}]"),
-        ));
+/// Declares the glossy models, one line each: the module, the type (which
+/// names the [`Glossy`] variant), and puts the module's `INFO` in [`MODELS`].
+/// [`Glossy`] implements [`Lobe`] by static dispatch over the variants.
+macro_rules! glossy_models {
+    ($($module:ident :: $ty:ident),* $(,)?) => {
+        $(pub mod $module; pub use $module::$ty;)*
+
+        /// Every model, Lambert first.
+        pub const MODELS: &[&ModelInfo] = &[&lambert::INFO, $(&$module::INFO),*];
+
+        /// The glossy lobe of a material (static dispatch).
+        #[derive(Debug, Clone, Copy, PartialEq)]
+        pub enum Glossy {
+            None,
+            $($ty($ty)),*
+        }
+
+        impl Glossy {
+            /// The `type` name of the material with this lobe.
+            #[must_use]
+            pub fn model_name(&self) -> &'static str {
+                match self {
+                    Glossy::None => lambert::INFO.name,
+                    $(Glossy::$ty(_) => $module::INFO.name),*
+                }
+            }
+        }
+
+        /// `Glossy::None` is the lobe that reflects nothing and samples
+        /// nothing.
+        impl Lobe for Glossy {
+            #[inline]
+            fn eval(&self, wo: DVec3, wi: DVec3) -> Rgb {
+                match self {
+                    Glossy::None => Rgb::ZERO,
+                    $(Glossy::$ty(l) => l.eval(wo, wi)),*
+                }
+            }
+            #[inline]
+            fn sample(&self, strategy: Strategy, wo: DVec3, u: DVec2) -> Option<DVec3> {
+                match self {
+                    Glossy::None => None,
+                    $(Glossy::$ty(l) => l.sample(strategy, wo, u)),*
+                }
+            }
+            #[inline]
+            fn pdf(&self, strategy: Strategy, wo: DVec3, wi: DVec3) -> f64 {
+                match self {
+                    Glossy::None => 0.0,
+                    $(Glossy::$ty(l) => l.pdf(strategy, wo, wi)),*
+                }
+            }
+            #[inline]
+            fn sample_eval(&self, strategy: Strategy, wo: DVec3, u: DVec2) -> Option<(DVec3, Rgb, f64)> {
+                match self {
+                    Glossy::None => None,
+                    $(Glossy::$ty(l) => l.sample_eval(strategy, wo, u)),*
+                }
+            }
+            #[inline]
+            fn eval_pdf(&self, strategy: Strategy, wo: DVec3, wi: DVec3) -> (Rgb, f64) {
+                match self {
+                    Glossy::None => (Rgb::ZERO, 0.0),
+                    $(Glossy::$ty(l) => l.eval_pdf(strategy, wo, wi)),*
+                }
+            }
+            #[inline]
+            fn albedo_hint(&self, wo: DVec3) -> f64 {
+                match self {
+                    Glossy::None => 0.0,
+                    $(Glossy::$ty(l) => l.albedo_hint(wo)),*
+                }
+            }
+            fn supports(&self, strategy: Strategy) -> Result<(), String> {
+                match self {
+                    Glossy::None => Err("no glossy lobe".into()),
+                    $(Glossy::$ty(l) => l.supports(strategy)),*
+                }
+            }
+        }
+    };
+}
+
+glossy_models! {
+    phong::Phong,
+    blinn_phong::BlinnPhong,
+    cook_torrance::CookTorrance,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The doc comment at the top of each model file shows its parameter
+    /// table: the one made from `INFO.params`.
+    #[test]
+    fn doc_tables_are_the_param_tables() {
+        let sources = [
+            ("lambert", include_str!("lambert.rs")),
+            ("phong", include_str!("phong.rs")),
+            ("blinn-phong", include_str!("blinn_phong.rs")),
+            ("cook-torrance", include_str!("cook_torrance.rs")),
+        ];
+        assert_eq!(sources.len(), MODELS.len());
+        for (name, src) in sources {
+            let doc: String = src
+                .lines()
+                .filter_map(|l| l.strip_prefix("//!"))
+                .map(|l| format!("{}\n", l.strip_prefix(' ').unwrap_or(l)))
+                .collect();
+            let table = find(name).unwrap().doc_table();
+            assert!(
+                doc.contains(&table),
+                "the doc table of {name} is not its parameter table; it should read:\n{table}"
+            );
+        }
     }
-    Ok(n)
+
+    #[test]
+    fn numbers_read_as_written() {
+        assert_eq!(Num(1e7).to_string(), "1e7");
+        assert_eq!(Num(1e-4).to_string(), "1e-4");
+        assert_eq!(Num(0.3).to_string(), "0.3");
+        assert_eq!(Num(32.0).to_string(), "32");
+    }
 }

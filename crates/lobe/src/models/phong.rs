@@ -2,9 +2,12 @@
 //!
 //! | parameter | range | default | meaning |
 //! |---|---|---|---|
-//! | `ks` | RGB ≥ 0 (≤ 1 when normalized) | 1 | specular colour |
-//! | `exponent` `n` | [0, 10⁷] | 32 | shininess: larger is a tighter highlight |
+//! | `ks` | RGB in [0, 1] (any ≥ 0 when not normalized) | 1 | specular colour |
+//! | `kd` | RGB in [0, 1] | 0 | diffuse colour, added as `kd/π` |
+//! | `exponent` | [0, 1e7] | 32 | shininess `n`: larger is a tighter highlight |
 //! | `normalized` | bool | true | use the energy-normalized form |
+//!
+//! (This table is [`PARAMS`]; a test checks that they agree.)
 //!
 //! With `α` the angle between `wi` and the mirror direction of `wo` about the
 //! normal (equivalently between `wo` and the mirror of `wi`: the model is
@@ -25,10 +28,52 @@
 //! around the mirror direction. Directions below the horizon are failed
 //! samples; the pdf is that density on the upper hemisphere and 0 below.
 
-use super::Lobe;
+use super::{Lobe, MAX_EXPONENT, ModelInfo, Param, Range, Value};
 use crate::math::{INV_TWO_PI, Rgb, luminance, mirror_z};
 use crate::{Frame, Strategy, warp};
 use glam::{DVec2, DVec3};
+
+pub const KS: Param = Param {
+    name: "ks",
+    range: Range::Colour { max: 1.0 },
+    note: "(any ≥ 0 when not normalized)",
+    default: Value::Number(1.0),
+    meaning: "specular colour",
+};
+pub const EXPONENT: Param = Param {
+    name: "exponent",
+    range: Range::Number {
+        min: 0.0,
+        max: MAX_EXPONENT,
+    },
+    note: "",
+    default: Value::Number(32.0),
+    meaning: "shininess `n`: larger is a tighter highlight",
+};
+pub const NORMALIZED: Param = Param {
+    name: "normalized",
+    range: Range::Bool,
+    note: "",
+    default: Value::Bool(true),
+    meaning: "use the energy-normalized form",
+};
+
+/// The keys of a Phong material.
+pub const PARAMS: &[Param] = &[KS, super::KD, EXPONENT, NORMALIZED];
+
+pub const INFO: ModelInfo = ModelInfo {
+    name: "phong",
+    params: PARAMS,
+    #[cfg(feature = "desc")]
+    from_desc,
+};
+
+#[cfg(feature = "desc")]
+fn from_desc(d: &crate::desc::MaterialDesc) -> crate::error::Result<crate::Material> {
+    let (ks, kd, exponent, normalized) = super::lecture_keys(d, KS, EXPONENT, NORMALIZED);
+    let lobe = Phong::new(ks, exponent, normalized)?;
+    crate::Material::with_diffuse(kd, super::Glossy::Phong(lobe))
+}
 
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Phong {
@@ -39,10 +84,10 @@ pub struct Phong {
 
 impl Phong {
     pub fn new(ks: Rgb, exponent: f64, normalized: bool) -> crate::error::Result<Self> {
-        let ks = super::check_rgb("ks", ks, if normalized { 1.0 } else { f64::MAX })?;
+        let ks = KS.check_colour(ks, (!normalized).then_some(f64::MAX))?;
         Ok(Phong {
             ks,
-            exponent: super::check_exponent(exponent)?,
+            exponent: EXPONENT.check_number(exponent, "the exponent")?,
             normalized,
         })
     }
@@ -78,7 +123,7 @@ impl Lobe for Phong {
 
     #[inline]
     fn pdf(&self, _strategy: Strategy, wo: DVec3, wi: DVec3) -> f64 {
-        (self.exponent + 1.0) * INV_TWO_PI * Self::cos_alpha(wo, wi).powf(self.exponent)
+        warp::cos_power_pdf(mirror_z(wo).dot(wi), self.exponent)
     }
 
     fn albedo_hint(&self, _wo: DVec3) -> f64 {

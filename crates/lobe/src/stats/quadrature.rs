@@ -472,13 +472,35 @@ fn integrate_2d_with_grid(
     }
 }
 
-/// The unit direction with polar angle `theta` (from `+z`) and azimuth `phi`.
+pub use crate::frame::spherical_direction;
+
+/// Nodes and weights of the 4-point Gauss–Legendre rule on `[−1, 1]`.
+pub const GAUSS_LEGENDRE_4: [(f64, f64); 4] = [
+    (-0.861_136_311_594_052_6, 0.347_854_845_137_453_9),
+    (-0.339_981_043_584_856_3, 0.652_145_154_862_546_1),
+    (0.339_981_043_584_856_3, 0.652_145_154_862_546_1),
+    (0.861_136_311_594_052_6, 0.347_854_845_137_453_9),
+];
+
+/// The 4 × 4 Gauss–Legendre rule for `∫∫ f(x, y) dx dy` over
+/// `[x0, x1] × [y0, y1]`, for any value that adds and scales (`f64`, RGB).
+/// The widths may be signed: the result is the integral over the rectangle
+/// with positive area (`Σ wᵢwⱼ f · |hx hy|`).
 #[inline]
 #[must_use]
-pub fn spherical_direction(theta: f64, phi: f64) -> DVec3 {
-    let (st, ct) = theta.sin_cos();
-    let (sp, cp) = phi.sin_cos();
-    DVec3::new(st * cp, st * sp, ct)
+pub fn gauss_legendre_4x4<T>(f: impl Fn(f64, f64) -> T, x0: f64, x1: f64, y0: f64, y1: f64) -> T
+where
+    T: Copy + Default + std::ops::Add<Output = T> + std::ops::Mul<f64, Output = T>,
+{
+    let (hx, hy) = (0.5 * (x1 - x0), 0.5 * (y1 - y0));
+    let (mx, my) = (0.5 * (x1 + x0), 0.5 * (y1 + y0));
+    let mut s = T::default();
+    for (xi, wx) in GAUSS_LEGENDRE_4 {
+        for (yi, wy) in GAUSS_LEGENDRE_4 {
+            s = s + f(mx + hx * xi, my + hy * yi) * (wx * wy);
+        }
+    }
+    s * (hx * hy).abs()
 }
 
 /// Integrates `f(ω) dω` over the spherical region
@@ -651,6 +673,17 @@ mod tests {
     }
 
     #[test]
+    fn gauss_legendre_4x4_is_exact_for_degree_7() {
+        let f = |x: f64, y: f64| x.powi(7) + 3.0 * x.powi(6) * y.powi(5) + y.powi(2);
+        // ∫₀¹∫₋₁² f dy dx, with the x range reversed (signed width).
+        let exact = 3.0 / 8.0 + 3.0 * (1.0 / 7.0) * (64.0 - 1.0) / 6.0 + 3.0 * 1.0;
+        let est = gauss_legendre_4x4(f, 1.0, 0.0, -1.0, 2.0);
+        assert!((est - exact).abs() < 1e-13, "{est} vs {exact}");
+        let rgb = gauss_legendre_4x4(|x, y| crate::Rgb::splat(f(x, y)), 1.0, 0.0, -1.0, 2.0);
+        assert_eq!(rgb, crate::Rgb::splat(est));
+    }
+
+    #[test]
     fn cosine_over_hemisphere_is_pi() {
         let est = integrate_hemisphere(|w| w.z, Tolerance::new(1e-13, 1e-13));
         assert!(est.converged);
@@ -681,7 +714,7 @@ mod tests {
     fn narrow_tilted_lobe_integrates_to_one() {
         let n = 1e4;
         let t = 40f64.to_radians();
-        let axis = DVec3::new(t.sin(), 0.0, t.cos());
+        let axis = spherical_direction(t, 0.0);
         let lobe = |w: DVec3| (n + 1.0) / TAU * w.dot(axis).max(0.0).powf(n);
         let est = integrate_sphere(lobe, Tolerance::new(1e-12, 1e-9));
         assert!(est.converged, "{est:?}");

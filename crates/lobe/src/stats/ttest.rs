@@ -1,12 +1,15 @@
-//! One-sample Student's t-test and running moments, for checking that a Monte
-//! Carlo estimator's mean matches a reference value.
+//! One-sample Student's t-test (feature `stats`) and running moments, for
+//! checking that a Monte Carlo estimator's mean matches a reference value.
 
+#[cfg(feature = "stats")]
 use statrs::distribution::{ContinuousCDF, StudentsT};
 
 /// Relative tolerance under which a zero-variance mean equals the reference.
+#[cfg(feature = "stats")]
 const ZERO_VARIANCE_REL: f64 = 1e-12;
 
 /// Outcome of [`t_test`].
+#[cfg(feature = "stats")]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TTest {
     /// `(mean − reference) / sqrt(variance / n)`.
@@ -15,6 +18,7 @@ pub struct TTest {
     pub p_value: f64,
 }
 
+#[cfg(feature = "stats")]
 impl TTest {
     /// Whether the mean is compatible with the reference at level `alpha`
     /// (`p_value > alpha`; false for a NaN p-value).
@@ -32,6 +36,7 @@ impl TTest {
 /// With `variance == 0`, the p-value is 1 when `mean` equals `reference`
 /// within `1e-12` relative (`t = 0`), else 0 (`t = ±∞`). With `n < 2`, a
 /// negative variance or non-finite inputs, `t` and `p_value` are NaN.
+#[cfg(feature = "stats")]
 #[must_use]
 pub fn t_test(mean: f64, variance: f64, n: usize, reference: f64) -> TTest {
     let nan = TTest {
@@ -141,6 +146,7 @@ impl Moments {
     }
 
     /// [`t_test`] of these moments against `reference`.
+    #[cfg(feature = "stats")]
     #[must_use]
     pub fn t_test(&self, reference: f64) -> TTest {
         t_test(self.mean(), self.variance(), self.count(), reference)
@@ -166,7 +172,9 @@ impl FromIterator<f64> for Moments {
 #[cfg(test)]
 mod tests {
     use super::*;
+    #[cfg(feature = "stats")]
     use rand::{RngExt, SeedableRng};
+    #[cfg(feature = "stats")]
     use rand_pcg::Pcg64;
 
     #[test]
@@ -207,6 +215,7 @@ mod tests {
         assert_eq!(f, all);
     }
 
+    #[cfg(feature = "stats")]
     #[test]
     fn degenerate_moments() {
         let m = Moments::new();
@@ -218,6 +227,7 @@ mod tests {
         assert!(m.t_test(3.0).p_value.is_nan());
     }
 
+    #[cfg(feature = "stats")]
     #[test]
     fn t_test_known_values() {
         // t = 2 with 9 dof: two-sided p = 0.076_552_823_770_69... (Simpson on the density)
@@ -234,6 +244,7 @@ mod tests {
         assert!(t_test(0.0, 1.0, 100, 0.0).p_value == 1.0);
     }
 
+    #[cfg(feature = "stats")]
     #[test]
     fn zero_variance_and_bad_input() {
         assert_eq!(
@@ -252,6 +263,7 @@ mod tests {
         assert!(!t_test(f64::NAN, 1.0, 10, 0.0).passes(0.01));
     }
 
+    #[cfg(feature = "stats")]
     #[test]
     fn detects_biased_estimator_and_accepts_unbiased() {
         let mut rng = Pcg64::seed_from_u64(11);

@@ -34,10 +34,8 @@ pub const VIEWS: [f64; 5] = [0.0, 30.0, 60.0, 80.0, 89.0];
 
 #[must_use]
 pub fn wo(theta_deg: f64) -> DVec3 {
-    let t = theta_deg.to_radians();
-    // A small azimuth so that anisotropic lobes are not seen along an axis.
-    let phi = 0.3f64;
-    DVec3::new(t.sin() * phi.cos(), t.sin() * phi.sin(), t.cos())
+    // A small azimuth (0.3 rad) so that anisotropic lobes are not seen along an axis.
+    lobe::frame::wo_from_theta(theta_deg, 0.3f64.to_degrees())
 }
 
 pub const EXPONENTS: [f64; 5] = [1.0, 10.0, 100.0, 1000.0, 10000.0];
