@@ -1,14 +1,12 @@
-//! Pieces shared by the commands: view and light arguments, progress bars,
-//! and the multi-threaded estimate that gives the same numbers whatever the
-//! thread count.
+//! Pieces shared by the commands: view and light arguments, progress bars
+//! and output names.
 
 use anyhow::{Result, anyhow, bail};
 use clap::Args;
 use glam::DVec3;
 use indicatif::{ProgressBar, ProgressStyle};
-use lobe::estimator::{Accumulator, Plan, estimate_chunk};
-use lobe::{Frame, Light, Material, Rgb};
-use rayon::prelude::*;
+use lobe::progress::Progress;
+use lobe::{Frame, Light, Rgb};
 use std::path::{Path, PathBuf};
 
 /// `--theta DEG` or `--wo x,y,z`: the view direction in the local frame.
@@ -179,42 +177,33 @@ pub fn progress(len: u64, message: &str, quiet: bool) -> ProgressBar {
     pb
 }
 
-/// Run an estimate on every thread of rayon's pool, chunk by chunk, and merge
-/// the chunks in order: the same numbers for any thread count.
-pub fn estimate_par(
-    m: &Material,
-    wo: DVec3,
-    light: &Light,
-    plan: &Plan,
-    pb: &ProgressBar,
-) -> Accumulator {
-    let parts: Vec<Accumulator> = (0..plan.chunks())
-        .into_par_iter()
-        .map(|c| {
-            let a = estimate_chunk(m, wo, light, plan, c);
-            pb.inc(a.count() as u64);
-            a
-        })
-        .collect();
-    let mut acc = Accumulator::default();
-    for p in &parts {
-        acc.merge(p);
+/// A [`Progress`] shown as an indicatif bar on stderr (hidden with
+/// `--quiet`): each task the library starts resets the bar to its label and
+/// length.
+pub struct Bar(pub ProgressBar);
+
+impl Bar {
+    /// A bar, hidden when `quiet`.
+    #[must_use]
+    pub fn new(quiet: bool) -> Self {
+        Bar(progress(0, "", quiet))
     }
-    acc
+
+    /// Remove the bar from the terminal.
+    pub fn finish(&self) {
+        self.0.finish_and_clear();
+    }
 }
 
-/// [`lobe::estimator::reference`] with an environment map's rows summed on
-/// rayon's pool (in row order, so the same number for any thread count).
-pub fn reference_par(m: &Material, wo: DVec3, light: &Light, rel: f64) -> Rgb {
-    match light {
-        Light::Env { map, frame } => {
-            let rows: Vec<Rgb> = (0..map.size().1)
-                .into_par_iter()
-                .map(|j| lobe::estimator::reference_env_row(m, wo, map, frame, j, rel))
-                .collect();
-            rows.iter().fold(Rgb::ZERO, |a, &b| a + b)
-        }
-        _ => lobe::estimator::reference(m, wo, light, rel),
+impl Progress for Bar {
+    fn start(&self, label: &str, total: u64) {
+        self.0.reset();
+        self.0.set_length(total);
+        self.0.set_message(label.to_string());
+    }
+
+    fn advance(&self, n: u64) {
+        self.0.inc(n);
     }
 }
 
