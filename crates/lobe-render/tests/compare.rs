@@ -35,7 +35,13 @@ fn metrics_of_identical_images_are_zero() {
 #[test]
 fn metrics_of_known_differences() {
     let r = image(4, 2, |_| Rgb::splat(1.0));
-    let a = image(4, 2, |k| if k == 0 { Rgb::new(4.0, 1.0, 1.0) } else { Rgb::ONE });
+    let a = image(4, 2, |k| {
+        if k == 0 {
+            Rgb::new(4.0, 1.0, 1.0)
+        } else {
+            Rgb::ONE
+        }
+    });
     // One channel of one pixel off by 3: sqrt(9 / (3 × 8)).
     assert!((rmse(&a, &r) - (9.0f64 / 24.0).sqrt()).abs() < 1e-15);
     assert!((error_epsilon(&r) - 0.01).abs() < 1e-15);
@@ -43,7 +49,10 @@ fn metrics_of_known_differences() {
     assert_eq!(error_epsilon(&black), 1e-6);
     let b = image(4, 2, |_| Rgb::splat(1.5));
     let map = error_map(&b, &r, 0.01);
-    assert!(map.iter().all(|&e| (e - 0.5 / 1.01).abs() < 1e-12), "{map:?}");
+    assert!(
+        map.iter().all(|&e| (e - 0.5 / 1.01).abs() < 1e-12),
+        "{map:?}"
+    );
     assert_eq!(rmse(&Image::new(0, 0), &r), 0.0);
 }
 
@@ -72,7 +81,10 @@ fn resample_preserves_a_constant_image() {
         };
         assert_eq!((r.width, r.height), (ew, eh), "up {up} down {down}");
         assert_eq!(r.bytes.len(), ew * eh * 3);
-        assert!(r.bytes.chunks(3).all(|p| p == [10, 200, 77]), "up {up} down {down}");
+        assert!(
+            r.bytes.chunks(3).all(|p| p == [10, 200, 77]),
+            "up {up} down {down}"
+        );
     }
     // A box average of a 2×2 checker is its mean.
     let checker = [0u8, 0, 0, 255, 255, 255, 255, 255, 255, 0, 0, 0];
@@ -104,7 +116,12 @@ impl Progress for Tasks {
 fn furnace() -> Scene {
     let camera = Camera::new(DVec3::new(0.0, 0.0, 4.0), DVec3::ZERO, DVec3::Y, 40.0, 8, 6).unwrap();
     Scene::new(camera, EnvMap::constant(Rgb::ONE)).with(
-        Object::sphere(DVec3::ZERO, 1.0, Material::lambert(Rgb::splat(0.5)).unwrap()).unwrap(),
+        Object::sphere(
+            DVec3::ZERO,
+            1.0,
+            Material::lambert(Rgb::splat(0.5)).unwrap(),
+        )
+        .unwrap(),
     )
 }
 
@@ -120,7 +137,10 @@ fn a_comparison_under_a_fake_clock() {
         ]
     );
     let settings = Settings {
-        methods: vec![Method::Bsdf(Strategy::Cosine), Method::Mis(Heuristic::Balance)],
+        methods: vec![
+            Method::Bsdf(Strategy::Cosine),
+            Method::Mis(Heuristic::Balance),
+        ],
         spp: 2,
         reference_spp: 16,
         seed: 9,
@@ -132,12 +152,30 @@ fn a_comparison_under_a_fake_clock() {
     let cmp = run_comparison(&scene, &settings, &tasks, &Squares(Mutex::new(0)));
     // Renders: cosine 2 spp (3 s), mis 2 spp (7 s), cosine at equal time,
     // the reference (mis at equal time is its pilot, not rendered again).
-    let labels: Vec<String> = tasks.0.lock().unwrap().iter().map(|t| t.0.clone()).collect();
+    let labels: Vec<String> = tasks
+        .0
+        .lock()
+        .unwrap()
+        .iter()
+        .map(|t| t.0.clone())
+        .collect();
     assert_eq!(
         labels,
-        ["cosine 2 spp", "mis 2 spp", "cosine 5 spp, eq. time", "reference 16 spp"]
+        [
+            "cosine 2 spp",
+            "mis 2 spp",
+            "cosine 5 spp, eq. time",
+            "reference 16 spp"
+        ]
     );
-    assert!(tasks.0.lock().unwrap().iter().all(|t| t.1 == 48 && t.2 == 48));
+    assert!(
+        tasks
+            .0
+            .lock()
+            .unwrap()
+            .iter()
+            .all(|t| t.1 == 48 && t.2 == 48)
+    );
     assert_eq!(cmp.equal_samples[0].time_s, 3.0);
     assert_eq!(cmp.equal_samples[1].time_s, 7.0);
     let et = cmp.equal_time.as_ref().unwrap();
@@ -156,7 +194,11 @@ fn a_comparison_under_a_fake_clock() {
     }
     // Cosine sampling of a Lambert sphere in a furnace is exact: its pixels
     // on the sphere equal the reference's.
-    assert!(cmp.equal_samples[0].rmse < 0.2, "{}", cmp.equal_samples[0].rmse);
+    assert!(
+        cmp.equal_samples[0].rmse < 0.2,
+        "{}",
+        cmp.equal_samples[0].rmse
+    );
     assert_eq!(reference_seed(9), !9);
     assert_eq!(default_reference_spp(16), 1024);
     assert_eq!(default_reference_spp(100), 1600);
