@@ -1,14 +1,13 @@
-//! Pieces shared by the commands: view and light arguments, progress bars,
-//! and the multi-threaded estimate that gives the same numbers whatever the
-//! thread count.
+//! Pieces shared by the commands: view and light arguments, progress bars
+//! and output names.
 
 use anyhow::{Result, anyhow, bail};
 use clap::Args;
 use glam::DVec3;
 use indicatif::{ProgressBar, ProgressStyle};
-use lobe::estimator::{Accumulator, Plan, ShadingPoint, estimate_chunk};
-use lobe::{Frame, Light, Material, Rgb};
-use rayon::prelude::*;
+use lobe::estimator::ShadingPoint;
+use lobe::progress::Progress;
+use lobe::{Frame, Light, Rgb};
 use std::path::{Path, PathBuf};
 
 /// `--theta DEG` or `--wo x,y,z`: the view direction in the local frame.
@@ -44,7 +43,8 @@ pub fn theta_to_wo(theta: f64) -> Result<DVec3> {
     if !theta.is_finite() || !(0.0..90.0).contains(&theta) {
         bail!("--theta {theta}: the view angle must be in [0, 90) degrees");
     }
-    Ok(lobe::frame::wo_from_theta(theta, 0.0))
+    let t = theta.to_radians();
+    Ok(DVec3::new(t.sin(), 0.0, t.cos()))
 }
 
 /// Parse `x,y,z` into a non-zero finite vector.
@@ -191,43 +191,33 @@ pub fn progress(len: u64, message: &str, quiet: bool) -> ProgressBar {
     pb
 }
 
-/// Run an estimate on every thread of rayon's pool, chunk by chunk, and merge
-/// the chunks in order: the same numbers for any thread count.
-pub fn estimate_par(
-    m: &Material,
-    sp: &ShadingPoint,
-    light: &Light,
-    plan: &Plan,
-    pb: &ProgressBar,
-) -> Result<Accumulator> {
-    let est = plan.technique.for_material(m)?;
-    let parts: Vec<Accumulator> = (0..plan.chunks())
-        .into_par_iter()
-        .map(|c| {
-            let a = estimate_chunk(&est, sp, light, plan, c);
-            pb.inc(a.count() as u64);
-            a
-        })
-        .collect();
-    let mut acc = Accumulator::default();
-    for p in &parts {
-        acc.merge(p);
+/// A [`Progress`] shown as an indicatif bar on stderr (hidden with
+/// `--quiet`): each task the library starts resets the bar to its label and
+/// length.
+pub struct Bar(pub ProgressBar);
+
+impl Bar {
+    /// A bar, hidden when `quiet`.
+    #[must_use]
+    pub fn new(quiet: bool) -> Self {
+        Bar(progress(0, "", quiet))
     }
-    Ok(acc)
+
+    /// Remove the bar from the terminal.
+    pub fn finish(&self) {
+        self.0.finish_and_clear();
+    }
 }
 
-/// [`lobe::estimator::reference`] with an environment map's rows summed on
-/// rayon's pool (in row order, so the same number for any thread count).
-pub fn reference_par(m: &Material, sp: &ShadingPoint, light: &Light, rel: f64) -> Rgb {
-    match light {
-        Light::Env(map) => {
-            let rows: Vec<Rgb> = (0..map.size().1)
-                .into_par_iter()
-                .map(|j| lobe::estimator::reference_env_row(m, sp, map, j, rel))
-                .collect();
-            rows.iter().fold(Rgb::ZERO, |a, &b| a + b)
-        }
-        _ => lobe::estimator::reference(m, sp, light, rel),
+impl Progress for Bar {
+    fn start(&self, label: &str, total: u64) {
+        self.0.reset();
+        self.0.set_length(total);
+        self.0.set_message(label.to_string());
+    }
+
+    fn advance(&self, n: u64) {
+        self.0.inc(n);
     }
 }
 

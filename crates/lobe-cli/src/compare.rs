@@ -2,41 +2,28 @@
 //! samples and at equal time, next to a high-spp reference, and draw one
 //! grid of the renders with their per-pixel error maps and RMSE.
 //!
-//! The pieces are public to the crate so that `lobe demo` can run the same
-//! comparison on its built-in showcase and draw the same grid:
-//! [`run_comparison`], [`write_grid`], [`summary`].
-//!
-//! * **RMSE**: the root mean square, over all pixels and the three channels,
-//!   of the linear RGB difference from the reference.
-//! * **Error map**: per pixel, the relative error of luminance
-//!   `|Y − Y_ref| / (Y_ref + ε)`, with `ε` 1 % of the reference's mean
-//!   luminance (so that black pixels do not divide by zero), on one
-//!   logarithmic colour scale shared by every map of the figure.
-//! * **Equal time**: the budget is the wall time of `mis` at equal samples
-//!   (of the slowest strategy when `mis` is not compared). Each strategy's
-//!   equal-samples render is its pilot: its time per sample per pixel gives
-//!   the spp that fit in the budget (at least 1), and the strategy is
-//!   rendered again with that spp.
-//! * **Reference**: `mis` at the reference spp, with the bitwise complement
-//!   of the seed, so that its samples are independent of the compared
-//!   renders' (the same seed would make `mis`'s first samples the
-//!   reference's own and flatter its error).
+//! The renders and the numbers come from [`lobe_render::compare`]; this
+//! module parses the arguments, shows progress, draws the grid
+//! ([`write_grid`]) and writes NAME.json ([`summary`]). `lobe demo` draws
+//! its showcase with the same pieces.
 
-use crate::common::progress;
+use crate::common::Bar;
 use crate::figures::viridis;
 use anyhow::{Result, anyhow, bail};
 use clap::Args;
-use lobe::Strategy;
-use lobe::estimator::{Heuristic, Technique};
-use lobe::math::luminance;
-use lobe_render::{Image, RenderOptions, Scene, fallbacks, load_scene, render};
+use lobe::progress::SystemClock;
+use lobe_render::compare::{
+    Comparison, LogScale, Settings, Shot, default_methods, default_reference_spp, error_epsilon,
+    error_map, resample, run_comparison,
+};
+use lobe::estimator::Technique;
+use lobe_render::{fallbacks, load_scene};
 use plotters::coord::Shift;
 use plotters::element::BitMapElement;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 use serde::Serialize;
 use std::path::{Path, PathBuf};
-use std::time::Instant;
 
 /// The arguments of `lobe compare`.
 #[derive(Args, Debug)]
@@ -91,74 +78,6 @@ pub struct CompareArgs {
     pub quiet: bool,
 }
 
-/// The method of the reference render.
-pub const REFERENCE_METHOD: Technique = Technique::mis(Heuristic::Balance);
-
-/// Most samples per pixel an equal-time render may take.
-const MAX_EQUAL_TIME_SPP: f64 = 1_048_576.0;
-
-/// What to compare and how.
-#[derive(Debug, Clone)]
-pub struct Settings {
-    pub methods: Vec<Technique>,
-    /// Samples per pixel at equal samples.
-    pub spp: u32,
-    pub reference_spp: u32,
-    pub seed: u64,
-    pub max_depth: u32,
-    pub threads: Option<usize>,
-    /// Render the equal-time row too.
-    pub equal_time: bool,
-    pub quiet: bool,
-}
-
-/// One render of a comparison.
-#[derive(Debug, Clone)]
-pub struct Shot {
-    pub method: Technique,
-    pub spp: u32,
-    /// Wall time of the render.
-    pub time_s: f64,
-    /// Against the reference (0 for the reference itself).
-    pub rmse: f64,
-    pub image: Image,
-}
-
-/// The equal-time row.
-#[derive(Debug, Clone)]
-pub struct EqualTime {
-    /// The time each strategy was given.
-    pub budget_s: f64,
-    /// Where the budget comes from, e.g. `mis at 16 spp`.
-    pub budget_from: String,
-    pub shots: Vec<Shot>,
-}
-
-/// Every render of a comparison.
-#[derive(Debug, Clone)]
-pub struct Comparison {
-    pub reference: Shot,
-    pub reference_seed: u64,
-    pub equal_samples: Vec<Shot>,
-    pub equal_time: Option<EqualTime>,
-}
-
-/// The default strategies for `scene`: brdf, vndf (when an object's
-/// material has it), light and mis.
-#[must_use]
-pub fn default_methods(scene: &Scene) -> Vec<Technique> {
-    let mut v = vec![Technique::Bsdf(Strategy::Brdf)];
-    if scene
-        .objects
-        .iter()
-        .any(|o| o.material.check(Strategy::Vndf).is_ok())
-    {
-        v.push(Technique::Bsdf(Strategy::Vndf));
-    }
-    v.extend([Technique::Light, Technique::mis(Heuristic::Balance)]);
-    v
-}
-
 /// Parse `--strategies`: a comma-separated list of method names, each once.
 pub fn parse_methods(spec: &str) -> Result<Vec<Technique>> {
     let mut v = Vec::new();
@@ -177,266 +96,63 @@ pub fn parse_methods(spec: &str) -> Result<Vec<Technique>> {
     Ok(v)
 }
 
-/// The seed of the reference: the complement of `seed`, so that its pixel
-/// streams are independent of the compared renders'.
+/// The rows of the figure: equal samples, then equal time if rendered.
 #[must_use]
-pub fn reference_seed(seed: u64) -> u64 {
-    !seed
+pub fn sections(cmp: &Comparison) -> Vec<(String, &[Shot])> {
+    let spp = cmp.equal_samples.first().map_or(0, |s| s.spp);
+    let mut v = vec![(
+        format!("Equal samples: {spp} spp each"),
+        cmp.equal_samples.as_slice(),
+    )];
+    if let Some(et) = &cmp.equal_time {
+        v.push((
+            format!(
+                "Equal time: {} each ({})",
+                fmt_time(et.budget_s),
+                et.budget_from
+            ),
+            et.shots.as_slice(),
+        ));
+    }
+    v
 }
 
-/// The default reference spp: 16 × `spp`, at least 1024.
-#[must_use]
-pub fn default_reference_spp(spp: u32) -> u32 {
-    spp.saturating_mul(16).max(1024)
-}
-
-fn render_one(
-    scene: &Scene,
-    s: &Settings,
-    method: Technique,
-    spp: u32,
-    seed: u64,
-    what: &str,
-) -> (Image, f64) {
-    let opts = RenderOptions {
-        spp: spp.into(),
-        technique: method,
-        seed,
-        max_depth: s.max_depth,
-        threads: s.threads,
-    };
-    let pixels = u64::from(scene.camera.width) * u64::from(scene.camera.height);
-    // `brdf 16 spp`, `brdf 40 spp, eq. time`, `reference 1024 spp`.
-    let message = match what {
-        "" => format!("{method} {spp} spp"),
-        "reference" => format!("reference {spp} spp"),
-        _ => format!("{method} {spp} spp, {what}"),
-    };
-    let pb = progress(pixels * u64::from(spp), &message, s.quiet);
-    let t0 = Instant::now();
-    let image = render(scene, &opts, |n| pb.inc(n));
-    let time = t0.elapsed().as_secs_f64();
-    pb.finish_and_clear();
-    if image.stats.nonfinite > 0 {
-        eprintln!(
-            "lobe: warning: {method} at {spp} spp: {} path samples were not finite numbers and counted as 0",
-            image.stats.nonfinite
-        );
-    }
-    (image, time)
-}
-
-/// Render every strategy at equal samples (and at equal time when
-/// `s.equal_time`), then the reference, and measure each render's RMSE.
-#[must_use]
-pub fn run_comparison(scene: &Scene, s: &Settings) -> Comparison {
-    let spp = s.spp.max(1);
-    let mut equal_samples = Vec::new();
-    for &m in &s.methods {
-        let (image, time_s) = render_one(scene, s, m, spp, s.seed, "");
-        equal_samples.push(Shot {
-            method: m,
-            spp,
-            time_s,
-            rmse: f64::NAN,
-            image,
-        });
-    }
-    let equal_time = s.equal_time.then(|| {
-        let mis = equal_samples
-            .iter()
-            .find(|x| x.method == Technique::mis(Heuristic::Balance));
-        let (budget_s, budget_from) = match mis {
-            Some(x) => (x.time_s, format!("the time of mis at {spp} spp")),
-            None => {
-                let slowest = equal_samples
-                    .iter()
-                    .max_by(|a, b| a.time_s.total_cmp(&b.time_s))
-                    .expect("at least one strategy");
-                (
-                    slowest.time_s,
-                    format!("the time of {} at {spp} spp, the slowest", slowest.method),
-                )
-            }
-        };
-        let shots = equal_samples
-            .iter()
-            .map(|pilot| {
-                let per_spp = pilot.time_s.max(1e-9) / f64::from(spp);
-                let n = (budget_s / per_spp).round().clamp(1.0, MAX_EQUAL_TIME_SPP) as u32;
-                if n == spp {
-                    return pilot.clone();
-                }
-                let (image, time_s) = render_one(scene, s, pilot.method, n, s.seed, "eq. time");
-                Shot {
-                    method: pilot.method,
-                    spp: n,
-                    time_s,
-                    rmse: f64::NAN,
-                    image,
-                }
-            })
-            .collect();
-        EqualTime {
-            budget_s,
-            budget_from,
-            shots,
-        }
-    });
-    let seed = reference_seed(s.seed);
-    let (image, time_s) = render_one(
-        scene,
-        s,
-        REFERENCE_METHOD,
-        s.reference_spp.max(1),
-        seed,
-        "reference",
-    );
-    let reference = Shot {
-        method: REFERENCE_METHOD,
-        spp: s.reference_spp.max(1),
-        time_s,
-        rmse: 0.0,
-        image,
-    };
-    let mut cmp = Comparison {
-        reference,
-        reference_seed: seed,
-        equal_samples,
-        equal_time,
-    };
-    let r = cmp.reference.image.clone();
-    for shot in cmp.shots_mut() {
-        shot.rmse = rmse(&shot.image, &r);
-    }
-    cmp
-}
-
-impl Comparison {
-    /// The rows of the figure: equal samples, then equal time if rendered.
-    #[must_use]
-    pub fn sections(&self) -> Vec<(String, &[Shot])> {
-        let spp = self.equal_samples.first().map_or(0, |s| s.spp);
-        let mut v = vec![(
-            format!("Equal samples: {spp} spp each"),
-            self.equal_samples.as_slice(),
-        )];
-        if let Some(et) = &self.equal_time {
-            v.push((
-                format!(
-                    "Equal time: {} each ({})",
-                    fmt_time(et.budget_s),
-                    et.budget_from
-                ),
-                et.shots.as_slice(),
-            ));
-        }
-        v
-    }
-
-    fn shots_mut(&mut self) -> impl Iterator<Item = &mut Shot> {
-        self.equal_samples.iter_mut().chain(
-            self.equal_time
-                .as_mut()
-                .map(|e| e.shots.iter_mut())
-                .into_iter()
-                .flatten(),
+/// Warn on stderr of every render whose path samples were not all finite
+/// (an equal-time shot that is its pilot was not rendered again).
+pub fn warn_nonfinite(cmp: &Comparison) {
+    let spp = cmp.equal_samples.first().map_or(0, |s| s.spp);
+    let rendered = cmp
+        .equal_samples
+        .iter()
+        .chain(
+            cmp.equal_time
+                .iter()
+                .flat_map(|e| e.shots.iter().filter(|s| s.spp != spp)),
         )
-    }
-}
-
-/// Root mean square over all pixels and channels of the linear RGB
-/// difference `a − reference`.
-#[must_use]
-pub fn rmse(a: &Image, reference: &Image) -> f64 {
-    let n = a.pixels.len().min(reference.pixels.len());
-    if n == 0 {
-        return 0.0;
-    }
-    let sum: f64 = a
-        .pixels
-        .iter()
-        .zip(&reference.pixels)
-        .map(|(p, r)| (*p - *r).length_squared())
-        .sum();
-    (sum / (3 * n) as f64).sqrt()
-}
-
-/// `ε` of the error maps: 1 % of the reference's mean luminance (1e-6 when
-/// the reference is black).
-#[must_use]
-pub fn error_epsilon(reference: &Image) -> f64 {
-    let n = reference.pixels.len().max(1) as f64;
-    let mean = reference
-        .pixels
-        .iter()
-        .map(|p| luminance(*p).max(0.0))
-        .sum::<f64>()
-        / n;
-    if mean > 0.0 && mean.is_finite() {
-        0.01 * mean
-    } else {
-        1e-6
-    }
-}
-
-/// Per pixel, `|Y − Y_ref| / (Y_ref + ε)` of luminance.
-#[must_use]
-pub fn error_map(image: &Image, reference: &Image, eps: f64) -> Vec<f64> {
-    image
-        .pixels
-        .iter()
-        .zip(&reference.pixels)
-        .map(|(p, r)| {
-            let yr = luminance(*r).max(0.0);
-            (luminance(*p) - yr).abs() / (yr + eps)
-        })
-        .collect()
-}
-
-/// A logarithmic colour scale from `lo` to `hi` (both powers of ten).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-pub struct LogScale {
-    pub lo: f64,
-    pub hi: f64,
-}
-
-/// Decades the error colour scale spans.
-const SCALE_DECADES: i32 = 4;
-
-impl LogScale {
-    /// The scale of `maps`: its top is the power of ten at or above the
-    /// 99th percentile of the positive values, and it spans
-    /// [`SCALE_DECADES`] decades.
-    #[must_use]
-    pub fn of(maps: &[Vec<f64>]) -> LogScale {
-        let mut v: Vec<f64> = maps
-            .iter()
-            .flatten()
-            .copied()
-            .filter(|x| *x > 0.0 && x.is_finite())
-            .collect();
-        let top = if v.is_empty() {
-            0
-        } else {
-            let k = ((v.len() - 1) as f64 * 0.99).round() as usize;
-            let (_, p, _) = v.select_nth_unstable_by(k, f64::total_cmp);
-            p.log10().ceil() as i32
-        };
-        LogScale {
-            lo: 10f64.powi(top - SCALE_DECADES),
-            hi: 10f64.powi(top),
+        .chain(std::iter::once(&cmp.reference));
+    for s in rendered {
+        if s.image.stats.nonfinite > 0 {
+            eprintln!(
+                "lobe: warning: {} at {} spp: {} path samples were not finite numbers and counted as 0",
+                s.method, s.spp, s.image.stats.nonfinite
+            );
         }
     }
+}
 
-    /// Position of `x` on the scale, clamped to [0, 1].
-    #[must_use]
-    pub fn t(&self, x: f64) -> f64 {
-        if x.is_nan() || x <= self.lo {
-            return 0.0;
-        }
-        ((x.log10() - self.lo.log10()) / (self.hi.log10() - self.lo.log10())).clamp(0.0, 1.0)
-    }
+/// [`run_comparison`] with a progress bar (hidden when `quiet`) and the
+/// system clock, then the warnings of [`warn_nonfinite`].
+#[must_use]
+pub fn run_with_progress(
+    scene: &lobe_render::Scene,
+    settings: &Settings,
+    quiet: bool,
+) -> Comparison {
+    let bar = Bar::new(quiet);
+    let cmp = run_comparison(scene, settings, &bar, &SystemClock::new());
+    bar.finish();
+    warn_nonfinite(&cmp);
+    cmp
 }
 
 // ---------------------------------------------------------------------------
@@ -656,7 +372,7 @@ fn layout(spec: &FigureSpec, title_h: i32, arrange: Arrange, pair: Pair) -> Geom
     let (up, down) = display_scale(img.width);
     let dw = (img.width * up / down).max(1) as i32;
     let dh = (img.height * up / down).max(1) as i32;
-    let sections = cmp.sections();
+    let sections = sections(cmp);
     let n = sections.iter().map(|s| s.1.len()).max().unwrap_or(0);
     let mut g = Geometry {
         arrange,
@@ -739,47 +455,6 @@ fn best_layout(spec: &FigureSpec, title_h: i32) -> Geometry {
         }
     }
     best.expect("four layouts").1
-}
-
-/// Resize RGB bytes by `up` (nearest) or `down` (box average).
-fn resample(rgb: &[u8], w: usize, h: usize, up: usize, down: usize) -> (Vec<u8>, usize, usize) {
-    if up > 1 {
-        let (ow, oh) = (w * up, h * up);
-        let mut out = vec![0u8; ow * oh * 3];
-        for y in 0..oh {
-            for x in 0..ow {
-                let s = ((y / up) * w + x / up) * 3;
-                let d = (y * ow + x) * 3;
-                out[d..d + 3].copy_from_slice(&rgb[s..s + 3]);
-            }
-        }
-        (out, ow, oh)
-    } else if down > 1 {
-        let (ow, oh) = ((w / down).max(1), (h / down).max(1));
-        let mut out = vec![0u8; ow * oh * 3];
-        for y in 0..oh {
-            for x in 0..ow {
-                let mut acc = [0u32; 3];
-                let mut cnt = 0u32;
-                for yy in y * down..((y + 1) * down).min(h) {
-                    for xx in x * down..((x + 1) * down).min(w) {
-                        let s = (yy * w + xx) * 3;
-                        for c in 0..3 {
-                            acc[c] += u32::from(rgb[s + c]);
-                        }
-                        cnt += 1;
-                    }
-                }
-                let d = (y * ow + x) * 3;
-                for c in 0..3 {
-                    out[d + c] = ((acc[c] + cnt / 2) / cnt.max(1)) as u8;
-                }
-            }
-        }
-        (out, ow, oh)
-    } else {
-        (rgb.to_vec(), w, h)
-    }
 }
 
 fn blit(area: &Area, rgb: Vec<u8>, (x, y): (i32, i32), (w, h): (i32, i32)) -> Result<()> {
@@ -922,7 +597,7 @@ pub fn write_grid(path: &Path, spec: &FigureSpec) -> Result<FigureInfo> {
     let cmp = spec.cmp;
     let reference = &cmp.reference.image;
     let eps = error_epsilon(reference);
-    let sections = cmp.sections();
+    let sections = sections(cmp);
     let maps: Vec<Vec<Vec<f64>>> = sections
         .iter()
         .map(|(_, shots)| {
@@ -939,96 +614,101 @@ pub fn write_grid(path: &Path, spec: &FigureSpec) -> Result<FigureInfo> {
     let g = best_layout(spec, title_h);
     let (up, down) = display_scale(reference.width);
     let shown = path.display();
-    let root = BitMapBackend::new(path, (g.width as u32, g.height as u32)).into_drawing_area();
-    root.fill(&WHITE).map_err(de)?;
-    let ts = fit(&spec.title, title_size, g.width - 2 * MARGIN);
-    put(
-        &root,
-        &spec.title,
-        (MARGIN, MARGIN),
-        ts,
-        TEXT,
-        (HPos::Left, VPos::Top),
-    )?;
-    for (text, x, y, w) in &g.headings {
-        let size = fit(text, 17.0, *w);
+    let size = (g.width as u32, g.height as u32);
+    let mut buffer = vec![0u8; g.width as usize * g.height as usize * 3];
+    {
+        let root = BitMapBackend::with_buffer(&mut buffer, size).into_drawing_area();
+        root.fill(&WHITE).map_err(de)?;
+        let ts = fit(&spec.title, title_size, g.width - 2 * MARGIN);
         put(
             &root,
-            text,
-            (*x, y + HEAD_H - 6),
-            size,
+            &spec.title,
+            (MARGIN, MARGIN),
+            ts,
             TEXT,
-            (HPos::Left, VPos::Bottom),
+            (HPos::Left, VPos::Top),
         )?;
-        root.draw(&PathElement::new(
-            vec![(*x, y + HEAD_H - 2), (x + w, y + HEAD_H - 2)],
-            RGBColor(180, 180, 180).stroke_width(1),
-        ))
-        .map_err(de)?;
-    }
-    let (w, h) = (reference.width, reference.height);
-    let show = |rgb: Vec<u8>| resample(&rgb, w, h, up, down).0;
-    let second = g.second();
-    let caption = |x: i32, y: i32, head: &str, tail: Option<&str>| -> Result<()> {
-        let lines = caption_lines(head, tail, g.cell_w);
-        let base = y + g.caption_h() - 5 - (lines.len() as i32 - 1) * LINE_H;
-        for (k, line) in lines.iter().enumerate() {
-            let size = fit(line, CAPTION_SIZE, g.cell_w);
+        for (text, x, y, w) in &g.headings {
+            let size = fit(text, 17.0, *w);
             put(
                 &root,
-                line,
-                (x, base + k as i32 * LINE_H),
+                text,
+                (*x, y + HEAD_H - 6),
                 size,
                 TEXT,
                 (HPos::Left, VPos::Bottom),
             )?;
+            root.draw(&PathElement::new(
+                vec![(*x, y + HEAD_H - 2), (x + w, y + HEAD_H - 2)],
+                RGBColor(180, 180, 180).stroke_width(1),
+            ))
+            .map_err(de)?;
         }
-        Ok(())
-    };
+        let (w, h) = (reference.width, reference.height);
+        let show = |rgb: Vec<u8>| resample(&rgb, w, h, up, down).bytes;
+        let second = g.second();
+        let caption = |x: i32, y: i32, head: &str, tail: Option<&str>| -> Result<()> {
+            let lines = caption_lines(head, tail, g.cell_w);
+            let base = y + g.caption_h() - 5 - (lines.len() as i32 - 1) * LINE_H;
+            for (k, line) in lines.iter().enumerate() {
+                let size = fit(line, CAPTION_SIZE, g.cell_w);
+                put(
+                    &root,
+                    line,
+                    (x, base + k as i32 * LINE_H),
+                    size,
+                    TEXT,
+                    (HPos::Left, VPos::Bottom),
+                )?;
+            }
+            Ok(())
+        };
 
-    // The reference, its labels, and the colour bar beside or below it.
-    let (rx, ry) = g.reference;
-    let r = &cmp.reference;
-    caption(
-        rx,
-        ry,
-        &format!("{} · {} spp · {}", r.method, r.spp, fmt_time(r.time_s)),
-        None,
-    )?;
-    let top = ry + g.caption_h();
-    blit(&root, show(reference.to_srgb8(&lobe_render::ToneMap::default())), (rx, top), (g.dw, g.dh))?;
-    let k = g.dw as f64 / w as f64;
-    let label_size = (f64::from(g.dh) / 15.0).clamp(9.0, 13.0);
-    for l in &spec.labels {
-        draw_label(
-            &root,
-            &l.text,
-            (
-                (l.x * k).round() as i32 + rx,
-                (l.y * k).round() as i32 + top,
-            ),
-            label_size,
+        // The reference, its labels, and the colour bar beside or below it.
+        let (rx, ry) = g.reference;
+        let r = &cmp.reference;
+        caption(
+            rx,
+            ry,
+            &format!("{} · {} spp · {}", r.method, r.spp, fmt_time(r.time_s)),
+            None,
         )?;
-    }
-    draw_colorbar(&root, (rx + second.0, top + second.1), (g.dw, g.dh), &scale)?;
-
-    for (c, (_, shots)) in sections.iter().enumerate() {
-        for (i, s) in shots.iter().enumerate() {
-            let (x, y) = g.cells[c][i];
-            let (head, tail) = shot_caption(s);
-            caption(x, y, &head, tail.as_deref())?;
-            let top = y + g.caption_h();
-            blit(&root, show(s.image.to_srgb8(&lobe_render::ToneMap::default())), (x, top), (g.dw, g.dh))?;
-            blit(
+        let top = ry + g.caption_h();
+        blit(&root, show(reference.to_srgb8(&lobe_render::ToneMap::default())), (rx, top), (g.dw, g.dh))?;
+        let k = g.dw as f64 / w as f64;
+        let label_size = (f64::from(g.dh) / 15.0).clamp(9.0, 13.0);
+        for l in &spec.labels {
+            draw_label(
                 &root,
-                show(error_rgb(&maps[c][i], &scale)),
-                (x + second.0, top + second.1),
-                (g.dw, g.dh),
+                &l.text,
+                (
+                    (l.x * k).round() as i32 + rx,
+                    (l.y * k).round() as i32 + top,
+                ),
+                label_size,
             )?;
         }
+        draw_colorbar(&root, (rx + second.0, top + second.1), (g.dw, g.dh), &scale)?;
+
+        for (c, (_, shots)) in sections.iter().enumerate() {
+            for (i, s) in shots.iter().enumerate() {
+                let (x, y) = g.cells[c][i];
+                let (head, tail) = shot_caption(s);
+                caption(x, y, &head, tail.as_deref())?;
+                let top = y + g.caption_h();
+                blit(&root, show(s.image.to_srgb8(&lobe_render::ToneMap::default())), (x, top), (g.dw, g.dh))?;
+                blit(
+                    &root,
+                    show(error_rgb(&maps[c][i], &scale)),
+                    (x + second.0, top + second.1),
+                    (g.dw, g.dh),
+                )?;
+            }
+        }
+        root.present()
+            .map_err(|e| anyhow!("drawing {shown}: {e}"))?;
     }
-    root.present()
-        .map_err(|e| anyhow!("cannot write {shown}: {e}"))?;
+    crate::figures::write_png(path, &buffer, size)?;
     Ok(FigureInfo {
         width: g.width as u32,
         height: g.height as u32,
@@ -1141,7 +821,7 @@ pub fn print_table(cmp: &Comparison) {
         r.spp,
         fmt_time(r.time_s)
     );
-    for (heading, shots) in cmp.sections() {
+    for (heading, shots) in sections(cmp) {
         println!("{heading}");
         println!(
             "  {:<15} {:>8} {:>10} {:>12}",
@@ -1190,7 +870,6 @@ pub fn run(args: &CompareArgs) -> Result<()> {
         max_depth: scene.options.max_depth,
         threads: args.threads.map(|t| t as usize),
         equal_time: true,
-        quiet: args.quiet,
     };
     for w in &scene.warnings {
         eprintln!("lobe: warning: {w}");
@@ -1211,7 +890,7 @@ pub fn run(args: &CompareArgs) -> Result<()> {
             );
         }
     }
-    let cmp = run_comparison(&scene, &settings);
+    let cmp = run_with_progress(&scene, &settings, args.quiet);
     let png = crate::common::with_ext(&base, "png");
     let json = crate::common::with_ext(&base, "json");
     let (w, h) = (scene.camera.width, scene.camera.height);

@@ -1,40 +1,21 @@
 //! `lobe converge`: how fast the error of each strategy and sample sequence
-//! falls with the number of samples.
-//!
-//! For every strategy × sequence and every `N = 2^0 .. 2^K`, `R` independent
-//! estimates of the luminance of `L_o(wo)` are compared with the quadrature
-//! reference; their root mean square error is plotted against `N` on log-log
-//! axes, and the slope of that line is fitted by least squares over the upper
-//! half of the range of `log N` (the small-`N` end is dominated by the
-//! constant of the error, not by its rate). Plain Monte Carlo falls as
-//! `N^-1/2` (slope −0.5); stratified and Sobol points fall faster on smooth
-//! integrands.
-//!
-//! Each estimate is a [`Plan`] of exactly `N` samples (as a renderer taking
-//! `N` samples would use), never a prefix of one long run, and run `r` at
-//! `N = 2^k` has its own seed `hash(S, r, k)`, so that the estimates at
-//! different `N` are independent of each other and the least-squares fit
-//! sees independent errors. The estimates run on rayon's pool, one task per
-//! (series, run, N); each task depends only on its inputs, so the numbers do
-//! not depend on the thread count.
+//! falls with the number of samples. The curves and slopes come from
+//! [`lobe::experiment::converge`]; this module parses the arguments, writes
+//! the CSV and the plots, and prints the slopes.
 
 use crate::common::with_ext;
-use crate::common::{LightArgs, ViewArgs, progress};
+use crate::common::{Bar, LightArgs, ViewArgs};
 use crate::figures::{self, Series};
 use anyhow::{Context, Result, bail};
 use clap::Args;
-use indicatif::ProgressBar;
-use lobe::estimator::Technique;
-use lobe::estimator::{Plan, ShadingPoint, estimate, reference};
+use lobe::estimator::{Technique, reference};
+use lobe::experiment::converge::{
+    Curve, CurveSettings, REFERENCE_TOLERANCE, curves, fit_start, product,
+};
 use lobe::math::luminance;
-use lobe::sequence::{Sequence, hash64};
-use lobe::{Light, Material};
-use rayon::prelude::*;
+use lobe::sequence::Sequence;
 use std::fmt::Write as _;
 use std::path::PathBuf;
-
-/// Relative tolerance of the quadrature reference.
-pub const REFERENCE_TOLERANCE: f64 = 1e-9;
 /// Largest accepted `--max-exp`: `N` up to 2^20 samples.
 pub const MAX_EXP: u32 = 20;
 
@@ -109,128 +90,8 @@ impl Setup {
     /// Every strategy × sequence, strategy-major.
     #[must_use]
     pub fn series(&self) -> Vec<(Technique, Sequence)> {
-        self.strategies
-            .iter()
-            .flat_map(|&s| self.sequences.iter().map(move |&q| (s, q)))
-            .collect()
+        product(&self.strategies, &self.sequences)
     }
-}
-
-/// The RMSE of one strategy × sequence at every `N`.
-#[derive(Debug, Clone)]
-pub struct Curve {
-    pub strategy: Technique,
-    pub sequence: Sequence,
-    /// `(N, RMSE)` for `N = 2^0 .. 2^K`.
-    pub points: Vec<(usize, f64)>,
-    /// Least-squares slope of log RMSE against log N over the upper half.
-    pub slope: Option<f64>,
-}
-
-/// The seed of run `run` at `N = 2^exp`.
-#[must_use]
-pub fn run_seed(seed: u64, run: usize, exp: u32) -> u64 {
-    hash64(hash64(hash64(seed) ^ run as u64) ^ u64::from(exp))
-}
-
-/// The first exponent of the fit: the upper half of `0..=max_exp`.
-#[must_use]
-pub fn fit_start(max_exp: u32) -> u32 {
-    max_exp.div_ceil(2)
-}
-
-/// Number of samples [`curves`] draws for `series` series (for a progress bar).
-#[must_use]
-pub fn total_samples(series: usize, runs: usize, max_exp: u32) -> u64 {
-    ((1u64 << (max_exp + 1)) - 1) * (series * runs) as u64
-}
-
-/// RMSE curves of `series` against the luminance `target`, each over `runs`
-/// runs at `N = 2^0 .. 2^max_exp`. Runs on rayon's pool; the result depends
-/// only on the arguments, not on the thread count.
-#[must_use]
-#[allow(clippy::too_many_arguments)]
-pub fn curves(
-    m: &Material,
-    sp: &ShadingPoint,
-    light: &Light,
-    target: f64,
-    series: &[(Technique, Sequence)],
-    runs: usize,
-    max_exp: u32,
-    seed: u64,
-    pb: &ProgressBar,
-) -> Vec<Curve> {
-    let exps = max_exp + 1;
-    // One task per (series, exponent, run), largest N first so that the long
-    // tasks start early and the pool ends evenly.
-    let mut tasks: Vec<(usize, u32, usize)> = Vec::new();
-    for k in (0..exps).rev() {
-        for i in 0..series.len() {
-            for r in 0..runs {
-                tasks.push((i, k, r));
-            }
-        }
-    }
-    let errors: Vec<f64> = tasks
-        .par_iter()
-        .map(|&(i, k, r)| {
-            let (strategy, sequence) = series[i];
-            let plan = Plan {
-                technique: strategy,
-                sequence,
-                samples: 1usize << k,
-                seed: run_seed(seed, r, k),
-            };
-            let acc = estimate(m, sp, light, &plan).expect("techniques are checked when parsed");
-            pb.inc(plan.samples as u64);
-            acc.lum.mean() - target
-        })
-        .collect();
-    // Sum the squared errors in task order: the same sums on any thread count.
-    let mut sq = vec![vec![0.0; exps as usize]; series.len()];
-    for (&(i, k, _), e) in tasks.iter().zip(&errors) {
-        sq[i][k as usize] += e * e;
-    }
-    let start = fit_start(max_exp) as usize;
-    series
-        .iter()
-        .zip(sq)
-        .map(|(&(strategy, sequence), sq)| {
-            let points: Vec<(usize, f64)> = sq
-                .iter()
-                .enumerate()
-                .map(|(k, s)| (1usize << k, (s / runs as f64).sqrt()))
-                .collect();
-            let slope = fit_slope(&points[start..]);
-            Curve {
-                strategy,
-                sequence,
-                points,
-                slope,
-            }
-        })
-        .collect()
-}
-
-/// Least-squares slope of `log RMSE` against `log N`, over the points whose
-/// RMSE is positive and finite; `None` with fewer than two such points.
-#[must_use]
-pub fn fit_slope(points: &[(usize, f64)]) -> Option<f64> {
-    let xy: Vec<(f64, f64)> = points
-        .iter()
-        .filter(|(_, e)| *e > 0.0 && e.is_finite())
-        .map(|&(n, e)| ((n as f64).log2(), e.log2()))
-        .collect();
-    if xy.len() < 2 {
-        return None;
-    }
-    let k = xy.len() as f64;
-    let mx = xy.iter().map(|p| p.0).sum::<f64>() / k;
-    let my = xy.iter().map(|p| p.1).sum::<f64>() / k;
-    let sxy: f64 = xy.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
-    let sxx: f64 = xy.iter().map(|p| (p.0 - mx) * (p.0 - mx)).sum();
-    (sxx > 0.0).then(|| sxy / sxx)
 }
 
 /// Parse a comma-separated list of sequences.
@@ -325,10 +186,9 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
         );
     }
     let sequences = parse_sequences(&args.sequence)?;
-    let m = crate::eval::load_material(&args.material)?;
+    let m = lobe::desc::load_material(&args.material)?;
     let wo = args.view.wo()?;
     let light = args.light.light()?;
-    let sp = args.light.shading_point(&light, wo)?;
     let strategies =
         crate::estimate::parse_techniques(&args.strategy, &m, m.best_bsdf_strategy(), 1, 1)?;
     let setup = Setup {
@@ -339,28 +199,27 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
         seed: args.seed,
     };
 
+    let sp = args.light.shading_point(&light, wo)?;
     let target = luminance(reference(&m, &sp, &light, REFERENCE_TOLERANCE));
     if !target.is_finite() {
         bail!("the quadrature reference is not finite ({target})");
     }
     let series = setup.series();
-    let pb = progress(
-        total_samples(series.len(), setup.runs, setup.max_exp),
-        "converge",
-        args.quiet,
-    );
+    let bar = Bar::new(args.quiet);
     let curves = curves(
         &m,
         &sp,
         &light,
         target,
         &series,
-        setup.runs,
-        setup.max_exp,
-        setup.seed,
-        &pb,
-    );
-    pb.finish_and_clear();
+        CurveSettings {
+            runs: setup.runs,
+            max_exp: setup.max_exp,
+            seed: setup.seed,
+        },
+        &bar,
+    )?;
+    bar.finish();
     if let Some(c) = curves
         .iter()
         .find(|c| c.points.iter().any(|p| !p.1.is_finite()))

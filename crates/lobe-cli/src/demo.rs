@@ -3,22 +3,26 @@
 //! 1. A short tour: for the lecture's models (Phong, Blinn-Phong,
 //!    Cook-Torrance with GGX and Beckmann) at θo = 30° under a white
 //!    furnace, uniform hemisphere sampling against the importance samplers
-//!    at the same number of samples ([`crate::estimate::run_table`]).
+//!    at the same number of samples ([`lobe::experiment::table::run_table`]).
 //! 2. The showcase: a row of spheres, two of each model, on a grey ground
 //!    under the built-in sky, rendered with BSDF sampling, light sampling
 //!    and MIS at equal samples next to a reference, drawn as the grid of
 //!    `lobe compare` with error maps and RMSE.
 
+use crate::common::Bar;
 use crate::compare::{
-    FigureSpec, Label, Settings, print_table, run_comparison, summary, write_grid, write_json,
+    FigureSpec, Label, print_table, run_with_progress, summary, write_grid, write_json,
 };
 use anyhow::{Context, Result};
 use clap::Args;
 use glam::DVec3;
 use lobe::estimator::{Heuristic, Technique};
+use lobe::experiment::table::{TableSettings, run_table};
 use lobe::math::luminance;
+use lobe::progress::SystemClock;
 use lobe::sequence::Sequence;
 use lobe::{Light, MaterialDesc, Rgb, Strategy};
+use lobe_render::compare::Settings;
 use lobe_render::{Camera, Object, Scene, load_envmap};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -133,16 +137,21 @@ fn tour(plan: &Plan, quiet: bool) -> Result<()> {
             .filter(|s| *s != Strategy::Cosine)
             .map(Technique::from)
             .collect();
-        let table = crate::estimate::run_table(
+        let bar = Bar::new(quiet);
+        let table = run_table(
             &m,
             &lobe::estimator::ShadingPoint::local(wo),
             &light,
             &techniques,
-            Sequence::Independent,
-            n,
-            1,
-            quiet,
+            TableSettings {
+                sequence: Sequence::Independent,
+                samples: n,
+                seed: 1,
+            },
+            &bar,
+            &SystemClock::new(),
         )?;
+        bar.finish();
         println!(
             "{label}: reference {:.5}",
             luminance(Rgb::from_array(table.reference))
@@ -288,7 +297,6 @@ fn showcase(plan: &Plan, dir: &Path, quiet: bool) -> Result<()> {
         max_depth: 1,
         threads: None,
         equal_time: false,
-        quiet,
     };
     println!(
         "lobe demo, part 2: the showcase, {}×{}: eight spheres (Phong, Blinn-Phong, GGX, Beckmann gold; a",
@@ -303,7 +311,7 @@ fn showcase(plan: &Plan, dir: &Path, quiet: bool) -> Result<()> {
     );
     std::fs::create_dir_all(dir)
         .with_context(|| format!("{}: cannot create the directory", dir.display()))?;
-    let cmp = run_comparison(&scene, &settings);
+    let cmp = run_with_progress(&scene, &settings, quiet);
     let png = dir.join("showcase.png");
     let json = dir.join("showcase.json");
     let figure = write_grid(

@@ -1,19 +1,15 @@
 //! `lobe estimate`: estimate the reflected radiance at one shading point with
 //! each strategy and measure its noise against a quadrature reference.
 
-use crate::common::{LightArgs, ViewArgs, estimate_par, progress};
+use crate::common::{Bar, LightArgs, ViewArgs};
 use anyhow::{Result, bail};
 use clap::Args;
 use glam::DVec3;
-use lobe::estimator::{Heuristic, Mis, MisForm, Plan, ShadingPoint, Technique};
-use lobe::math::luminance;
+use lobe::estimator::{Heuristic, Mis, MisForm, Technique};
+use lobe::experiment::table::{Table, TableSettings, run_table};
+use lobe::progress::SystemClock;
 use lobe::sequence::Sequence;
-use lobe::{Light, Material, Strategy};
-use serde::Serialize;
-use std::time::Instant;
-
-/// Relative tolerance of the quadrature reference.
-pub const REFERENCE_TOLERANCE: f64 = 1e-9;
+use lobe::{Material, Strategy};
 
 #[derive(Args, Debug)]
 #[command(
@@ -65,33 +61,6 @@ pub struct EstimateArgs {
     /// No progress bars
     #[arg(long, short)]
     pub quiet: bool,
-}
-
-/// One strategy's result.
-#[derive(Debug, Clone, Serialize)]
-pub struct Row {
-    pub name: String,
-    pub samples: usize,
-    pub mean: [f64; 3],
-    pub stderr: [f64; 3],
-    /// Relative error of the luminance of the mean against the reference.
-    pub relative_error: f64,
-    /// Per-sample variance of the luminance of f·L·cos/p.
-    pub variance: f64,
-    /// Uniform's variance over this one; `None` when this one is zero.
-    pub variance_reduction: Option<f64>,
-    pub time_s: f64,
-    /// 1/(variance × time); `None` when the variance is zero.
-    pub efficiency: Option<f64>,
-}
-
-/// A comparison of strategies at one shading point.
-#[derive(Debug, Clone, Serialize)]
-pub struct Table {
-    pub reference: [f64; 3],
-    pub reference_method: &'static str,
-    pub sequence: String,
-    pub strategies: Vec<Row>,
 }
 
 /// Parse `all` or a list of technique names: the BSDF strategies
@@ -170,88 +139,8 @@ pub fn parse_sequence(spec: &str) -> Result<Sequence> {
     })
 }
 
-#[allow(clippy::too_many_arguments)]
-/// Run every strategy with the same samples, sequence and seed; the
-/// variance reduction is against `uniform`, run too if not in the list.
-pub fn run_table(
-    m: &Material,
-    sp: &ShadingPoint,
-    light: &Light,
-    techniques: &[Technique],
-    sequence: Sequence,
-    samples: usize,
-    seed: u64,
-    quiet: bool,
-) -> Result<Table> {
-    let reference = crate::common::reference_par(m, sp, light, REFERENCE_TOLERANCE);
-    let r_lum = luminance(reference);
-    let uniform = Technique::Bsdf(Strategy::Uniform);
-    let mut todo: Vec<Technique> = techniques.to_vec();
-    if !todo.contains(&uniform) {
-        todo.push(uniform);
-    }
-    let pb = progress((samples * todo.len()) as u64, "estimating", quiet);
-    let mut rows: Vec<(Technique, Row)> = Vec::new();
-    for &s in &todo {
-        let plan = Plan {
-            technique: s,
-            sequence,
-            samples,
-            seed,
-        };
-        let t0 = Instant::now();
-        let acc = estimate_par(m, sp, light, &plan, &pb)?;
-        let time_s = t0.elapsed().as_secs_f64();
-        let mean = acc.mean();
-        let variance = acc.lum.variance();
-        let relative_error = if r_lum != 0.0 {
-            (luminance(mean) - r_lum).abs() / r_lum.abs()
-        } else {
-            luminance(mean).abs()
-        };
-        rows.push((
-            s,
-            Row {
-                name: s.name(),
-                samples,
-                mean: mean.to_array(),
-                stderr: acc.std_error().to_array(),
-                relative_error,
-                variance,
-                variance_reduction: None,
-                time_s,
-                efficiency: (variance > 0.0).then(|| 1.0 / (variance * time_s.max(1e-9))),
-            },
-        ));
-    }
-    pb.finish_and_clear();
-    let uniform = rows
-        .iter()
-        .find(|(s, _)| *s == uniform)
-        .map(|(_, r)| r.variance)
-        .unwrap_or(f64::NAN);
-    let mut out = Vec::new();
-    for (s, mut row) in rows {
-        if !techniques.contains(&s) {
-            continue;
-        }
-        row.variance_reduction = (row.variance > 0.0).then(|| uniform / row.variance);
-        out.push(row);
-    }
-    Ok(Table {
-        reference: reference.to_array(),
-        reference_method: if matches!(light, Light::Env(_)) {
-            "a sum over the map's texels of radiance × ∫ f cos dω (4×4 Gauss-Legendre per texel, refined to 1e-9 relative, f64)"
-        } else {
-            "deterministic adaptive quadrature (Gauss-Kronrod, f64, relative tolerance 1e-9)"
-        },
-        sequence: sequence.name().to_string(),
-        strategies: out,
-    })
-}
-
 pub fn run(args: &EstimateArgs) -> Result<()> {
-    let m = crate::eval::load_material(&args.material)?;
+    let m = lobe::desc::load_material(&args.material)?;
     let wo = args.view.wo()?;
     let light = args.light.light()?;
     if args.samples < 2 {
@@ -276,17 +165,22 @@ pub fn run(args: &EstimateArgs) -> Result<()> {
     let (n_bsdf, n_light) = parse_mis_samples(&args.mis_samples)?;
     let strategies = parse_techniques(&args.strategy, &m, mis_bsdf, n_bsdf, n_light)?;
     let sequence = parse_sequence(&args.sequence)?;
+    let bar = Bar::new(args.quiet);
     let sp = args.light.shading_point(&light, wo)?;
     let table = run_table(
         &m,
         &sp,
         &light,
         &strategies,
-        sequence,
-        args.samples,
-        args.seed,
-        args.quiet,
+        TableSettings {
+            sequence,
+            samples: args.samples,
+            seed: args.seed,
+        },
+        &bar,
+        &SystemClock::new(),
     )?;
+    bar.finish();
     for row in &table.strategies {
         if !row.mean.iter().chain(&row.stderr).all(|v| v.is_finite()) || !row.variance.is_finite() {
             bail!(

@@ -8,7 +8,7 @@
 use anyhow::{Result, anyhow};
 use clap::Args;
 use glam::{DVec2, DVec3};
-use lobe::{Material, MaterialDesc, Strategy};
+use lobe::{Material, Strategy};
 use serde::de::{self, DeserializeSeed, Deserializer, IgnoredAny, MapAccess, SeqAccess, Visitor};
 use serde::{Deserialize, Serialize};
 use std::cell::Cell;
@@ -77,7 +77,7 @@ fn after_long_help() -> String {
 
 /// Run `lobe eval`: stdin to stdout.
 pub fn run(args: &EvalArgs) -> Result<()> {
-    let material = load_material(&args.material)?;
+    let material = lobe::desc::load_material(&args.material)?;
     let mut out = BufWriter::with_capacity(1 << 16, io::stdout().lock());
     let result = process(&material, io::stdin().lock(), &mut out);
     // Flush what was computed before any error, so that the lines before a bad
@@ -570,99 +570,12 @@ fn unit_interval(key: Key, x: f64) -> Result<(), String> {
 // The material
 // ---------------------------------------------------------------------------
 
-/// Build the material from `--material`: JSON text, `@file.json` or
-/// `@file.toml`. Errors start with `material` (and the file) and name the
-/// field.
-pub fn load_material(arg: &str) -> Result<Material> {
-    let (desc, origin) = match arg.strip_prefix('@') {
-        Some("") => {
-            return Err(anyhow!(
-                "material: `@` needs a file name (@FILE.json or @FILE.toml)"
-            ));
-        }
-        Some(path) => {
-            let origin = format!("material (file {path})");
-            let text = std::fs::read_to_string(path)
-                .map_err(|e| anyhow!("{origin}: cannot read {path}: {e}"))?;
-            let is_toml = std::path::Path::new(path)
-                .extension()
-                .is_some_and(|x| x.eq_ignore_ascii_case("toml"));
-            let desc = if is_toml {
-                desc_from_toml(&text)
-            } else {
-                desc_from_json(&text)
-            };
-            (desc.map_err(|m| anyhow!("{origin}: {m}"))?, origin)
-        }
-        None => {
-            let origin = "material".to_string();
-            let desc = desc_from_json(arg).map_err(|m| {
-                if arg.trim_start().starts_with('{') {
-                    anyhow!("{origin}: {m}")
-                } else {
-                    anyhow!("{origin}: not a JSON object (give JSON text, @FILE.json or @FILE.toml): {m}")
-                }
-            })?;
-            (desc, origin)
-        }
-    };
-    desc.build().map_err(|e| anyhow!("{origin}: {e}"))
-}
-
-/// `field `a.b`: ` for an error below the top level, else nothing.
-fn field_prefix(path: &serde_path_to_error::Path) -> String {
-    let path = path.to_string();
-    if path == "." || path.is_empty() {
-        String::new()
-    } else {
-        format!("field `{path}`: ")
-    }
-}
-
-fn desc_from_json(text: &str) -> Result<MaterialDesc, String> {
-    let mut de = serde_json::Deserializer::from_str(text);
-    let desc: MaterialDesc = serde_path_to_error::deserialize(&mut de).map_err(|e| {
-        let prefix = field_prefix(e.path());
-        let inner = e.into_inner();
-        let kind = match inner.classify() {
-            serde_json::error::Category::Syntax | serde_json::error::Category::Eof => {
-                "invalid JSON: "
-            }
-            _ => "",
-        };
-        format!("{prefix}{kind}{inner}")
-    })?;
-    de.end().map_err(|e| format!("invalid JSON: {e}"))?;
-    Ok(desc)
-}
-
-fn desc_from_toml(text: &str) -> Result<MaterialDesc, String> {
-    let at = |e: &toml::de::Error| match e.span() {
-        Some(span) => {
-            let line = text.as_bytes()[..span.start.min(text.len())]
-                .iter()
-                .filter(|&&b| b == b'\n')
-                .count()
-                + 1;
-            format!(" (line {line})")
-        }
-        None => String::new(),
-    };
-    let de = toml::Deserializer::parse(text)
-        .map_err(|e| format!("invalid TOML: {}{}", e.message(), at(&e)))?;
-    serde_path_to_error::deserialize(de).map_err(|e| {
-        let prefix = field_prefix(e.path());
-        let inner = e.inner();
-        format!("{prefix}{}{}", inner.message(), at(inner))
-    })
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
 
     fn run_lines(material: &str, input: &str) -> Result<String, String> {
-        let m = load_material(material).map_err(|e| e.to_string())?;
+        let m = lobe::desc::load_material(material).map_err(|e| e.to_string())?;
         let mut out = Vec::new();
         match process(&m, input.as_bytes(), &mut out) {
             Ok(()) => Ok(String::from_utf8(out).unwrap()),

@@ -13,15 +13,12 @@
 
 use anyhow::{Result, anyhow, bail};
 use glam::{DVec2, DVec3};
-use lobe::math::luminance;
+use lobe::experiment::histogram::{WeightPixel, weight_pixels};
 use lobe::{Material, Strategy};
 use plotters::coord::Shift;
 use plotters::coord::ranged1d::{DefaultFormatting, KeyPointHint, Ranged};
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
-use rand::{RngExt, SeedableRng};
-use rand_pcg::Pcg64;
-use rayon::prelude::*;
 use std::path::Path;
 use std::sync::OnceLock;
 
@@ -132,7 +129,7 @@ pub fn polar_plot_scaled(
 /// appended to `title`.
 ///
 /// `observed` and `expected` are `res × res` grids laid out as
-/// [`projected_histograms`] returns them.
+/// [`lobe::experiment::histogram::projected_histograms`] returns them.
 ///
 /// Writes an SVG if `path` ends in `.svg`, a PNG (800×400) if `.png`.
 ///
@@ -166,106 +163,6 @@ pub fn warp_histogram(
             p_value,
         },
     )
-}
-
-/// Observed and expected sample counts of `material.sample(strategy, wo, ..)`
-/// over a `res × res` grid on the projected hemisphere (the unit disk of
-/// `(wi.x, wi.y)`), as `(observed, expected)`.
-///
-/// Layout: row-major, pixel `(i, j)` at index `j * res + i` covers
-/// `x ∈ [−1 + 2i/res, −1 + 2(i+1)/res)` and likewise `y` with `j`, so row 0
-/// is the bottom (`y = −1`). Pixels outside the disk hold zero.
-///
-/// The observed counts come from `samples` draws with the uniforms `uc`,
-/// `u.x`, `u.y` taken in that order from `Pcg64::seed_from_u64(seed)`, the
-/// same stream as [`lobe::stats::chi2::chi2_test`]; failed samples are
-/// counted in `samples` but fall in no pixel. The expected count of a pixel
-/// is `samples × ∫ pdf dω` over its directions: the pixel is cut into a few
-/// × a few cells in disk coordinates, each weighing the pdf at its centre by
-/// its solid angle `∫∫ dx dy / z` (computed exactly, so the pixels on the
-/// rim, where `1/z` blows up, are as accurate as the others).
-///
-/// `res` must be at least 1; the strategy must apply to the material (see
-/// [`Material::check`]), otherwise the pdf is meaningless.
-#[must_use]
-pub fn projected_histograms(
-    material: &Material,
-    strategy: Strategy,
-    wo: DVec3,
-    samples: usize,
-    seed: u64,
-    res: usize,
-) -> (Vec<f64>, Vec<f64>) {
-    projected_histograms_with_progress(material, strategy, wo, samples, seed, res, &|_| {})
-}
-
-/// [`projected_histograms`], calling `progress(k)` after every further `k`
-/// samples drawn (for a progress bar of length `samples`).
-#[must_use]
-pub fn projected_histograms_with_progress(
-    material: &Material,
-    strategy: Strategy,
-    wo: DVec3,
-    samples: usize,
-    seed: u64,
-    res: usize,
-    progress: &(dyn Fn(u64) + Sync),
-) -> (Vec<f64>, Vec<f64>) {
-    let res = res.max(1);
-    let mut observed = vec![0.0; res * res];
-    let mut rng = Pcg64::seed_from_u64(seed);
-    const STEP: usize = 1 << 16;
-    for n in 0..samples {
-        let uc: f64 = rng.random();
-        let ux: f64 = rng.random();
-        let uy: f64 = rng.random();
-        if let Some(s) = material.sample(strategy, wo, uc, DVec2::new(ux, uy)) {
-            let (i, j) = (disk_cell(s.wi.x, res), disk_cell(s.wi.y, res));
-            observed[j * res + i] += 1.0;
-        }
-        if (n + 1) % STEP == 0 {
-            progress(STEP as u64);
-        }
-    }
-    progress((samples % STEP) as u64);
-
-    // Each pixel is cut into sub × sub cells; a cell contributes the pdf at
-    // its centre (pulled inside the disk at the rim) times its exact solid
-    // angle, so the 1/z singularity of dω = dx dy / z at the rim costs no
-    // accuracy.
-    let sub = (512 / res).clamp(3, 8);
-    let h = 2.0 / res as f64;
-    let hs = h / sub as f64;
-    let n = samples as f64;
-    let expected = (0..res * res)
-        .into_par_iter()
-        .map(|k| {
-            let (i, j) = (k % res, k / res);
-            let mut acc = 0.0;
-            for b in 0..sub {
-                let y0 = -1.0 + j as f64 * h + b as f64 * hs;
-                for a in 0..sub {
-                    let x0 = -1.0 + i as f64 * h + a as f64 * hs;
-                    let omega = rect_solid_angle(x0, x0 + hs, y0, y0 + hs);
-                    if omega <= 0.0 {
-                        continue;
-                    }
-                    let mut c = DVec2::new(x0 + 0.5 * hs, y0 + 0.5 * hs);
-                    let r = c.length();
-                    if r > 1.0 - 1e-7 {
-                        c *= (1.0 - 1e-7) / r;
-                    }
-                    let wi = DVec3::new(c.x, c.y, (1.0 - c.length_squared()).max(0.0).sqrt());
-                    let p = material.pdf(strategy, wo, wi);
-                    if p.is_finite() && p > 0.0 {
-                        acc += p * omega;
-                    }
-                }
-            }
-            n * acc
-        })
-        .collect();
-    (observed, expected)
 }
 
 /// Draws a heat map over the projected hemisphere of the sample weight
@@ -333,64 +230,6 @@ pub fn viridis(t: f64) -> RGBColor {
     RGBColor(mix(a.0, b.0), mix(a.1, b.1), mix(a.2, b.2))
 }
 
-/// An antiderivative of `1/sqrt(1 − x² − y²)` in `x` and `y` over the unit
-/// disk (continuous up to its rim): `∂²F/∂x∂y = 1/z` and
-/// `∂F/∂y = asin(x / sqrt(1 − y²))`.
-fn solid_angle_antiderivative(x: f64, y: f64) -> f64 {
-    let half_asin = |num: f64, den2: f64| {
-        if den2 > 0.0 {
-            (num / den2.sqrt()).clamp(-1.0, 1.0).asin()
-        } else if num == 0.0 {
-            0.0
-        } else {
-            std::f64::consts::FRAC_PI_2.copysign(num)
-        }
-    };
-    let z = (1.0 - x * x - y * y).max(0.0).sqrt();
-    y * half_asin(x, 1.0 - y * y) + x * half_asin(y, 1.0 - x * x) - (x * y).atan2(z)
-}
-
-/// The solid angle of the directions whose `(x, y)` lie in the rectangle
-/// `[x0, x1] × [y0, y1]` and in the unit disk: `∫∫ dx dy / z`, exactly.
-fn rect_solid_angle(x0: f64, x1: f64, y0: f64, y1: f64) -> f64 {
-    use std::f64::consts::FRAC_PI_2;
-    let (ya, yb) = (y0.max(-1.0), y1.min(1.0));
-    if ya >= yb || x0 >= x1 {
-        return 0.0;
-    }
-    // Cut [ya, yb] where the rim crosses x = x0 and x = x1, so that in each
-    // piece each side of the rectangle is either inside the disk or not.
-    let mut cuts = vec![ya, yb];
-    for x in [x0, x1] {
-        if x.abs() < 1.0 {
-            let yc = (1.0 - x * x).sqrt();
-            cuts.extend([-yc, yc].into_iter().filter(|&v| v > ya && v < yb));
-        }
-    }
-    cuts.sort_by(f64::total_cmp);
-    let f = solid_angle_antiderivative;
-    let mut total = 0.0;
-    for w in cuts.windows(2) {
-        let (a, b) = (w[0], w[1]);
-        let c = (1.0 - (0.5 * (a + b)).powi(2)).max(0.0).sqrt();
-        if x1 <= -c || x0 >= c {
-            continue;
-        }
-        let upper = if x1 < c {
-            f(x1, b) - f(x1, a)
-        } else {
-            FRAC_PI_2 * (b - a)
-        };
-        let lower = if x0 > -c {
-            f(x0, b) - f(x0, a)
-        } else {
-            -FRAC_PI_2 * (b - a)
-        };
-        total += upper - lower;
-    }
-    total.max(0.0)
-}
-
 // ---------------------------------------------------------------------------
 // Rendering to a file
 // ---------------------------------------------------------------------------
@@ -402,6 +241,19 @@ type DResult<DB, T = ()> =
 trait Figure {
     fn size(&self) -> (u32, u32);
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DResult<DB>;
+}
+
+/// Writes RGB8 pixels (`size.0 × size.1`, row-major) as a PNG file.
+pub(crate) fn write_png(path: &Path, rgb: &[u8], size: (u32, u32)) -> Result<()> {
+    image::save_buffer_with_format(
+        path,
+        rgb,
+        size.0,
+        size.1,
+        image::ExtendedColorType::Rgb8,
+        image::ImageFormat::Png,
+    )
+    .map_err(|e| anyhow!("cannot write {}: {e}", path.display()))
 }
 
 /// Registers the embedded DejaVu Sans once; plotters' ab_glyph text needs it.
@@ -428,11 +280,16 @@ fn render(path: &Path, fig: &impl Figure) -> Result<()> {
         .map(str::to_ascii_lowercase);
     match ext.as_deref() {
         Some("png") => {
-            let root = BitMapBackend::new(path, fig.size()).into_drawing_area();
-            fig.draw(&root)
-                .map_err(|e| anyhow!("drawing {shown}: {e}"))?;
-            root.present()
-                .map_err(|e| anyhow!("cannot write {shown}: {e}"))?;
+            let (w, h) = fig.size();
+            let mut buffer = vec![0u8; w as usize * h as usize * 3];
+            {
+                let root = BitMapBackend::with_buffer(&mut buffer, (w, h)).into_drawing_area();
+                fig.draw(&root)
+                    .map_err(|e| anyhow!("drawing {shown}: {e}"))?;
+                root.present()
+                    .map_err(|e| anyhow!("drawing {shown}: {e}"))?;
+            }
+            write_png(path, &buffer, (w, h))?;
         }
         Some("svg") => {
             let root = SVGBackend::new(path, fig.size()).into_drawing_area();
@@ -1095,16 +952,6 @@ impl Figure for Polar<'_> {
 // Heat maps over the projected hemisphere
 // ---------------------------------------------------------------------------
 
-/// The pixel column (or row) holding coordinate `x ∈ [−1, 1]`.
-fn disk_cell(x: f64, res: usize) -> usize {
-    let i = ((x + 1.0) * 0.5 * res as f64).floor();
-    if i.is_nan() || i < 0.0 {
-        0
-    } else {
-        (i as usize).min(res - 1)
-    }
-}
-
 /// Where a disk map goes: a `size`-pixel square at `(x0, y0)` of the area.
 #[derive(Clone, Copy)]
 struct MapBox {
@@ -1375,47 +1222,6 @@ impl Figure for WarpHistogram<'_> {
     }
 }
 
-/// What a pixel of the weight map shows.
-#[derive(Clone, Copy, PartialEq)]
-enum WeightPixel {
-    Outside,
-    /// `f = 0`: the weight is zero.
-    ZeroF,
-    /// `f > 0` and `pdf = 0`: never sampled.
-    Unsampled,
-    Weight(f64),
-}
-
-fn weight_pixels(
-    material: &Material,
-    strategy: Strategy,
-    wo: DVec3,
-    res: usize,
-) -> Vec<WeightPixel> {
-    (0..res * res)
-        .into_par_iter()
-        .map(|k| {
-            let (i, j) = (k % res, k / res);
-            let x = -1.0 + (i as f64 + 0.5) * 2.0 / res as f64;
-            let y = -1.0 + (j as f64 + 0.5) * 2.0 / res as f64;
-            let r2 = x * x + y * y;
-            if r2 >= 1.0 {
-                return WeightPixel::Outside;
-            }
-            let wi = DVec3::new(x, y, (1.0 - r2).sqrt());
-            let f = luminance(material.eval(wo, wi));
-            let pdf = material.pdf(strategy, wo, wi);
-            if f.is_nan() || f <= 0.0 {
-                WeightPixel::ZeroF
-            } else if pdf.is_nan() || pdf <= 0.0 {
-                WeightPixel::Unsampled
-            } else {
-                WeightPixel::Weight(f * wi.z / pdf)
-            }
-        })
-        .collect()
-}
-
 struct WeightMap<'a> {
     title: &'a str,
     pixels: &'a [WeightPixel],
@@ -1645,7 +1451,16 @@ mod tests {
         ];
         let m = Material::lambert(lobe::Rgb::splat(0.8)).unwrap();
         let wo = DVec3::new(0.5, 0.0, 0.75f64.sqrt());
-        let (o, e) = projected_histograms(&m, Strategy::Cosine, wo, 10_000, 3, 16);
+        let h = lobe::experiment::histogram::projected_histograms(
+            &m,
+            Strategy::Cosine,
+            wo,
+            10_000,
+            3,
+            16,
+            &(),
+        );
+        let (o, e) = (h.observed, h.expected);
         let curves = vec![("a".to_string(), vec![(-1.0, 1.0), (0.0, 2.0), (1.0, 1.0)])];
         for ext in ["png", "svg"] {
             let p = |name: &str| dir.join(format!("{name}.{ext}"));
@@ -1677,63 +1492,5 @@ mod tests {
         if std::env::var_os("LOBE_FIGURES_DIR").is_none() {
             let _ = std::fs::remove_dir_all(&dir);
         }
-    }
-
-    #[test]
-    fn solid_angles_of_rectangles() {
-        use std::f64::consts::PI;
-        // Points on the rim lose about half the digits (z = sqrt of a rounding error).
-        let close = |a: f64, b: f64| (a - b).abs() < 1e-7 * b.abs().max(1.0);
-        assert!(close(rect_solid_angle(-1.0, 1.0, -1.0, 1.0), 2.0 * PI));
-        assert!(close(rect_solid_angle(0.0, 1.0, 0.0, 1.0), PI / 2.0));
-        assert!(close(rect_solid_angle(-2.0, 3.0, -1.5, 1.5), 2.0 * PI));
-        assert!(close(rect_solid_angle(0.3, 0.5, -1.0, 1.0), PI * 0.2));
-        assert!(close(rect_solid_angle(-1.0, 1.0, -0.7, -0.2), PI * 0.5));
-        assert_eq!(rect_solid_angle(0.8, 1.0, 0.8, 1.0), 0.0);
-        // Against a fine midpoint rule, on a rectangle that crosses the rim.
-        let (x0, x1, y0, y1) = (0.55, 0.8, 0.3, 0.9);
-        let m = 2000;
-        let mut num = 0.0;
-        for i in 0..m {
-            for j in 0..m {
-                let x = x0 + (x1 - x0) * (f64::from(i) + 0.5) / f64::from(m);
-                let y = y0 + (y1 - y0) * (f64::from(j) + 0.5) / f64::from(m);
-                let r2 = x * x + y * y;
-                if r2 < 1.0 {
-                    num += 1.0 / (1.0 - r2).sqrt();
-                }
-            }
-        }
-        num *= (x1 - x0) * (y1 - y0) / f64::from(m * m);
-        let exact = rect_solid_angle(x0, x1, y0, y1);
-        assert!((num / exact - 1.0).abs() < 2e-3, "{num} vs {exact}");
-    }
-
-    /// For a uniform pdf, the expected counts of a column of pixels are
-    /// `N × (x1 − x0) / 2` exactly, rim included.
-    #[test]
-    fn expected_counts_are_accurate_at_the_rim() {
-        let m = Material::lambert(lobe::Rgb::splat(0.8)).unwrap();
-        let wo = DVec3::new(0.0, 0.0, 1.0);
-        let res = 16;
-        let (_, e) = projected_histograms(&m, Strategy::Uniform, wo, 1_000_000, 1, res);
-        for i in 0..res {
-            let column: f64 = (0..res).map(|j| e[j * res + i]).sum();
-            let exact = 1_000_000.0 / res as f64;
-            assert!(
-                (column / exact - 1.0).abs() < 1e-6,
-                "column {i}: {column} vs {exact}"
-            );
-        }
-    }
-
-    #[test]
-    fn histograms_agree_for_cosine_sampling() {
-        let m = Material::lambert(lobe::Rgb::splat(0.8)).unwrap();
-        let wo = DVec3::new(0.5, 0.0, 0.75f64.sqrt());
-        let (o, e) = projected_histograms(&m, Strategy::Cosine, wo, 200_000, 3, 16);
-        let (so, se): (f64, f64) = (o.iter().sum(), e.iter().sum());
-        assert_eq!(so, 200_000.0);
-        assert!((se / 200_000.0 - 1.0).abs() < 2e-3, "{se}");
     }
 }

@@ -9,12 +9,13 @@
 //!
 //! The figures themselves are drawn by [`crate::figures`].
 
-use crate::common::{ViewArgs, progress};
-use crate::eval::load_material;
+use crate::common::{Bar, ViewArgs, progress};
 use crate::figures;
 use anyhow::{Context, Result, anyhow, bail};
 use clap::Args;
 use glam::DVec3;
+use lobe::desc::load_material;
+use lobe::experiment::histogram::projected_histograms;
 use lobe::math::luminance;
 use lobe::stats::chi2::{Chi2Config, chi2_test};
 use lobe::{Material, Strategy};
@@ -256,17 +257,9 @@ fn histogram(
     title: &str,
     path: &Path,
 ) -> Result<()> {
-    let pb = progress(args.samples as u64, "histogram", args.quiet);
-    let (observed, expected) = figures::projected_histograms_with_progress(
-        m,
-        s,
-        wo,
-        args.samples,
-        args.seed,
-        args.res,
-        &|k| pb.inc(k),
-    );
-    pb.finish_and_clear();
+    let bar = Bar::new(args.quiet);
+    let h = projected_histograms(m, s, wo, args.samples, args.seed, args.res, &bar);
+    bar.finish();
 
     let cfg = Chi2Config {
         samples: args.samples,
@@ -315,5 +308,12 @@ fn histogram(
             .map(|m| format!(" ({m})"))
             .unwrap_or_default()
     );
-    figures::warp_histogram(path, title, &observed, &expected, args.res, result.p_value)
+    figures::warp_histogram(
+        path,
+        title,
+        &h.observed,
+        &h.expected,
+        args.res,
+        result.p_value,
+    )
 }

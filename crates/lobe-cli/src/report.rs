@@ -5,7 +5,7 @@
 //!
 //! The work runs in two phases. First the comparison tables, one shading
 //! point after the other, each estimate on every thread
-//! ([`crate::estimate::run_table`]): nothing else runs meanwhile, so the
+//! ([`lobe::experiment::table::run_table`]): nothing else runs meanwhile, so the
 //! measured times (and the efficiencies) are not disturbed. Then everything
 //! else in parallel: convergence curves, polar plots, warp tests and weight
 //! maps. All numbers except the times depend only on the seed.
@@ -16,15 +16,17 @@
 //! the tests read from headless Chromium.
 
 use crate::common::progress;
-use crate::converge::{self, Curve};
-use crate::estimate::{Row, Table, run_table};
+use crate::converge;
 use crate::figures::{self, PolarScale};
 use anyhow::{Context, Result, anyhow};
 use clap::Args;
 use glam::{DVec2, DVec3};
-use indicatif::ProgressBar;
 use lobe::estimator::Technique;
+use lobe::experiment::converge::{Curve, CurveSettings, curves};
+use lobe::experiment::histogram::projected_histograms;
+use lobe::experiment::table::{Row, Table, TableSettings, run_table};
 use lobe::math::luminance;
+use lobe::progress::SystemClock;
 use lobe::sequence::{Sequence, hash64};
 use lobe::stats::chi2::{Chi2Config, chi2_test};
 use lobe::{Light, Material, MaterialDesc, Rgb, Strategy};
@@ -215,7 +217,8 @@ fn build(model: &Model, value: f64) -> Result<Material> {
 }
 
 fn view(theta: f64) -> DVec3 {
-    lobe::frame::wo_from_theta(theta, 0.0)
+    let t = theta.to_radians();
+    DVec3::new(t.sin(), 0.0, t.cos())
 }
 
 /// One shading point of a model: its table and lost-sample fractions.
@@ -326,10 +329,13 @@ pub fn run(args: &ReportArgs) -> Result<()> {
                     &lobe::estimator::ShadingPoint::local(view(theta)),
                     &light,
                     &techniques,
-                    Sequence::Independent,
-                    settings.samples,
-                    args.seed,
-                    true,
+                    TableSettings {
+                        sequence: Sequence::Independent,
+                        samples: settings.samples,
+                        seed: args.seed,
+                    },
+                    &(),
+                    &SystemClock::new(),
                 )?;
                 v.push((value, theta, t));
                 pb.inc(1);
@@ -448,17 +454,19 @@ fn run_job(
                 .map(|(_, _, t)| luminance(Rgb::from_array(t.reference)))
                 .ok_or_else(|| anyhow!("no table for the figure's configuration"))?;
             let series = convergence_series(m);
-            let curves = converge::curves(
+            let curves = curves(
                 m,
                 &lobe::estimator::ShadingPoint::local(wo),
                 &light,
                 target,
                 &series,
-                st.runs,
-                st.max_exp,
-                seed,
-                &ProgressBar::hidden(),
-            );
+                CurveSettings {
+                    runs: st.runs,
+                    max_exp: st.max_exp,
+                    seed,
+                },
+                &(),
+            )?;
             let file = format!("{}-convergence.png", model.id);
             let title = format!("{}: RMSE of {} runs", caption(model), st.runs);
             figures::convergence_plot(&dir.join(&file), &title, &converge::plot_series(&curves))
@@ -507,8 +515,7 @@ fn run_job(
                 |uc, u| m.sample(s, wo, uc, u).map(|x| x.wi),
                 |w| m.pdf(s, wo, w),
             );
-            let (observed, expected) =
-                figures::projected_histograms(m, s, wo, st.warp_samples, wseed, st.warp_res);
+            let h = projected_histograms(m, s, wo, st.warp_samples, wseed, st.warp_res, &());
             let file = format!("{}-warp-{}.png", model.id, s.name());
             let title = format!(
                 "{}, {} = {}, θo = {}°: {} sampler",
@@ -521,8 +528,8 @@ fn run_job(
             figures::warp_histogram(
                 &dir.join(&file),
                 &title,
-                &observed,
-                &expected,
+                &h.observed,
+                &h.expected,
                 st.warp_res,
                 chi2.p_value,
             )
@@ -1085,7 +1092,7 @@ fn section(h: &mut String, model: &Model, r: &ModelResult, st: &Settings) {
              (N&nbsp;≥&nbsp;2<sup>{}</sup>): {}.",
             st.runs,
             st.max_exp,
-            converge::fit_start(st.max_exp),
+            lobe::experiment::converge::fit_start(st.max_exp),
             slopes.join(", ")
         ),
     );

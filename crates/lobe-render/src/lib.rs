@@ -6,6 +6,8 @@
 //! ray's hit estimates the reflected radiance by BSDF sampling, light
 //! sampling or MIS exactly as `lobe::estimator` does, plus a shadow ray
 //! ([`mod@render`] module docs); `max_depth > 1` adds path tracing.
+//! [`compare`] renders several methods at equal samples and equal time
+//! against a reference and measures their errors.
 //!
 //! ```no_run
 //! use lobe_render::{load_scene, render};
@@ -33,6 +35,7 @@
 //! ```
 
 pub mod camera;
+pub mod compare;
 pub mod envmap_io;
 pub mod geometry;
 pub mod mesh;

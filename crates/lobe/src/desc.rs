@@ -171,17 +171,17 @@ pub struct MaterialDesc {
 }
 
 impl MaterialDesc {
-    /// Parse a JSON object; the error names the line, column and field.
+    /// Parse a JSON object (nothing may follow it); the error starts with
+    /// `material: ` and names the field, or says `invalid JSON` with the
+    /// line and column.
     pub fn from_json(text: &str) -> Result<Self, Error> {
-        let de = &mut serde_json::Deserializer::from_str(text);
-        serde_path_to_error::deserialize(de).map_err(|e| {
-            let path = e.path().to_string();
-            if path == "." {
-                Error::Parse(format!("material: {}", e.inner()))
-            } else {
-                Error::Parse(format!("material: field `{path}`: {}", e.inner()))
-            }
-        })
+        parse_json(text).map_err(|m| Error::Parse(format!("material: {m}")))
+    }
+
+    /// Parse a TOML table; the error starts with `material: ` and names the
+    /// field, or says `invalid TOML`, with the line.
+    pub fn from_toml(text: &str) -> Result<Self, Error> {
+        parse_toml(text).map_err(|m| Error::Parse(format!("material: {m}")))
     }
 
     /// A description with only the `type` set (every other key at its default).
@@ -235,6 +235,100 @@ impl MaterialDesc {
             ("fresnel", self.fresnel.is_some()),
         ]
     }
+}
+
+/// Build a material from a command-line style argument: JSON text, or
+/// `@FILE` naming a `.toml` file (TOML) or any other file (JSON). Every
+/// error starts with `material` (or `material (file FILE)`) and names the
+/// field at fault.
+pub fn load_material(arg: &str) -> Result<Material, Error> {
+    let fail = |m: String| Error::Parse(m);
+    let (desc, origin) = match arg.strip_prefix('@') {
+        Some("") => {
+            return Err(fail(
+                "material: `@` needs a file name (@FILE.json or @FILE.toml)".into(),
+            ));
+        }
+        Some(path) => {
+            let origin = format!("material (file {path})");
+            let text = std::fs::read_to_string(path)
+                .map_err(|e| fail(format!("{origin}: cannot read {path}: {e}")))?;
+            let is_toml = std::path::Path::new(path)
+                .extension()
+                .is_some_and(|x| x.eq_ignore_ascii_case("toml"));
+            let desc = if is_toml {
+                parse_toml(&text)
+            } else {
+                parse_json(&text)
+            };
+            (desc.map_err(|m| fail(format!("{origin}: {m}")))?, origin)
+        }
+        None => {
+            let origin = "material".to_string();
+            let desc = parse_json(arg).map_err(|m| {
+                if arg.trim_start().starts_with('{') {
+                    fail(format!("{origin}: {m}"))
+                } else {
+                    fail(format!(
+                        "{origin}: not a JSON object (give JSON text, @FILE.json or @FILE.toml): {m}"
+                    ))
+                }
+            })?;
+            (desc, origin)
+        }
+    };
+    desc.build().map_err(|e| fail(format!("{origin}: {e}")))
+}
+
+/// `field `a.b`: ` for an error below the top level, else nothing.
+fn field_prefix(path: &serde_path_to_error::Path) -> String {
+    let path = path.to_string();
+    if path == "." || path.is_empty() {
+        String::new()
+    } else {
+        format!("field `{path}`: ")
+    }
+}
+
+/// A JSON description; the message names the field or says `invalid JSON`.
+fn parse_json(text: &str) -> Result<MaterialDesc, String> {
+    let mut de = serde_json::Deserializer::from_str(text);
+    let desc: MaterialDesc = serde_path_to_error::deserialize(&mut de).map_err(|e| {
+        let prefix = field_prefix(e.path());
+        let inner = e.into_inner();
+        let kind = match inner.classify() {
+            serde_json::error::Category::Syntax | serde_json::error::Category::Eof => {
+                "invalid JSON: "
+            }
+            _ => "",
+        };
+        format!("{prefix}{kind}{inner}")
+    })?;
+    de.end().map_err(|e| format!("invalid JSON: {e}"))?;
+    Ok(desc)
+}
+
+/// A TOML description; the message names the field or says `invalid TOML`,
+/// with the line.
+fn parse_toml(text: &str) -> Result<MaterialDesc, String> {
+    let at = |e: &toml::de::Error| match e.span() {
+        Some(span) => {
+            let line = text.as_bytes()[..span.start.min(text.len())]
+                .iter()
+                .filter(|&&b| b == b'\n')
+                .count()
+                + 1;
+            format!(" (line {line})")
+        }
+        None => String::new(),
+    };
+    let de = toml::Deserializer::parse(text)
+        .map_err(|e| format!("invalid TOML: {}{}", e.message(), at(&e)))?;
+    serde_path_to_error::deserialize(de).map_err(|e| {
+        let prefix = field_prefix(e.path());
+        let inner = e.inner();
+        format!("{prefix}{}{}", inner.message(), at(inner))
+    })
 }
 
 impl FresnelDesc {
@@ -396,5 +490,90 @@ mod tests {
         );
         assert!(err(r#"{"type":"cook-torrance","alpha_u":0.1}"#).contains("alpha_v"));
         assert!(err(r#"{"type":"lambert","albedo":1.5}"#).contains("albedo"));
+    }
+
+    #[test]
+    fn toml_and_json_give_the_same_description() {
+        let j =
+            MaterialDesc::from_json(r#"{"type":"cook-torrance","alpha":0.2,"kd":[0.1,0.2,0.3]}"#)
+                .unwrap();
+        let t = MaterialDesc::from_toml(
+            "type = \"cook-torrance\"\nalpha = 0.2\nkd = [0.1, 0.2, 0.3]\n",
+        )
+        .unwrap();
+        assert_eq!(j, t);
+        let e = MaterialDesc::from_toml("type = \"phong\"\nexponnt = 3\n").unwrap_err();
+        assert!(
+            e.to_string()
+                .starts_with("material: field `exponnt`: unknown field `exponnt`"),
+            "{e}"
+        );
+        assert!(e.to_string().contains("(line 2)"), "{e}");
+        let e = MaterialDesc::from_toml("type = \n")
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("material: invalid TOML: "), "{e}");
+        let e = MaterialDesc::from_json(r#"{"type":"lambert"} x"#)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with("material: invalid JSON: trailing characters"),
+            "{e}"
+        );
+        let e = MaterialDesc::from_json(r#"{"type":"phong","ks":[1,"a",3]}"#)
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("material: field `ks"), "{e}");
+    }
+
+    #[test]
+    fn loader_reads_inline_text_and_files() {
+        let m = load_material(r#"{"type":"phong","exponent":10}"#).unwrap();
+        assert_eq!(
+            m.model_name(),
+            MaterialDesc::from_json(r#"{"type":"phong","exponent":10}"#)
+                .unwrap()
+                .build()
+                .unwrap()
+                .model_name()
+        );
+        let dir = std::env::temp_dir().join(format!("lobe-desc-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let toml_path = dir.join("m.toml");
+        std::fs::write(&toml_path, "type = \"lambert\"\nalbedo = 0.5\n").unwrap();
+        let m = load_material(&format!("@{}", toml_path.display())).unwrap();
+        assert_eq!(m.diffuse.albedo, Rgb::splat(0.5));
+        let json_path = dir.join("m.json");
+        std::fs::write(&json_path, r#"{"type":"lambert","albedo":2}"#).unwrap();
+        let e = load_material(&format!("@{}", json_path.display()))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with(&format!(
+                "material (file {}): field `albedo`",
+                json_path.display()
+            )),
+            "{e}"
+        );
+        let _ = std::fs::remove_dir_all(&dir);
+        assert_eq!(
+            load_material("@").unwrap_err().to_string(),
+            "material: `@` needs a file name (@FILE.json or @FILE.toml)"
+        );
+        let e = load_material("@/nonexistent/lobe.json")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with(
+                "material (file /nonexistent/lobe.json): cannot read /nonexistent/lobe.json: "
+            ),
+            "{e}"
+        );
+        let e = load_material("phong").unwrap_err().to_string();
+        assert!(e.starts_with("material: not a JSON object (give JSON text, @FILE.json or @FILE.toml): invalid JSON"), "{e}");
+        let e = load_material(r#"{"type":"glass"}"#)
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("material: field `type`"), "{e}");
     }
 }

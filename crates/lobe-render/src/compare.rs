@@ -1,0 +1,411 @@
+//! Comparisons of methods on one scene: renders at equal samples and at
+//! equal time next to a high-spp reference, with their error metrics and
+//! error maps (the numbers of `lobe compare` and of `lobe demo`'s
+//! showcase; the figure is the caller's).
+//!
+//! * **RMSE** ([`rmse`]): the root mean square, over all pixels and the
+//!   three channels, of the linear RGB difference from the reference.
+//! * **Error map** ([`error_map`]): per pixel, the relative error of
+//!   luminance `|Y − Y_ref| / (Y_ref + ε)`, with `ε` ([`error_epsilon`]) 1 %
+//!   of the reference's mean luminance (so that black pixels do not divide
+//!   by zero).
+//! * **Equal time**: the budget is the time of `mis` at equal samples (of
+//!   the slowest method when `mis` is not compared). Each method's
+//!   equal-samples render is its pilot: its time per sample per pixel gives
+//!   the spp that fit in the budget (at least 1), and the method is rendered
+//!   again with that spp.
+//! * **Reference**: [`REFERENCE_METHOD`] at the reference spp, with the
+//!   bitwise complement of the seed ([`reference_seed`]), so that its
+//!   samples are independent of the compared renders' (the same seed would
+//!   make `mis`'s first samples the reference's own and flatter its error).
+//!
+//! Nothing here prints or reads the system clock: progress goes to the
+//! caller's [`Progress`] and times come from the caller's [`Clock`].
+
+use crate::options::RenderOptions;
+use crate::render::{Image, render};
+use crate::scene::Scene;
+use lobe::Strategy;
+use lobe::estimator::{Heuristic, Technique};
+use lobe::math::luminance;
+use lobe::progress::{Clock, Progress, timed};
+use serde::Serialize;
+
+/// The method of the reference render.
+pub const REFERENCE_METHOD: Technique = Technique::mis(Heuristic::Balance);
+
+/// Most samples per pixel an equal-time render may take.
+pub const MAX_EQUAL_TIME_SPP: f64 = 1_048_576.0;
+
+/// What to compare and how.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Settings {
+    pub methods: Vec<Technique>,
+    /// Samples per pixel at equal samples.
+    pub spp: u32,
+    pub reference_spp: u32,
+    pub seed: u64,
+    pub max_depth: u32,
+    /// Threads of a local pool; `None` runs on rayon's current pool.
+    pub threads: Option<usize>,
+    /// Render the equal-time row too.
+    pub equal_time: bool,
+}
+
+/// One render of a comparison.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Shot {
+    pub method: Technique,
+    pub spp: u32,
+    /// Seconds the render took on the caller's clock.
+    pub time_s: f64,
+    /// Against the reference (0 for the reference itself; NaN before it is
+    /// measured).
+    pub rmse: f64,
+    pub image: Image,
+}
+
+/// The equal-time row.
+#[derive(Debug, Clone, PartialEq)]
+pub struct EqualTime {
+    /// The time each method was given, in seconds.
+    pub budget_s: f64,
+    /// Where the budget comes from, e.g. `the time of mis at 16 spp`.
+    pub budget_from: String,
+    /// One shot per method, in the order of the equal-samples row. A shot
+    /// whose spp equals the equal-samples spp is its pilot, not rendered
+    /// again.
+    pub shots: Vec<Shot>,
+}
+
+/// Every render of a comparison.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Comparison {
+    pub reference: Shot,
+    pub reference_seed: u64,
+    pub equal_samples: Vec<Shot>,
+    pub equal_time: Option<EqualTime>,
+}
+
+/// The default methods for `scene`: brdf, vndf (when an object's material
+/// has it), light and mis.
+#[must_use]
+pub fn default_methods(scene: &Scene) -> Vec<Technique> {
+    let mut v = vec![Technique::Bsdf(Strategy::Brdf)];
+    if scene
+        .objects
+        .iter()
+        .any(|o| o.material.check(Strategy::Vndf).is_ok())
+    {
+        v.push(Technique::Bsdf(Strategy::Vndf));
+    }
+    v.extend([Technique::Light, Technique::mis(Heuristic::Balance)]);
+    v
+}
+
+/// The seed of the reference: the complement of `seed`, so that its pixel
+/// streams are independent of the compared renders'.
+#[must_use]
+pub fn reference_seed(seed: u64) -> u64 {
+    !seed
+}
+
+/// The default reference spp: 16 × `spp`, at least 1024.
+#[must_use]
+pub fn default_reference_spp(spp: u32) -> u32 {
+    spp.saturating_mul(16).max(1024)
+}
+
+/// Renders `scene` with `opts`, timed on `clock`, as a [`Shot`] whose RMSE
+/// is not measured yet (NaN). Progress: one task `label` of one step per
+/// pixel.
+#[must_use]
+pub fn render_one(
+    scene: &Scene,
+    opts: &RenderOptions,
+    label: &str,
+    progress: &dyn Progress,
+    clock: &dyn Clock,
+) -> Shot {
+    let pixels = u64::from(scene.camera.width) * u64::from(scene.camera.height);
+    progress.start(label, pixels.saturating_mul(opts.spp));
+    let (image, time_s) = timed(clock, || render(scene, opts, |n| progress.advance(n)));
+    Shot {
+        method: opts.technique,
+        spp: u32::try_from(opts.spp).unwrap_or(u32::MAX),
+        time_s,
+        rmse: f64::NAN,
+        image,
+    }
+}
+
+/// The progress label of a render: `brdf 16 spp`, `brdf 40 spp, eq. time`,
+/// `reference 1024 spp`.
+fn label(method: Technique, spp: u32, what: &str) -> String {
+    match what {
+        "" => format!("{method} {spp} spp"),
+        "reference" => format!("reference {spp} spp"),
+        _ => format!("{method} {spp} spp, {what}"),
+    }
+}
+
+/// Renders every method at equal samples (and at equal time when
+/// `s.equal_time`), then the reference, and measures each render's RMSE
+/// against the reference. Each render is one progress task (see
+/// [`render_one`]); the times come from `clock`, and only the equal-time
+/// spp depend on them.
+#[must_use]
+pub fn run_comparison(
+    scene: &Scene,
+    s: &Settings,
+    progress: &dyn Progress,
+    clock: &dyn Clock,
+) -> Comparison {
+    let spp = s.spp.max(1);
+    let shot = |method: Technique, spp: u32, seed: u64, what: &str| {
+        let opts = RenderOptions {
+            spp: spp.into(),
+            technique: method,
+            seed,
+            max_depth: s.max_depth,
+            threads: s.threads,
+        };
+        render_one(scene, &opts, &label(method, spp, what), progress, clock)
+    };
+    let equal_samples: Vec<Shot> = s
+        .methods
+        .iter()
+        .map(|&m| shot(m, spp, s.seed, ""))
+        .collect();
+    let equal_time = s.equal_time.then(|| {
+        let mis = equal_samples
+            .iter()
+            .find(|x| x.method == Technique::mis(Heuristic::Balance));
+        let (budget_s, budget_from) = match mis {
+            Some(x) => (x.time_s, format!("the time of mis at {spp} spp")),
+            None => {
+                let slowest = equal_samples
+                    .iter()
+                    .max_by(|a, b| a.time_s.total_cmp(&b.time_s))
+                    .expect("at least one method");
+                (
+                    slowest.time_s,
+                    format!("the time of {} at {spp} spp, the slowest", slowest.method),
+                )
+            }
+        };
+        let shots = equal_samples
+            .iter()
+            .map(|pilot| {
+                let per_spp = pilot.time_s.max(1e-9) / f64::from(spp);
+                let n = (budget_s / per_spp).round().clamp(1.0, MAX_EQUAL_TIME_SPP) as u32;
+                if n == spp {
+                    return pilot.clone();
+                }
+                shot(pilot.method, n, s.seed, "eq. time")
+            })
+            .collect();
+        EqualTime {
+            budget_s,
+            budget_from,
+            shots,
+        }
+    });
+    let seed = reference_seed(s.seed);
+    let mut reference = shot(REFERENCE_METHOD, s.reference_spp.max(1), seed, "reference");
+    reference.rmse = 0.0;
+    let mut cmp = Comparison {
+        reference,
+        reference_seed: seed,
+        equal_samples,
+        equal_time,
+    };
+    let r = cmp.reference.image.clone();
+    for shot in cmp.shots_mut() {
+        shot.rmse = rmse(&shot.image, &r);
+    }
+    cmp
+}
+
+impl Comparison {
+    /// Every compared shot: equal samples, then equal time.
+    pub fn shots(&self) -> impl Iterator<Item = &Shot> {
+        self.equal_samples.iter().chain(
+            self.equal_time
+                .as_ref()
+                .map(|e| e.shots.iter())
+                .into_iter()
+                .flatten(),
+        )
+    }
+
+    fn shots_mut(&mut self) -> impl Iterator<Item = &mut Shot> {
+        self.equal_samples.iter_mut().chain(
+            self.equal_time
+                .as_mut()
+                .map(|e| e.shots.iter_mut())
+                .into_iter()
+                .flatten(),
+        )
+    }
+}
+
+/// Root mean square over all pixels and channels of the linear RGB
+/// difference `a − reference` (over the pixels both have; 0 for none).
+#[must_use]
+pub fn rmse(a: &Image, reference: &Image) -> f64 {
+    let n = a.pixels.len().min(reference.pixels.len());
+    if n == 0 {
+        return 0.0;
+    }
+    let sum: f64 = a
+        .pixels
+        .iter()
+        .zip(&reference.pixels)
+        .map(|(p, r)| (*p - *r).length_squared())
+        .sum();
+    (sum / (3 * n) as f64).sqrt()
+}
+
+/// `ε` of the error maps: 1 % of the reference's mean luminance (negative
+/// pixels counted as 0), or 1e-6 when that mean is not positive and finite.
+#[must_use]
+pub fn error_epsilon(reference: &Image) -> f64 {
+    let n = reference.pixels.len().max(1) as f64;
+    let mean = reference
+        .pixels
+        .iter()
+        .map(|p| luminance(*p).max(0.0))
+        .sum::<f64>()
+        / n;
+    if mean > 0.0 && mean.is_finite() {
+        0.01 * mean
+    } else {
+        1e-6
+    }
+}
+
+/// Per pixel, the relative error of luminance `|Y − Y_ref| / (Y_ref + ε)`
+/// (`Y_ref` clamped at 0), row-major like the images.
+#[must_use]
+pub fn error_map(image: &Image, reference: &Image, eps: f64) -> Vec<f64> {
+    image
+        .pixels
+        .iter()
+        .zip(&reference.pixels)
+        .map(|(p, r)| {
+            let yr = luminance(*r).max(0.0);
+            (luminance(*p) - yr).abs() / (yr + eps)
+        })
+        .collect()
+}
+
+/// Decades an error colour scale spans.
+pub const SCALE_DECADES: i32 = 4;
+
+/// A logarithmic colour scale from `lo` to `hi` (both powers of ten).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct LogScale {
+    pub lo: f64,
+    pub hi: f64,
+}
+
+impl LogScale {
+    /// The scale of `maps`: its top is the power of ten at or above the
+    /// 99th percentile of the positive finite values (1 when there are
+    /// none), and it spans [`SCALE_DECADES`] decades.
+    #[must_use]
+    pub fn of(maps: &[Vec<f64>]) -> LogScale {
+        let mut v: Vec<f64> = maps
+            .iter()
+            .flatten()
+            .copied()
+            .filter(|x| *x > 0.0 && x.is_finite())
+            .collect();
+        let top = if v.is_empty() {
+            0
+        } else {
+            let k = ((v.len() - 1) as f64 * 0.99).round() as usize;
+            let (_, p, _) = v.select_nth_unstable_by(k, f64::total_cmp);
+            p.log10().ceil() as i32
+        };
+        LogScale {
+            lo: 10f64.powi(top - SCALE_DECADES),
+            hi: 10f64.powi(top),
+        }
+    }
+
+    /// Position of `x` on the scale, clamped to [0, 1] (0 for NaN).
+    #[must_use]
+    pub fn t(&self, x: f64) -> f64 {
+        if x.is_nan() || x <= self.lo {
+            return 0.0;
+        }
+        ((x.log10() - self.lo.log10()) / (self.hi.log10() - self.lo.log10())).clamp(0.0, 1.0)
+    }
+}
+
+/// An RGB8 picture (`w × h`, row-major, 3 bytes a pixel) and its size.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Rgb8 {
+    pub bytes: Vec<u8>,
+    pub width: usize,
+    pub height: usize,
+}
+
+/// Resizes the RGB8 picture `rgb` of `w × h` pixels: by the integer factor
+/// `up` when it is above 1 (nearest neighbour), else down by `down` when it
+/// is above 1 (box average, rounded; the size is `w / down × h / down`, at
+/// least 1), else unchanged.
+#[must_use]
+pub fn resample(rgb: &[u8], w: usize, h: usize, up: usize, down: usize) -> Rgb8 {
+    if up > 1 {
+        let (ow, oh) = (w * up, h * up);
+        let mut out = vec![0u8; ow * oh * 3];
+        for y in 0..oh {
+            for x in 0..ow {
+                let s = ((y / up) * w + x / up) * 3;
+                let d = (y * ow + x) * 3;
+                out[d..d + 3].copy_from_slice(&rgb[s..s + 3]);
+            }
+        }
+        Rgb8 {
+            bytes: out,
+            width: ow,
+            height: oh,
+        }
+    } else if down > 1 {
+        let (ow, oh) = ((w / down).max(1), (h / down).max(1));
+        let mut out = vec![0u8; ow * oh * 3];
+        for y in 0..oh {
+            for x in 0..ow {
+                let mut acc = [0u32; 3];
+                let mut cnt = 0u32;
+                for yy in y * down..((y + 1) * down).min(h) {
+                    for xx in x * down..((x + 1) * down).min(w) {
+                        let s = (yy * w + xx) * 3;
+                        for c in 0..3 {
+                            acc[c] += u32::from(rgb[s + c]);
+                        }
+                        cnt += 1;
+                    }
+                }
+                let d = (y * ow + x) * 3;
+                for c in 0..3 {
+                    out[d + c] = ((acc[c] + cnt / 2) / cnt.max(1)) as u8;
+                }
+            }
+        }
+        Rgb8 {
+            bytes: out,
+            width: ow,
+            height: oh,
+        }
+    } else {
+        Rgb8 {
+            bytes: rgb.to_vec(),
+            width: w,
+            height: h,
+        }
+    }
+}

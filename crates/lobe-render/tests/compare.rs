@@ -1,0 +1,217 @@
+//! `lobe_render::compare`, called directly: error metrics on known images,
+//! resampling, and a whole comparison under a fake clock.
+
+use glam::DVec3;
+use lobe::Strategy;
+use lobe::envmap::EnvMap;
+use lobe::estimator::Heuristic;
+use lobe::progress::{Clock, Progress};
+use lobe::{Material, Rgb};
+use lobe_render::compare::{
+    LogScale, REFERENCE_METHOD, Settings, default_methods, default_reference_spp, error_epsilon,
+    error_map, reference_seed, resample, rmse, run_comparison,
+};
+use lobe_render::{Camera, Image, Method, Object, Scene};
+use std::sync::Mutex;
+use std::time::Duration;
+
+fn image(w: usize, h: usize, f: impl Fn(usize) -> Rgb) -> Image {
+    let mut img = Image::new(w, h);
+    for (k, p) in img.pixels.iter_mut().enumerate() {
+        *p = f(k);
+    }
+    img
+}
+
+#[test]
+fn metrics_of_identical_images_are_zero() {
+    let a = image(5, 4, |k| Rgb::new(k as f64, 0.5, 2.0));
+    assert_eq!(rmse(&a, &a), 0.0);
+    let eps = error_epsilon(&a);
+    assert!(error_map(&a, &a, eps).iter().all(|&e| e == 0.0));
+    assert_eq!(error_map(&a, &a, eps).len(), 20);
+}
+
+#[test]
+fn metrics_of_known_differences() {
+    let r = image(4, 2, |_| Rgb::splat(1.0));
+    let a = image(4, 2, |k| {
+        if k == 0 {
+            Rgb::new(4.0, 1.0, 1.0)
+        } else {
+            Rgb::ONE
+        }
+    });
+    // One channel of one pixel off by 3: sqrt(9 / (3 × 8)).
+    assert!((rmse(&a, &r) - (9.0f64 / 24.0).sqrt()).abs() < 1e-15);
+    assert!((error_epsilon(&r) - 0.01).abs() < 1e-15);
+    let black = Image::new(4, 2);
+    assert_eq!(error_epsilon(&black), 1e-6);
+    let b = image(4, 2, |_| Rgb::splat(1.5));
+    let map = error_map(&b, &r, 0.01);
+    assert!(
+        map.iter().all(|&e| (e - 0.5 / 1.01).abs() < 1e-12),
+        "{map:?}"
+    );
+    assert_eq!(rmse(&Image::new(0, 0), &r), 0.0);
+}
+
+#[test]
+fn log_scale() {
+    let s = LogScale::of(&[vec![0.003, 0.02, 0.0, f64::NAN], vec![0.5]]);
+    assert_eq!((s.lo, s.hi), (1e-4, 1.0));
+    assert_eq!(s.t(1.0), 1.0);
+    assert_eq!(s.t(1e-4), 0.0);
+    assert!((s.t(1e-2) - 0.5).abs() < 1e-12);
+    assert_eq!(s.t(f64::NAN), 0.0);
+    let empty = LogScale::of(&[]);
+    assert_eq!((empty.lo, empty.hi), (1e-4, 1.0));
+}
+
+#[test]
+fn resample_preserves_a_constant_image() {
+    let (w, h) = (6, 4);
+    let rgb: Vec<u8> = (0..w * h).flat_map(|_| [10u8, 200, 77]).collect();
+    for (up, down) in [(1, 1), (3, 1), (1, 2), (1, 4)] {
+        let r = resample(&rgb, w, h, up, down);
+        let (ew, eh) = if up > 1 {
+            (w * up, h * up)
+        } else {
+            ((w / down).max(1), (h / down).max(1))
+        };
+        assert_eq!((r.width, r.height), (ew, eh), "up {up} down {down}");
+        assert_eq!(r.bytes.len(), ew * eh * 3);
+        assert!(
+            r.bytes.chunks(3).all(|p| p == [10, 200, 77]),
+            "up {up} down {down}"
+        );
+    }
+    // A box average of a 2×2 checker is its mean.
+    let checker = [0u8, 0, 0, 255, 255, 255, 255, 255, 255, 0, 0, 0];
+    assert_eq!(resample(&checker, 2, 2, 1, 2).bytes, vec![128, 128, 128]);
+}
+
+/// A clock whose `k`-th reading is `k²` seconds: the `i`-th timed render
+/// (readings `2i − 1` and `2i`) takes `4i − 1` seconds.
+struct Squares(Mutex<u64>);
+impl Clock for Squares {
+    fn now(&self) -> Duration {
+        let mut k = self.0.lock().unwrap();
+        *k += 1;
+        Duration::from_secs(*k * *k)
+    }
+}
+
+#[derive(Default)]
+struct Tasks(Mutex<Vec<(String, u64, u64)>>);
+impl Progress for Tasks {
+    fn start(&self, label: &str, total: u64) {
+        self.0.lock().unwrap().push((label.to_string(), total, 0));
+    }
+    fn advance(&self, n: u64) {
+        self.0.lock().unwrap().last_mut().unwrap().2 += n;
+    }
+}
+
+fn furnace() -> Scene {
+    let camera = Camera::new(DVec3::new(0.0, 0.0, 4.0), DVec3::ZERO, DVec3::Y, 40.0, 8, 6).unwrap();
+    Scene::new(camera, EnvMap::constant(Rgb::ONE)).with(
+        Object::sphere(
+            DVec3::ZERO,
+            1.0,
+            Material::lambert(Rgb::splat(0.5)).unwrap(),
+        )
+        .unwrap(),
+    )
+}
+
+#[test]
+fn a_comparison_under_a_fake_clock() {
+    let scene = furnace();
+    assert_eq!(
+        default_methods(&scene),
+        [
+            Method::Bsdf(Strategy::Brdf),
+            Method::Light,
+            Method::Mis(Heuristic::Balance)
+        ]
+    );
+    let settings = Settings {
+        methods: vec![
+            Method::Bsdf(Strategy::Cosine),
+            Method::Mis(Heuristic::Balance),
+        ],
+        spp: 2,
+        reference_spp: 16,
+        seed: 9,
+        max_depth: 1,
+        threads: Some(1),
+        equal_time: true,
+    };
+    let tasks = Tasks::default();
+    let cmp = run_comparison(&scene, &settings, &tasks, &Squares(Mutex::new(0)));
+    // Renders: cosine 2 spp (3 s), mis 2 spp (7 s), cosine at equal time,
+    // the reference (mis at equal time is its pilot, not rendered again).
+    let labels: Vec<String> = tasks
+        .0
+        .lock()
+        .unwrap()
+        .iter()
+        .map(|t| t.0.clone())
+        .collect();
+    assert_eq!(
+        labels,
+        [
+            "cosine 2 spp",
+            "mis 2 spp",
+            "cosine 5 spp, eq. time",
+            "reference 16 spp"
+        ]
+    );
+    assert!(
+        tasks
+            .0
+            .lock()
+            .unwrap()
+            .iter()
+            .all(|t| t.1 == 48 && t.2 == 48)
+    );
+    assert_eq!(cmp.equal_samples[0].time_s, 3.0);
+    assert_eq!(cmp.equal_samples[1].time_s, 7.0);
+    let et = cmp.equal_time.as_ref().unwrap();
+    assert_eq!(et.budget_s, 7.0);
+    assert_eq!(et.budget_from, "the time of mis at 2 spp");
+    // 7 s at 1.5 s per spp: round(4.67) = 5 spp.
+    assert_eq!((et.shots[0].spp, et.shots[1].spp), (5, 2));
+    assert_eq!(et.shots[1], cmp.equal_samples[1]);
+    assert_eq!(cmp.reference.method, REFERENCE_METHOD);
+    assert_eq!(cmp.reference.spp, 16);
+    assert_eq!(cmp.reference_seed, reference_seed(9));
+    assert_eq!(cmp.reference.rmse, 0.0);
+    for s in cmp.shots() {
+        assert_eq!(s.rmse, rmse(&s.image, &cmp.reference.image));
+        assert!(s.rmse.is_finite());
+    }
+    // Cosine sampling of a Lambert sphere in a furnace is exact: its pixels
+    // on the sphere equal the reference's.
+    assert!(
+        cmp.equal_samples[0].rmse < 0.2,
+        "{}",
+        cmp.equal_samples[0].rmse
+    );
+    assert_eq!(reference_seed(9), !9);
+    assert_eq!(default_reference_spp(16), 1024);
+    assert_eq!(default_reference_spp(100), 1600);
+    // Without equal time: no equal-time row, three renders fewer.
+    let plain = run_comparison(
+        &scene,
+        &Settings {
+            equal_time: false,
+            ..settings
+        },
+        &(),
+        &Squares(Mutex::new(0)),
+    );
+    assert!(plain.equal_time.is_none());
+    assert_eq!(plain.equal_samples[0].image, cmp.equal_samples[0].image);
+}

@@ -1,0 +1,135 @@
+//! Experiments: the numbers behind every table and figure of the `lobe`
+//! command line, as plain functions of plain values.
+//!
+//! * [`table`]: one shading point, every technique, against a quadrature
+//!   reference (`lobe estimate`).
+//! * [`converge`]: RMSE against the number of samples, with fitted slopes
+//!   (`lobe converge`).
+//! * [`histogram`]: sample histograms and sample weights over the projected
+//!   hemisphere (`lobe plot`).
+//!
+//! Progress and time reach these functions only through the
+//! [`Progress`](crate::progress::Progress) and [`Clock`](crate::progress::Clock)
+//! the caller passes. With the cargo feature `parallel` (on by default) the
+//! work runs on rayon's pool; the work is cut into pieces that depend only on
+//! the inputs and merged in a fixed order, so the numbers are the same with
+//! or without the feature and for any thread count.
+
+pub mod converge;
+pub mod histogram;
+pub mod table;
+
+use crate::estimator::{
+    Accumulator, Plan, ShadingPoint, estimate_chunk, reference, reference_env_row,
+};
+use crate::progress::Progress;
+use crate::{Error, Light, Material, Rgb};
+
+/// `(0..n).map(f)` collected in index order: on rayon's pool with the
+/// feature `parallel`, else on this thread.
+#[cfg(feature = "parallel")]
+pub(crate) fn map_indices<T: Send>(n: usize, f: impl Fn(usize) -> T + Sync + Send) -> Vec<T> {
+    use rayon::prelude::*;
+    (0..n).into_par_iter().map(f).collect()
+}
+
+/// `(0..n).map(f)` collected in index order: on rayon's pool with the
+/// feature `parallel`, else on this thread.
+#[cfg(not(feature = "parallel"))]
+pub(crate) fn map_indices<T: Send>(n: usize, f: impl Fn(usize) -> T + Sync + Send) -> Vec<T> {
+    (0..n).map(f).collect()
+}
+
+/// [`crate::estimator::estimate`] with its chunks run in parallel (feature
+/// `parallel`) and merged in chunk order: the same numbers as the serial
+/// estimate, for any thread count. Calls `progress.advance(k)` after each
+/// chunk of `k` samples (it does not call `start`). The error says why the
+/// plan's technique does not apply to `m`.
+pub fn estimate_chunked(
+    m: &Material,
+    sp: &ShadingPoint,
+    light: &Light,
+    plan: &Plan,
+    progress: &dyn Progress,
+) -> Result<Accumulator, Error> {
+    let est = plan.technique.for_material(m)?;
+    let parts = map_indices(plan.chunks(), |c| {
+        let a = estimate_chunk(&est, sp, light, plan, c);
+        progress.advance(a.count() as u64);
+        a
+    });
+    let mut acc = Accumulator::default();
+    for p in &parts {
+        acc.merge(p);
+    }
+    Ok(acc)
+}
+
+/// [`crate::estimator::reference`], the reflected radiance `∫ f L cos dω`
+/// by quadrature, with an environment map's rows summed in parallel (feature
+/// `parallel`) in row order: the same number as the serial reference.
+#[must_use]
+pub fn reference_rows(m: &Material, sp: &ShadingPoint, light: &Light, rel: f64) -> Rgb {
+    match light {
+        Light::Env(map) => {
+            let rows = map_indices(map.size().1, |j| reference_env_row(m, sp, map, j, rel));
+            rows.iter().fold(Rgb::ZERO, |a, &b| a + b)
+        }
+        _ => reference(m, sp, light, rel),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::DVec3;
+    use crate::estimator::{Technique, estimate};
+    use crate::sequence::Sequence;
+    use crate::{Frame, Strategy};
+    use std::sync::Arc;
+    use std::sync::atomic::{AtomicU64, Ordering};
+
+    struct Count(AtomicU64);
+    impl Progress for Count {
+        fn advance(&self, n: u64) {
+            self.0.fetch_add(n, Ordering::Relaxed);
+        }
+    }
+
+    #[test]
+    fn chunked_estimate_equals_the_serial_one() {
+        let m = Material::lambert(Rgb::splat(0.7)).unwrap();
+        let sp = ShadingPoint::local(DVec3::new(0.5, 0.0, 0.75f64.sqrt()));
+        let light = Light::Beam {
+            dir: DVec3::new(0.2, 0.3, 0.9).normalize(),
+            exponent: 8.0,
+            radiance: Rgb::ONE,
+        };
+        for sequence in Sequence::ALL {
+            let plan = Plan {
+                technique: Technique::Bsdf(Strategy::Uniform),
+                sequence,
+                samples: 3 * crate::estimator::CHUNK + 17,
+                seed: 5,
+            };
+            let count = Count(AtomicU64::new(0));
+            let a = estimate_chunked(&m, &sp, &light, &plan, &count).unwrap();
+            assert_eq!(a, estimate(&m, &sp, &light, &plan).unwrap(), "{sequence}");
+            assert_eq!(count.0.load(Ordering::Relaxed), plan.samples as u64);
+        }
+    }
+
+    #[test]
+    fn row_reference_equals_the_serial_one() {
+        let m = Material::lambert(Rgb::splat(0.5)).unwrap();
+        let map = crate::envmap::EnvMap::sky(16, 8, 30.0, 40.0);
+        let light = Light::Env(Arc::new(map));
+        let sp = ShadingPoint {
+            frame: Frame::from_normal_tangent(DVec3::Y, DVec3::X).unwrap(),
+            wo: DVec3::Z,
+        };
+        let a = reference_rows(&m, &sp, &light, 1e-6);
+        assert_eq!(a, reference(&m, &sp, &light, 1e-6));
+        assert!(a.x > 0.0);
+    }
+}
