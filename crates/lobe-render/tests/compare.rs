@@ -4,14 +4,14 @@
 use glam::DVec3;
 use lobe::Strategy;
 use lobe::envmap::EnvMap;
-use lobe::estimator::Heuristic;
+use lobe::estimator::{Heuristic, Technique};
 use lobe::progress::{Clock, Progress};
 use lobe::{Material, Rgb};
 use lobe_render::compare::{
     LogScale, REFERENCE_METHOD, Settings, default_methods, default_reference_spp, error_epsilon,
     error_map, reference_seed, resample, rmse, run_comparison,
 };
-use lobe_render::{Camera, Image, Method, Object, Scene};
+use lobe_render::{Camera, Image, Object, Scene};
 use std::sync::Mutex;
 use std::time::Duration;
 
@@ -131,15 +131,15 @@ fn a_comparison_under_a_fake_clock() {
     assert_eq!(
         default_methods(&scene),
         [
-            Method::Bsdf(Strategy::Brdf),
-            Method::Light,
-            Method::Mis(Heuristic::Balance)
+            Technique::Bsdf(Strategy::Brdf),
+            Technique::Light,
+            Technique::mis(Heuristic::Balance)
         ]
     );
     let settings = Settings {
         methods: vec![
-            Method::Bsdf(Strategy::Cosine),
-            Method::Mis(Heuristic::Balance),
+            Technique::Bsdf(Strategy::Cosine),
+            Technique::mis(Heuristic::Balance),
         ],
         spp: 2,
         reference_spp: 16,
