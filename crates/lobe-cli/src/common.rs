@@ -73,7 +73,7 @@ pub fn parse_vec3(flag: &str, s: &str) -> Result<DVec3> {
 #[derive(Args, Debug, Clone)]
 pub struct LightArgs {
     /// Lighting: `constant[:VALUE]` (the furnace, default 1);
-    /// `lobe[:K[:X,Y,Z[:VALUE]]]`, radiance VALUE·max(0, ω·d)^K toward the
+    /// `beam[:K[:X,Y,Z[:VALUE]]]`, radiance VALUE·max(0, ω·d)^K toward the
     /// world direction d (default K = 8, d = 0,1,0.5 normalized, VALUE = 1);
     /// `sky`, the built-in sky with a sun; or an equirectangular environment
     /// map FILE.hdr / FILE.exr (Mitsuba's convention, world +Y up)
@@ -143,14 +143,14 @@ pub fn parse_light(spec: &str, frame: &Frame) -> Result<Light> {
             }
             Ok(Light::Constant(Rgb::splat(v)))
         }
-        "lobe" => {
+        "beam" => {
             let k = parts.next().map_or(Ok(8.0), |s| number("exponent K", s))?;
             let d = parts.next().map_or(Ok(DVec3::new(0.0, 1.0, 0.5)), |s| {
                 parse_vec3("--light direction", s)
             })?;
             let v = parts.next().map_or(Ok(1.0), |s| number("value", s))?;
             if parts.next().is_some() {
-                bail!("--light {spec}: expected lobe[:K[:X,Y,Z[:VALUE]]]");
+                bail!("--light {spec}: expected beam[:K[:X,Y,Z[:VALUE]]]");
             }
             Ok(Light::Beam {
                 dir: frame.to_local(d.normalize()),
@@ -167,8 +167,11 @@ pub fn parse_light(spec: &str, frame: &Frame) -> Result<Light> {
             }
             Ok(Light::Env(std::sync::Arc::new(map)))
         }
+        "lobe" => bail!(
+            "--light {spec}: the analytic light `lobe` is now called `beam` (beam[:K[:X,Y,Z[:VALUE]]])"
+        ),
         _ => bail!(
-            "--light {spec}: unknown light `{kind}`, expected constant[:VALUE], lobe[:K[:X,Y,Z[:VALUE]]], sky, or an environment map FILE.hdr / FILE.exr"
+            "--light {spec}: unknown light `{kind}`, expected constant[:VALUE], beam[:K[:X,Y,Z[:VALUE]]], sky, or an environment map FILE.hdr / FILE.exr"
         ),
     }
 }

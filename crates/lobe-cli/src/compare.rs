@@ -11,12 +11,12 @@ use crate::common::Bar;
 use crate::figures::viridis;
 use anyhow::{Result, anyhow, bail};
 use clap::Args;
+use lobe::estimator::Strategy;
 use lobe::progress::SystemClock;
 use lobe_render::compare::{
-    Comparison, LogScale, Settings, Shot, default_methods, default_reference_spp, error_epsilon,
-    error_map, resample, run_comparison,
+    CompareSettings, Comparison, LogScale, Shot, default_methods, default_reference_spp,
+    error_epsilon, error_map, resample, run_comparison,
 };
-use lobe::estimator::Technique;
 use lobe_render::{fallbacks, load_scene};
 use plotters::coord::Shift;
 use plotters::element::BitMapElement;
@@ -79,16 +79,16 @@ pub struct CompareArgs {
 }
 
 /// Parse `--strategies`: a comma-separated list of method names, each once.
-pub fn parse_methods(spec: &str) -> Result<Vec<Technique>> {
+pub fn parse_methods(spec: &str) -> Result<Vec<Strategy>> {
     let mut v = Vec::new();
     for name in spec.split(',').map(str::trim) {
         if name.is_empty() {
             bail!(
                 "--strategies {spec}: an empty name; expected a comma-separated list of: {}",
-                Technique::names()
+                Strategy::names()
             );
         }
-        let m: Technique = name.parse().map_err(|e| anyhow!("--strategies: {e}"))?;
+        let m: Strategy = name.parse().map_err(|e| anyhow!("--strategies: {e}"))?;
         if !v.contains(&m) {
             v.push(m);
         }
@@ -145,7 +145,7 @@ pub fn warn_nonfinite(cmp: &Comparison) {
 #[must_use]
 pub fn run_with_progress(
     scene: &lobe_render::Scene,
-    settings: &Settings,
+    settings: &CompareSettings,
     quiet: bool,
 ) -> Comparison {
     let bar = Bar::new(quiet);
@@ -674,7 +674,12 @@ pub fn write_grid(path: &Path, spec: &FigureSpec) -> Result<FigureInfo> {
             None,
         )?;
         let top = ry + g.caption_h();
-        blit(&root, show(reference.to_srgb8(&lobe_render::ToneMap::default())), (rx, top), (g.dw, g.dh))?;
+        blit(
+            &root,
+            show(reference.to_srgb8(&lobe_render::ToneMap::default())),
+            (rx, top),
+            (g.dw, g.dh),
+        )?;
         let k = g.dw as f64 / w as f64;
         let label_size = (f64::from(g.dh) / 15.0).clamp(9.0, 13.0);
         for l in &spec.labels {
@@ -696,7 +701,12 @@ pub fn write_grid(path: &Path, spec: &FigureSpec) -> Result<FigureInfo> {
                 let (head, tail) = shot_caption(s);
                 caption(x, y, &head, tail.as_deref())?;
                 let top = y + g.caption_h();
-                blit(&root, show(s.image.to_srgb8(&lobe_render::ToneMap::default())), (x, top), (g.dw, g.dh))?;
+                blit(
+                    &root,
+                    show(s.image.to_srgb8(&lobe_render::ToneMap::default())),
+                    (x, top),
+                    (g.dw, g.dh),
+                )?;
                 blit(
                     &root,
                     show(error_rgb(&maps[c][i], &scale)),
@@ -782,7 +792,7 @@ fn shots_json(shots: &[Shot]) -> Vec<ShotJson> {
 
 /// The numbers of a comparison, for NAME.json.
 #[must_use]
-pub fn summary(scene: &str, s: &Settings, cmp: &Comparison, figure: FigureInfo) -> Summary {
+pub fn summary(scene: &str, s: &CompareSettings, cmp: &Comparison, figure: FigureInfo) -> Summary {
     let r = &cmp.reference;
     Summary {
         scene: scene.to_string(),
@@ -860,7 +870,7 @@ pub fn run(args: &CompareArgs) -> Result<()> {
         .spp
         .unwrap_or(u32::try_from(scene.options.spp).unwrap_or(u32::MAX))
         .max(1);
-    let settings = Settings {
+    let settings = CompareSettings {
         methods,
         spp,
         reference_spp: args

@@ -8,7 +8,7 @@ use crate::common::{Bar, LightArgs, ViewArgs};
 use crate::figures::{self, Series};
 use anyhow::{Context, Result, bail};
 use clap::Args;
-use lobe::estimator::{Technique, reference};
+use lobe::estimator::{Strategy, reference};
 use lobe::experiment::converge::{
     Curve, CurveSettings, REFERENCE_TOLERANCE, curves, fit_start, product,
 };
@@ -40,7 +40,7 @@ pub const MAX_EXP: u32 = 20;
                   be fitted, e.g. for an exact zero-variance estimator), PREFIX.svg and PREFIX.png, \
                   and prints the slopes.",
     after_help = "Examples:\n  \
-                  lobe converge --material '{\"type\":\"phong\",\"exponent\":10}' --theta 30 --light lobe:8 \\\n      \
+                  lobe converge --material '{\"type\":\"phong\",\"exponent\":10}' --theta 30 --light beam:8 \\\n      \
                   --strategy cosine,brdf --out conv/phong\n  \
                   lobe converge --material @ggx.toml --theta 75 --sequence independent,sobol --runs 64 --max-exp 18 --out ggx75"
 )]
@@ -79,7 +79,7 @@ pub struct ConvergeArgs {
 /// What to run: the series and the sample counts.
 #[derive(Debug, Clone)]
 pub struct Setup {
-    pub strategies: Vec<Technique>,
+    pub strategies: Vec<Strategy>,
     pub sequences: Vec<Sequence>,
     pub runs: usize,
     pub max_exp: u32,
@@ -89,7 +89,7 @@ pub struct Setup {
 impl Setup {
     /// Every strategy × sequence, strategy-major.
     #[must_use]
-    pub fn series(&self) -> Vec<(Technique, Sequence)> {
+    pub fn series(&self) -> Vec<(Strategy, Sequence)> {
         product(&self.strategies, &self.sequences)
     }
 }
@@ -190,7 +190,7 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
     let wo = args.view.wo()?;
     let light = args.light.light()?;
     let strategies =
-        crate::estimate::parse_techniques(&args.strategy, &m, m.best_bsdf_strategy(), 1, 1)?;
+        crate::estimate::parse_strategies(&args.strategy, &m, m.best_bsdf_strategy(), 1, 1)?;
     let setup = Setup {
         strategies,
         sequences,

@@ -16,13 +16,13 @@ use crate::compare::{
 use anyhow::{Context, Result};
 use clap::Args;
 use glam::DVec3;
-use lobe::estimator::{Heuristic, Technique};
+use lobe::estimator::{Heuristic, Strategy};
 use lobe::experiment::table::{TableSettings, run_table};
 use lobe::math::luminance;
 use lobe::progress::SystemClock;
 use lobe::sequence::Sequence;
-use lobe::{Light, MaterialDesc, Rgb, Strategy};
-use lobe_render::compare::Settings;
+use lobe::{BsdfStrategy, Light, MaterialDesc, Rgb};
+use lobe_render::compare::CompareSettings;
 use lobe_render::{Camera, Object, Scene, load_envmap};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -57,7 +57,7 @@ pub struct DemoArgs {
 }
 
 /// Sizes of the run.
-struct Plan {
+struct DemoSizes {
     tour_samples: usize,
     width: u32,
     height: u32,
@@ -65,10 +65,10 @@ struct Plan {
     reference_spp: u32,
 }
 
-impl Plan {
-    fn new(quick: bool) -> Plan {
+impl DemoSizes {
+    fn new(quick: bool) -> DemoSizes {
         if quick {
-            Plan {
+            DemoSizes {
                 tour_samples: 1024,
                 width: 96,
                 height: 30,
@@ -76,7 +76,7 @@ impl Plan {
                 reference_spp: 16,
             }
         } else {
-            Plan {
+            DemoSizes {
                 tour_samples: 65536,
                 width: 640,
                 height: 200,
@@ -107,7 +107,7 @@ const TOUR: [(&str, &str); 4] = [
 /// Run `lobe demo`.
 pub fn run(args: &DemoArgs) -> Result<()> {
     let t0 = Instant::now();
-    let plan = Plan::new(args.quick);
+    let plan = DemoSizes::new(args.quick);
     tour(&plan, args.quiet)?;
     showcase(&plan, &args.out, args.quiet)?;
     println!(
@@ -117,7 +117,7 @@ pub fn run(args: &DemoArgs) -> Result<()> {
     Ok(())
 }
 
-fn tour(plan: &Plan, quiet: bool) -> Result<()> {
+fn tour(plan: &DemoSizes, quiet: bool) -> Result<()> {
     let wo = crate::common::theta_to_wo(30.0)?;
     let light = Light::Constant(Rgb::ONE);
     let n = plan.tour_samples;
@@ -131,11 +131,11 @@ fn tour(plan: &Plan, quiet: bool) -> Result<()> {
     println!("times fewer samples it needs for the same noise.\n");
     for (label, json) in TOUR {
         let m = MaterialDesc::from_json(json)?.build()?;
-        let techniques: Vec<Technique> = m
+        let techniques: Vec<Strategy> = m
             .strategies()
             .into_iter()
-            .filter(|s| *s != Strategy::Cosine)
-            .map(Technique::from)
+            .filter(|s| *s != BsdfStrategy::Cosine)
+            .map(Strategy::from)
             .collect();
         let bar = Bar::new(quiet);
         let table = run_table(
@@ -283,13 +283,13 @@ fn showcase_scene(width: u32, height: u32) -> Result<(Scene, Vec<Label>)> {
     Ok((scene, labels))
 }
 
-fn showcase(plan: &Plan, dir: &Path, quiet: bool) -> Result<()> {
+fn showcase(plan: &DemoSizes, dir: &Path, quiet: bool) -> Result<()> {
     let (scene, labels) = showcase_scene(plan.width, plan.height)?;
-    let settings = Settings {
+    let settings = CompareSettings {
         methods: vec![
-            Technique::Bsdf(Strategy::Brdf),
-            Technique::Light,
-            Technique::mis(Heuristic::Balance),
+            Strategy::Bsdf(BsdfStrategy::Brdf),
+            Strategy::Light,
+            Strategy::mis(Heuristic::Balance),
         ],
         spp: plan.spp,
         reference_spp: plan.reference_spp,
@@ -330,7 +330,9 @@ fn showcase(plan: &Plan, dir: &Path, quiet: bool) -> Result<()> {
         &summary("built-in showcase", &settings, &cmp, figure),
     )?;
     let mut renders = vec![dir.join("reference.png")];
-    cmp.reference.image.write_png(&renders[0], &lobe_render::ToneMap::default())?;
+    cmp.reference
+        .image
+        .write_png(&renders[0], &lobe_render::ToneMap::default())?;
     for s in &cmp.equal_samples {
         let p = dir.join(format!("{}.png", s.method.name()));
         s.image.write_png(&p, &lobe_render::ToneMap::default())?;

@@ -5,11 +5,11 @@ use crate::common::{Bar, LightArgs, ViewArgs};
 use anyhow::{Result, bail};
 use clap::Args;
 use glam::DVec3;
-use lobe::estimator::{Heuristic, Mis, MisForm, Technique};
+use lobe::estimator::{Heuristic, Mis, MisForm, Strategy};
 use lobe::experiment::table::{Table, TableSettings, run_table};
 use lobe::progress::SystemClock;
 use lobe::sequence::Sequence;
-use lobe::{Material, Strategy};
+use lobe::{BsdfStrategy, Material};
 
 #[derive(Args, Debug)]
 #[command(
@@ -24,7 +24,7 @@ use lobe::{Material, Strategy};
                   1/(variance × time).",
     after_help = "Examples:\n  \
                   lobe estimate --material '{\"type\":\"phong\",\"exponent\":100}' --theta 30 --samples 65536\n  \
-                  lobe estimate --material @ggx.toml --theta 70 --light lobe:16:1,1,0 --strategy brdf,vndf --json\n  \
+                  lobe estimate --material @ggx.toml --theta 70 --light beam:16:1,1,0 --strategy brdf,vndf --json\n  \
                   lobe estimate --material '{\"type\":\"lambert\"}' --wo 0.3,0,1 --sequence sobol"
 )]
 pub struct EstimateArgs {
@@ -67,15 +67,15 @@ pub struct EstimateArgs {
 /// (uniform, cosine, brdf, vndf, spherical-caps, bounded-vndf), `light`,
 /// and MIS: `mis` (balance) and `mis-power`, multi-sample, or `mis-one` and
 /// `mis-power-one`, one-sample. Each is checked against the material.
-pub fn parse_techniques(
+pub fn parse_strategies(
     spec: &str,
     m: &Material,
-    mis_bsdf: Strategy,
+    mis_bsdf: BsdfStrategy,
     n_bsdf: u32,
     n_light: u32,
-) -> Result<Vec<Technique>> {
+) -> Result<Vec<Strategy>> {
     let mis = |h, form| {
-        Technique::Mis(Mis {
+        Strategy::Mis(Mis {
             bsdf: Some(mis_bsdf),
             heuristic: h,
             form,
@@ -84,9 +84,9 @@ pub fn parse_techniques(
         })
     };
     if spec == "all" {
-        let mut v: Vec<Technique> = m.strategies().into_iter().map(Technique::from).collect();
+        let mut v: Vec<Strategy> = m.strategies().into_iter().map(Strategy::from).collect();
         v.extend([
-            Technique::Light,
+            Strategy::Light,
             mis(Heuristic::Balance, MisForm::MultiSample),
             mis(Heuristic::Power, MisForm::MultiSample),
         ]);
@@ -95,20 +95,20 @@ pub fn parse_techniques(
     let mut v = Vec::new();
     for name in spec.split(',').map(str::trim) {
         let t = match name {
-            "light" => Technique::Light,
+            "light" => Strategy::Light,
             "mis" => mis(Heuristic::Balance, MisForm::MultiSample),
             "mis-power" => mis(Heuristic::Power, MisForm::MultiSample),
             "mis-one" => mis(Heuristic::Balance, MisForm::OneSample),
             "mis-power-one" => mis(Heuristic::Power, MisForm::OneSample),
             _ => {
-                let s: Strategy = name.parse().map_err(|_| {
+                let s: BsdfStrategy = name.parse().map_err(|_| {
                     anyhow::anyhow!(
                         "--strategy: unknown strategy `{name}`, expected all or a list of: {}, light, mis, mis-power, mis-one, mis-power-one",
-                        Strategy::names()
+                        BsdfStrategy::names()
                     )
                 })?;
                 m.check(s).map_err(|e| anyhow::anyhow!("--strategy: {e}"))?;
-                Technique::Bsdf(s)
+                Strategy::Bsdf(s)
             }
         };
         if !v.contains(&t) {
@@ -151,10 +151,10 @@ pub fn run(args: &EstimateArgs) -> Result<()> {
     }
     let mis_bsdf = match &args.mis_bsdf {
         Some(name) => {
-            let s: Strategy = name.parse().map_err(|_| {
+            let s: BsdfStrategy = name.parse().map_err(|_| {
                 anyhow::anyhow!(
                     "--mis-bsdf: unknown strategy `{name}`, expected one of: {}",
-                    Strategy::names()
+                    BsdfStrategy::names()
                 )
             })?;
             m.check(s).map_err(|e| anyhow::anyhow!("--mis-bsdf: {e}"))?;
@@ -163,7 +163,7 @@ pub fn run(args: &EstimateArgs) -> Result<()> {
         None => m.best_bsdf_strategy(),
     };
     let (n_bsdf, n_light) = parse_mis_samples(&args.mis_samples)?;
-    let strategies = parse_techniques(&args.strategy, &m, mis_bsdf, n_bsdf, n_light)?;
+    let strategies = parse_strategies(&args.strategy, &m, mis_bsdf, n_bsdf, n_light)?;
     let sequence = parse_sequence(&args.sequence)?;
     let bar = Bar::new(args.quiet);
     let sp = args.light.shading_point(&light, wo)?;

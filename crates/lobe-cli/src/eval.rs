@@ -8,7 +8,7 @@
 use anyhow::{Result, anyhow};
 use clap::Args;
 use glam::{DVec2, DVec3};
-use lobe::{Material, Strategy};
+use lobe::{BsdfStrategy, Material};
 use serde::de::{self, DeserializeSeed, Deserializer, IgnoredAny, MapAccess, SeqAccess, Visitor};
 use serde::{Deserialize, Serialize};
 use std::cell::Cell;
@@ -55,7 +55,7 @@ fn long_about() -> String {
          Empty lines are skipped. Numbers are printed so that they parse back to the same\n\
          f64. A bad line, or a result that is not finite, stops with an error that names\n\
          the line and the field.",
-        Strategy::names()
+        BsdfStrategy::names()
     )
 }
 
@@ -234,7 +234,7 @@ enum Key {
     Wi,
     U,
     Uc,
-    Strategy,
+    BsdfStrategy,
 }
 
 const KEY_NAMES: &str = "wo, wi, u, uc, strategy";
@@ -246,7 +246,7 @@ impl Key {
             Key::Wi => "wi",
             Key::U => "u",
             Key::Uc => "uc",
-            Key::Strategy => "strategy",
+            Key::BsdfStrategy => "strategy",
         }
     }
 }
@@ -265,7 +265,7 @@ impl<'de> Deserialize<'de> for Key {
                     "wi" => Key::Wi,
                     "u" => Key::U,
                     "uc" => Key::Uc,
-                    "strategy" => Key::Strategy,
+                    "strategy" => Key::BsdfStrategy,
                     _ => {
                         return Err(E::custom(format_args!(
                             "unknown key {v:?} (the keys are {KEY_NAMES})"
@@ -339,7 +339,7 @@ impl<'de, const N: usize> Deserialize<'de> for Numbers<N> {
 }
 
 /// A strategy given by name.
-struct StrategyName(Strategy);
+struct StrategyName(BsdfStrategy);
 
 impl<'de> Deserialize<'de> for StrategyName {
     fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
@@ -347,13 +347,13 @@ impl<'de> Deserialize<'de> for StrategyName {
         impl Visitor<'_> for V {
             type Value = StrategyName;
             fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
-                write!(f, "a strategy name ({})", Strategy::names())
+                write!(f, "a strategy name ({})", BsdfStrategy::names())
             }
             fn visit_str<E: de::Error>(self, v: &str) -> Result<StrategyName, E> {
                 v.parse().map(StrategyName).map_err(|_| {
                     E::custom(format_args!(
                         "unknown strategy {v:?}, expected one of: {}",
-                        Strategy::names()
+                        BsdfStrategy::names()
                     ))
                 })
             }
@@ -369,7 +369,7 @@ struct Query {
     wi: Option<[f64; 3]>,
     u: Option<[f64; 2]>,
     uc: Option<f64>,
-    strategy: Option<Strategy>,
+    strategy: Option<BsdfStrategy>,
 }
 
 /// Parses a line; records in `field` the key whose value is being read, so
@@ -420,7 +420,7 @@ impl<'de> Visitor<'de> for LineSeed<'_> {
                     twice(q.uc.is_some())?;
                     q.uc = Some(map.next_value::<Num>()?.0);
                 }
-                Key::Strategy => {
+                Key::BsdfStrategy => {
                     twice(q.strategy.is_some())?;
                     q.strategy = Some(map.next_value::<StrategyName>()?.0);
                 }
@@ -469,7 +469,7 @@ enum Request {
         wi: DVec3,
     },
     Sample {
-        strategy: Strategy,
+        strategy: BsdfStrategy,
         wo: DVec3,
         u: DVec2,
         uc: f64,
@@ -478,7 +478,7 @@ enum Request {
 
 impl Query {
     /// Check the keys present, the vectors and the strategy.
-    fn check(self, material: &Material, strategies: &[Strategy]) -> Result<Request, String> {
+    fn check(self, material: &Material, strategies: &[BsdfStrategy]) -> Result<Request, String> {
         const KINDS: &str =
             "an eval line has wo and wi; a sample line has wo, u, strategy and optionally uc";
         let wo = self

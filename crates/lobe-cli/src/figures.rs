@@ -14,7 +14,7 @@
 use anyhow::{Result, anyhow, bail};
 use glam::{DVec2, DVec3};
 use lobe::experiment::histogram::{WeightPixel, weight_pixels};
-use lobe::{Material, Strategy};
+use lobe::{BsdfStrategy, Material};
 use plotters::coord::Shift;
 use plotters::coord::ranged1d::{DefaultFormatting, KeyPointHint, Ranged};
 use plotters::prelude::*;
@@ -69,7 +69,7 @@ pub struct Series {
 ///
 /// An unknown extension, or the file cannot be written.
 pub fn convergence_plot(path: &Path, title: &str, series: &[Series]) -> Result<()> {
-    render(path, &Convergence { title, series })
+    save_figure(path, &Convergence { title, series })
 }
 
 /// Draws a polar plot of a BRDF in the plane of incidence: the upper half
@@ -112,7 +112,7 @@ pub fn polar_plot_scaled(
     curves: &[(String, Vec<(f64, f64)>)],
     scale: PolarScale,
 ) -> Result<()> {
-    render(
+    save_figure(
         path,
         &Polar {
             title,
@@ -153,7 +153,7 @@ pub fn warp_histogram(
             expected.len()
         );
     }
-    render(
+    save_figure(
         path,
         &WarpHistogram {
             title,
@@ -185,7 +185,7 @@ pub fn weight_heatmap(
     path: &Path,
     title: &str,
     material: &Material,
-    strategy: Strategy,
+    strategy: BsdfStrategy,
     wo: DVec3,
     res: usize,
 ) -> Result<()> {
@@ -193,7 +193,7 @@ pub fn weight_heatmap(
         bail!("weight_heatmap: res must be at least 1");
     }
     let pixels = weight_pixels(material, strategy, wo, res);
-    render(
+    save_figure(
         path,
         &WeightMap {
             title,
@@ -271,7 +271,7 @@ pub(crate) fn register_fonts() -> Result<()> {
     }
 }
 
-fn render(path: &Path, fig: &impl Figure) -> Result<()> {
+fn save_figure(path: &Path, fig: &impl Figure) -> Result<()> {
     register_fonts()?;
     let shown = path.display();
     let ext = path
@@ -1453,7 +1453,7 @@ mod tests {
         let wo = DVec3::new(0.5, 0.0, 0.75f64.sqrt());
         let h = lobe::experiment::histogram::projected_histograms(
             &m,
-            Strategy::Cosine,
+            BsdfStrategy::Cosine,
             wo,
             10_000,
             3,
@@ -1473,7 +1473,7 @@ mod tests {
             convergence_plot(&p("convergence-empty"), "no data", &[]).unwrap();
             polar_plot(&p("polar"), "polar", &curves).unwrap();
             warp_histogram(&p("histogram"), "cosine", &o, &e, 16, 0.5).unwrap();
-            weight_heatmap(&p("weights"), "weights", &m, Strategy::Uniform, wo, 16).unwrap();
+            weight_heatmap(&p("weights"), "weights", &m, BsdfStrategy::Uniform, wo, 16).unwrap();
             for name in [
                 "convergence",
                 "convergence-empty",

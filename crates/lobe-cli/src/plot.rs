@@ -18,7 +18,7 @@ use lobe::desc::load_material;
 use lobe::experiment::histogram::projected_histograms;
 use lobe::math::luminance;
 use lobe::stats::chi2::{Chi2Config, chi2_test};
-use lobe::{Material, Strategy};
+use lobe::{BsdfStrategy, Material};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::time::Duration;
@@ -97,10 +97,10 @@ pub fn run(args: &PlotArgs) -> Result<()> {
     let needs_strategy = kinds.iter().any(|&k| k != Kind::Polar);
     let strategy = match (&args.strategy, needs_strategy) {
         (Some(s), _) => {
-            let s: Strategy = s.parse().map_err(|_| {
+            let s: BsdfStrategy = s.parse().map_err(|_| {
                 anyhow!(
                     "--strategy {s}: unknown strategy, expected one of: {}",
-                    Strategy::names()
+                    BsdfStrategy::names()
                 )
             })?;
             if needs_strategy {
@@ -113,7 +113,7 @@ pub fn run(args: &PlotArgs) -> Result<()> {
         (None, true) => bail!(
             "--strategy is needed for --kind {}: one of {}",
             args.kind,
-            Strategy::names()
+            BsdfStrategy::names()
         ),
         (None, false) => None,
     };
@@ -169,7 +169,7 @@ pub fn run(args: &PlotArgs) -> Result<()> {
 fn prepare_dir(dir: &Path) -> Result<()> {
     std::fs::create_dir_all(dir)
         .with_context(|| format!("--out {}: cannot create the directory", dir.display()))?;
-    let probe = dir.join(format!(".lobe-plot-probe-{}", std::process::id()));
+    let probe = dir.join(format!(".component-plot-probe-{}", std::process::id()));
     std::fs::write(&probe, b"")
         .with_context(|| format!("--out {}: cannot write in the directory", dir.display()))?;
     let _ = std::fs::remove_file(&probe);
@@ -252,7 +252,7 @@ fn polar_curves(m: &Material) -> Vec<(String, Vec<(f64, f64)>)> {
 fn histogram(
     args: &PlotArgs,
     m: &Material,
-    s: Strategy,
+    s: BsdfStrategy,
     wo: DVec3,
     title: &str,
     path: &Path,

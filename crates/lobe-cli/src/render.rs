@@ -3,7 +3,7 @@
 use crate::common::progress;
 use anyhow::{Result, anyhow, bail};
 use clap::Args;
-use lobe::estimator::Technique;
+use lobe::estimator::Strategy;
 use lobe_render::{fallbacks, load_scene, render};
 use std::path::PathBuf;
 use std::time::Instant;
@@ -49,7 +49,12 @@ pub struct RenderArgs {
     pub out: Option<PathBuf>,
     /// Exposure of the PNG in stops: the linear image times 2^EV before the
     /// tone curve (the EXR stays linear)
-    #[arg(long, value_name = "EV", default_value_t = 0.0, allow_hyphen_values = true)]
+    #[arg(
+        long,
+        value_name = "EV",
+        default_value_t = 0.0,
+        allow_hyphen_values = true
+    )]
     pub exposure: f64,
     /// No progress bar and no notes
     #[arg(long, short)]
@@ -94,12 +99,15 @@ Examples:
 pub fn run(args: &RenderArgs) -> Result<()> {
     let base = crate::common::output_base(args.out.as_deref(), &args.scene, &["exr", "png"], "")?;
     if !args.exposure.is_finite() || args.exposure.abs() > 64.0 {
-        bail!("--exposure {}: must be a number of stops in [-64, 64]", args.exposure);
+        bail!(
+            "--exposure {}: must be a number of stops in [-64, 64]",
+            args.exposure
+        );
     }
     if args.spp == Some(0) {
         bail!("--spp 0: at least 1 sample per pixel");
     }
-    let method: Option<Technique> = match &args.strategy {
+    let method: Option<Strategy> = match &args.strategy {
         Some(s) => Some(s.parse().map_err(|m| anyhow!("--strategy: {m}"))?),
         None => None,
     };
@@ -109,7 +117,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         opts.spp = n;
     }
     if let Some(m) = method {
-        opts.technique = m;
+        opts.strategy = m;
     }
     if let Some(s) = args.seed {
         opts.seed = s;
@@ -120,7 +128,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         eprintln!("lobe: warning: {w}");
     }
     if !args.quiet {
-        for f in fallbacks(&scene, opts.technique) {
+        for f in fallbacks(&scene, opts.strategy) {
             eprintln!(
                 "lobe: note: object {} ({}): {} does not apply to its material, using {}",
                 f.object, f.model, f.requested, f.used
@@ -158,14 +166,19 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let exr = crate::common::with_ext(&base, "exr");
     let png = crate::common::with_ext(&base, "png");
     image.write_exr(&exr)?;
-    image.write_png(&png, &lobe_render::ToneMap { exposure: args.exposure })?;
+    image.write_png(
+        &png,
+        &lobe_render::ToneMap {
+            exposure: args.exposure,
+        },
+    )?;
     let samples = image.stats.camera_rays as f64;
     println!(
         "wrote {} and {} ({w}x{h}, {} spp, {}, max_depth {}): {:.2} s, {:.2} M samples/s, {:.2} M rays/s",
         exr.display(),
         png.display(),
         opts.spp,
-        opts.technique,
+        opts.strategy,
         opts.max_depth,
         secs,
         samples / secs.max(1e-9) / 1e6,

@@ -21,7 +21,7 @@ use crate::figures::{self, PolarScale};
 use anyhow::{Context, Result, anyhow};
 use clap::Args;
 use glam::{DVec2, DVec3};
-use lobe::estimator::Technique;
+use lobe::estimator::Strategy;
 use lobe::experiment::converge::{Curve, CurveSettings, curves};
 use lobe::experiment::histogram::projected_histograms;
 use lobe::experiment::table::{Row, Table, TableSettings, run_table};
@@ -29,7 +29,7 @@ use lobe::math::luminance;
 use lobe::progress::SystemClock;
 use lobe::sequence::{Sequence, hash64};
 use lobe::stats::chi2::{Chi2Config, chi2_test};
-use lobe::{Light, Material, MaterialDesc, Rgb, Strategy};
+use lobe::{BsdfStrategy, Light, Material, MaterialDesc, Rgb};
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64;
 use rayon::prelude::*;
@@ -74,7 +74,7 @@ pub struct ReportArgs {
 
 /// How much work the report does.
 #[derive(Debug, Clone, Copy)]
-struct Settings {
+struct ReportSizes {
     /// Samples per estimate in the tables.
     samples: usize,
     /// Runs and largest exponent of the convergence plots.
@@ -91,10 +91,10 @@ struct Settings {
     lost_samples: usize,
 }
 
-impl Settings {
+impl ReportSizes {
     fn new(quick: bool) -> Self {
         if quick {
-            Settings {
+            ReportSizes {
                 samples: 4096,
                 runs: 4,
                 max_exp: 8,
@@ -106,7 +106,7 @@ impl Settings {
                 lost_samples: 4096,
             }
         } else {
-            Settings {
+            ReportSizes {
                 samples: 1 << 16,
                 runs: 32,
                 max_exp: 14,
@@ -141,9 +141,9 @@ struct Model {
     /// the projected hemisphere.
     warp_theta: f64,
     /// Extra strategies whose sampler is warp-tested (brdf always is).
-    warp_extra: &'static [Strategy],
+    warp_extra: &'static [BsdfStrategy],
     /// Extra strategies whose weights are mapped (uniform and brdf always are).
-    heat_extra: &'static [Strategy],
+    heat_extra: &'static [BsdfStrategy],
     /// The material description for a parameter value.
     json: fn(f64) -> String,
     /// What the model is and how its brdf sampler works (HTML).
@@ -186,8 +186,8 @@ fn models() -> Vec<Model> {
             figure_value: 1,
             figure_theta: 75.0,
             warp_theta: 45.0,
-            warp_extra: &[Strategy::Vndf],
-            heat_extra: &[Strategy::Vndf],
+            warp_extra: &[BsdfStrategy::Vndf],
+            heat_extra: &[BsdfStrategy::Vndf],
             json: |a| format!(r#"{{"type":"cook-torrance","distribution":"ggx","alpha":{a}}}"#),
             intro: GGX_INTRO,
         },
@@ -200,7 +200,7 @@ fn models() -> Vec<Model> {
             figure_theta: 75.0,
             warp_theta: 45.0,
             warp_extra: &[],
-            heat_extra: &[Strategy::Vndf],
+            heat_extra: &[BsdfStrategy::Vndf],
             json: |a| {
                 format!(r#"{{"type":"cook-torrance","distribution":"beckmann","alpha":{a}}}"#)
             },
@@ -238,7 +238,7 @@ struct Figure {
 
 /// A warp test: the figure and its chi-square p-value.
 struct Warp {
-    strategy: Strategy,
+    strategy: BsdfStrategy,
     figure: Figure,
     p_value: f64,
     dof: usize,
@@ -255,15 +255,15 @@ struct ModelResult {
     convergence: Figure,
     polar: Figure,
     warps: Vec<Warp>,
-    heat: Vec<(Strategy, Figure)>,
+    heat: Vec<(BsdfStrategy, Figure)>,
 }
 
 /// The work of the second phase.
 enum Job {
     Convergence(usize),
     Polar(usize),
-    Warp(usize, Strategy),
-    Heat(usize, Strategy),
+    Warp(usize, BsdfStrategy),
+    Heat(usize, BsdfStrategy),
     Lost(usize),
 }
 
@@ -271,13 +271,13 @@ enum Done {
     Convergence(Vec<Curve>, Figure),
     Polar(Figure),
     Warp(Warp),
-    Heat(Strategy, Figure),
+    Heat(BsdfStrategy, Figure),
     Lost(Vec<Vec<f64>>),
 }
 
 pub fn run(args: &ReportArgs) -> Result<()> {
     let start = Instant::now();
-    let settings = Settings::new(args.quick);
+    let settings = ReportSizes::new(args.quick);
     let dir = &args.out;
     std::fs::create_dir_all(dir)
         .with_context(|| format!("--out: cannot create the directory {}", dir.display()))?;
@@ -300,11 +300,11 @@ pub fn run(args: &ReportArgs) -> Result<()> {
     for (i, model) in models.iter().enumerate() {
         jobs.push(Job::Convergence(i));
         jobs.push(Job::Polar(i));
-        jobs.push(Job::Warp(i, Strategy::Brdf));
+        jobs.push(Job::Warp(i, BsdfStrategy::Brdf));
         for &s in model.warp_extra {
             jobs.push(Job::Warp(i, s));
         }
-        for &s in [Strategy::Uniform, Strategy::Brdf]
+        for &s in [BsdfStrategy::Uniform, BsdfStrategy::Brdf]
             .iter()
             .chain(model.heat_extra)
         {
@@ -321,8 +321,8 @@ pub fn run(args: &ReportArgs) -> Result<()> {
     for (model, mats) in models.iter().zip(&materials) {
         let mut v = Vec::new();
         for (&value, m) in model.values.iter().zip(mats) {
-            let techniques: Vec<Technique> =
-                m.strategies().into_iter().map(Technique::from).collect();
+            let techniques: Vec<Strategy> =
+                m.strategies().into_iter().map(Strategy::from).collect();
             for &theta in &THETAS {
                 let t = run_table(
                     m,
@@ -428,7 +428,7 @@ fn run_job(
     models: &[Model],
     materials: &[Vec<Material>],
     tables: &[Vec<(f64, f64, Table)>],
-    st: &Settings,
+    st: &ReportSizes,
     seed: u64,
     dir: &Path,
 ) -> Result<Done> {
@@ -573,7 +573,7 @@ fn run_job(
                         .strategies
                         .iter()
                         .map(|row| {
-                            row.name.parse::<Strategy>().map_or(f64::NAN, |s| {
+                            row.name.parse::<BsdfStrategy>().map_or(f64::NAN, |s| {
                                 lost_fraction(m, s, view(*theta), st.lost_samples, seed)
                             })
                         })
@@ -588,32 +588,32 @@ fn run_job(
 /// The series of a report's convergence plot: every strategy but cosine and
 /// spherical caps (the same density as VNDF) with independent samples, and
 /// the best samplers with stratified and Sobol points.
-fn convergence_series(m: &Material) -> Vec<(Technique, Sequence)> {
+fn convergence_series(m: &Material) -> Vec<(Strategy, Sequence)> {
     let has = |s| m.check(s).is_ok();
     let mut v = vec![
-        (Strategy::Uniform.into(), Sequence::Independent),
-        (Strategy::Brdf.into(), Sequence::Independent),
-        (Strategy::Brdf.into(), Sequence::Stratified),
-        (Strategy::Brdf.into(), Sequence::Sobol),
+        (BsdfStrategy::Uniform.into(), Sequence::Independent),
+        (BsdfStrategy::Brdf.into(), Sequence::Independent),
+        (BsdfStrategy::Brdf.into(), Sequence::Stratified),
+        (BsdfStrategy::Brdf.into(), Sequence::Sobol),
     ];
-    if has(Strategy::Vndf) {
-        v.push((Strategy::Vndf.into(), Sequence::Independent));
-        v.push((Strategy::Vndf.into(), Sequence::Sobol));
+    if has(BsdfStrategy::Vndf) {
+        v.push((BsdfStrategy::Vndf.into(), Sequence::Independent));
+        v.push((BsdfStrategy::Vndf.into(), Sequence::Sobol));
     }
-    if has(Strategy::BoundedVndf) {
-        v.push((Strategy::BoundedVndf.into(), Sequence::Independent));
+    if has(BsdfStrategy::BoundedVndf) {
+        v.push((BsdfStrategy::BoundedVndf.into(), Sequence::Independent));
     }
     v
 }
 
 /// The strategies of the polar plot.
-fn polar_strategies(m: &Material) -> Vec<Strategy> {
+fn polar_strategies(m: &Material) -> Vec<BsdfStrategy> {
     [
-        Strategy::Uniform,
-        Strategy::Cosine,
-        Strategy::Brdf,
-        Strategy::Vndf,
-        Strategy::BoundedVndf,
+        BsdfStrategy::Uniform,
+        BsdfStrategy::Cosine,
+        BsdfStrategy::Brdf,
+        BsdfStrategy::Vndf,
+        BsdfStrategy::BoundedVndf,
     ]
     .into_iter()
     .filter(|&s| m.check(s).is_ok())
@@ -655,7 +655,7 @@ fn polar_curves(m: &Material, wo: DVec3) -> Vec<(String, Vec<(f64, f64)>)> {
 }
 
 /// Fraction of samples lost (below the horizon) by `s` at `wo`.
-fn lost_fraction(m: &Material, s: Strategy, wo: DVec3, samples: usize, seed: u64) -> f64 {
+fn lost_fraction(m: &Material, s: BsdfStrategy, wo: DVec3, samples: usize, seed: u64) -> f64 {
     let mut rng = Pcg64::seed_from_u64(hash64(seed ^ 0x6c6f_7374));
     let mut lost = 0usize;
     for _ in 0..samples {
@@ -1012,7 +1012,7 @@ fn slope_text(c: &Curve) -> String {
     }
 }
 
-fn section(h: &mut String, model: &Model, r: &ModelResult, st: &Settings) {
+fn section(h: &mut String, model: &Model, r: &ModelResult, st: &ReportSizes) {
     let fig_value = model.values[model.figure_value];
     let _ = writeln!(h, "<section id=\"{}\"><h2>{}</h2>", model.id, model.title);
     h.push_str(model.intro);
@@ -1173,14 +1173,14 @@ fn lost_note(w: &Warp) -> String {
     }
 }
 
-fn warp_note(model: &Model, s: Strategy) -> &'static str {
+fn warp_note(model: &Model, s: BsdfStrategy) -> &'static str {
     match (model.id, s) {
-        ("blinn-phong", Strategy::Brdf) => {
+        ("blinn-phong", BsdfStrategy::Brdf) => {
             " This sampler draws the half vector h, not ω<sub>i</sub>; its pdf includes the \
              Jacobian 1/(4&thinsp;ω<sub>o</sub>·h) of the reflection. Without it the right map \
              would not match the left one."
         }
-        ("ggx", Strategy::Vndf) => {
+        ("ggx", BsdfStrategy::Vndf) => {
             " VNDF draws only normals that face the viewer, so fewer of its samples are lost \
              than with <code>brdf</code> (the tables give the lost fraction at every view)."
         }
@@ -1211,7 +1211,7 @@ fn heat_note(model: &Model) -> &'static str {
 fn page(
     models: &[Model],
     results: &[ModelResult],
-    st: &Settings,
+    st: &ReportSizes,
     args: &ReportArgs,
     elapsed: f64,
 ) -> String {

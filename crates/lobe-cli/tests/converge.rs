@@ -4,10 +4,10 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-/// A smooth integrand: Phong n = 10 under a smooth lobe light, sampled with
+/// A smooth integrand: Phong n = 10 under a smooth beam light, sampled with
 /// the cosine strategy (`f·L·cos/p = π f L` is smooth over the square).
 const MATERIAL: &str = r#"{"type":"phong","exponent":10}"#;
-const LIGHT: &str = "lobe:8";
+const LIGHT: &str = "beam:8";
 
 /// A fresh, empty directory for one test.
 fn scratch(name: &str) -> PathBuf {

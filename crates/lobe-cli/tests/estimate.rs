@@ -23,7 +23,7 @@ fn json(threads: &str, sequence: &str) -> serde_json::Value {
             "--theta",
             "60",
             "--light",
-            "lobe:8:0.3,1,0.2",
+            "beam:8:0.3,1,0.2",
             "--samples",
             "100000",
             "--seed",

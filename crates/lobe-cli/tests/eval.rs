@@ -1,7 +1,7 @@
 //! `lobe eval` end to end: the built binary, stdin to stdout.
 
 use glam::{DVec2, DVec3};
-use lobe::{MaterialDesc, Strategy};
+use lobe::{BsdfStrategy, MaterialDesc};
 use serde_json::Value;
 use std::f64::consts::PI;
 use std::io::Write;
@@ -266,7 +266,7 @@ fn failed_samples_give_null() {
     let wo = dir(1.45, 0.0);
     let u = (0..64 * 64)
         .map(|k| DVec2::new((k % 64) as f64 / 64.0, (k / 64) as f64 / 64.0))
-        .find(|&u| m.sample(Strategy::Brdf, wo, 0.5, u).is_none())
+        .find(|&u| m.sample(BsdfStrategy::Brdf, wo, 0.5, u).is_none())
         .expect("a failed brdf sample at grazing wo");
     let input = format!(
         "{{\"wo\":{},\"u\":[{},{}],\"strategy\":\"brdf\"}}\n",
@@ -535,7 +535,7 @@ fn help_shows_examples_and_material_defaults() {
         "{}",
         run.stdout
     );
-    assert!(run.stdout.contains(&Strategy::names()));
+    assert!(run.stdout.contains(&BsdfStrategy::names()));
     for args in [&["--help"][..], &["demo", "--help"], &["eval", "-h"]] {
         let run = lobe(args, "");
         assert_eq!(run.code, Some(0), "{args:?}");

@@ -209,7 +209,10 @@ fn huge_spp_is_accepted_or_refused_clearly() {
     std::fs::write(&scene, SCENE).unwrap();
     let s = scene.to_str().unwrap();
     let e = one_line_error(&lobe(&["render", s, "--spp", "18446744073709551615"], None));
-    assert!(e.contains("--spp 18446744073709551615") && e.contains("64 bits"), "{e}");
+    assert!(
+        e.contains("--spp 18446744073709551615") && e.contains("64 bits"),
+        "{e}"
+    );
     let out = lobe(&["render", s, "--spp", "18446744073709551616"], None);
     assert!(!out.status.success());
     let e = String::from_utf8_lossy(&out.stderr);

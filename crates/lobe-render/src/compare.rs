@@ -22,25 +22,25 @@
 //! Nothing here prints or reads the system clock: progress goes to the
 //! caller's [`Progress`] and times come from the caller's [`Clock`].
 
+use crate::integrator::{Image, render};
 use crate::options::RenderOptions;
-use crate::render::{Image, render};
 use crate::scene::Scene;
-use lobe::Strategy;
-use lobe::estimator::{Heuristic, Technique};
+use lobe::BsdfStrategy;
+use lobe::estimator::{Heuristic, Strategy};
 use lobe::math::luminance;
 use lobe::progress::{Clock, Progress, timed};
 use serde::Serialize;
 
 /// The method of the reference render.
-pub const REFERENCE_METHOD: Technique = Technique::mis(Heuristic::Balance);
+pub const REFERENCE_METHOD: Strategy = Strategy::mis(Heuristic::Balance);
 
 /// Most samples per pixel an equal-time render may take.
 pub const MAX_EQUAL_TIME_SPP: f64 = 1_048_576.0;
 
 /// What to compare and how.
 #[derive(Debug, Clone, PartialEq)]
-pub struct Settings {
-    pub methods: Vec<Technique>,
+pub struct CompareSettings {
+    pub methods: Vec<Strategy>,
     /// Samples per pixel at equal samples.
     pub spp: u32,
     pub reference_spp: u32,
@@ -55,7 +55,7 @@ pub struct Settings {
 /// One render of a comparison.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Shot {
-    pub method: Technique,
+    pub method: Strategy,
     pub spp: u32,
     /// Seconds the render took on the caller's clock.
     pub time_s: f64,
@@ -90,16 +90,16 @@ pub struct Comparison {
 /// The default methods for `scene`: brdf, vndf (when an object's material
 /// has it), light and mis.
 #[must_use]
-pub fn default_methods(scene: &Scene) -> Vec<Technique> {
-    let mut v = vec![Technique::Bsdf(Strategy::Brdf)];
+pub fn default_methods(scene: &Scene) -> Vec<Strategy> {
+    let mut v = vec![Strategy::Bsdf(BsdfStrategy::Brdf)];
     if scene
         .objects
         .iter()
-        .any(|o| o.material.check(Strategy::Vndf).is_ok())
+        .any(|o| o.material.check(BsdfStrategy::Vndf).is_ok())
     {
-        v.push(Technique::Bsdf(Strategy::Vndf));
+        v.push(Strategy::Bsdf(BsdfStrategy::Vndf));
     }
-    v.extend([Technique::Light, Technique::mis(Heuristic::Balance)]);
+    v.extend([Strategy::Light, Strategy::mis(Heuristic::Balance)]);
     v
 }
 
@@ -131,7 +131,7 @@ pub fn render_one(
     progress.start(label, pixels.saturating_mul(opts.spp));
     let (image, time_s) = timed(clock, || render(scene, opts, |n| progress.advance(n)));
     Shot {
-        method: opts.technique,
+        method: opts.strategy,
         spp: u32::try_from(opts.spp).unwrap_or(u32::MAX),
         time_s,
         rmse: f64::NAN,
@@ -141,7 +141,7 @@ pub fn render_one(
 
 /// The progress label of a render: `brdf 16 spp`, `brdf 40 spp, eq. time`,
 /// `reference 1024 spp`.
-fn label(method: Technique, spp: u32, what: &str) -> String {
+fn label(method: Strategy, spp: u32, what: &str) -> String {
     match what {
         "" => format!("{method} {spp} spp"),
         "reference" => format!("reference {spp} spp"),
@@ -157,15 +157,15 @@ fn label(method: Technique, spp: u32, what: &str) -> String {
 #[must_use]
 pub fn run_comparison(
     scene: &Scene,
-    s: &Settings,
+    s: &CompareSettings,
     progress: &dyn Progress,
     clock: &dyn Clock,
 ) -> Comparison {
     let spp = s.spp.max(1);
-    let shot = |method: Technique, spp: u32, seed: u64, what: &str| {
+    let shot = |method: Strategy, spp: u32, seed: u64, what: &str| {
         let opts = RenderOptions {
             spp: spp.into(),
-            technique: method,
+            strategy: method,
             seed,
             max_depth: s.max_depth,
             threads: s.threads,
@@ -180,7 +180,7 @@ pub fn run_comparison(
     let equal_time = s.equal_time.then(|| {
         let mis = equal_samples
             .iter()
-            .find(|x| x.method == Technique::mis(Heuristic::Balance));
+            .find(|x| x.method == Strategy::mis(Heuristic::Balance));
         let (budget_s, budget_from) = match mis {
             Some(x) => (x.time_s, format!("the time of mis at {spp} spp")),
             None => {

@@ -5,7 +5,7 @@
 //! environment map, the only light, seen by a pinhole camera. Each camera
 //! ray's hit estimates the reflected radiance by BSDF sampling, light
 //! sampling or MIS exactly as `lobe::estimator` does, plus a shadow ray
-//! ([`mod@render`] module docs); `max_depth > 1` adds path tracing.
+//! ([`mod@integrator`] module docs); `max_depth > 1` adds path tracing.
 //! [`compare`] renders several methods at equal samples and equal time
 //! against a reference and measures their errors.
 //!
@@ -22,13 +22,13 @@
 //!
 //! ```
 //! use lobe_render::{Camera, Object, RenderOptions, Scene, render};
-//! use lobe::estimator::Technique;
-//! use lobe::{envmap::EnvMap, Material, Rgb, Strategy};
+//! use lobe::estimator::Strategy;
+//! use lobe::{envmap::EnvMap, Material, Rgb, BsdfStrategy};
 //! use glam::DVec3;
 //! let camera = Camera::new(DVec3::new(0.0, 0.0, 4.0), DVec3::ZERO, DVec3::Y, 40.0, 8, 6)?;
 //! let scene = Scene::new(camera, EnvMap::constant(Rgb::ONE))
 //!     .with(Object::sphere(DVec3::ZERO, 1.0, Material::lambert(Rgb::ONE)?)?);
-//! let opts = RenderOptions { spp: 4, technique: Technique::Bsdf(Strategy::Cosine), ..Default::default() };
+//! let opts = RenderOptions { spp: 4, strategy: Strategy::Bsdf(BsdfStrategy::Cosine), ..Default::default() };
 //! let img = render(&scene, &opts, |_| {});
 //! assert!((img.get(4, 3).x - 1.0).abs() < 1e-9); // the white furnace
 //! # Ok::<(), Box<dyn std::error::Error>>(())
@@ -38,17 +38,17 @@ pub mod camera;
 pub mod compare;
 pub mod envmap_io;
 pub mod geometry;
+pub mod integrator;
 pub mod mesh;
 pub mod options;
 pub mod output;
-pub mod render;
 pub mod scene;
 
 pub use camera::{Camera, CameraError};
 pub use envmap_io::{LoadError, load_envmap};
 pub use geometry::{Hit, Ray};
+pub use integrator::{Image, RenderStats, fallbacks, render, strategy_for};
 pub use mesh::{Mesh, MeshError};
-pub use output::{OutputError, ToneMap};
 pub use options::RenderOptions;
-pub use render::{Image, RenderStats, fallbacks, render, technique_for};
+pub use output::{OutputError, ToneMap};
 pub use scene::{Object, Scene, SceneDesc, SceneError, Shape, load_scene, parse_scene, showcase};

@@ -2,7 +2,7 @@
 //! depth and the thread count. A scene file's `[render]` table sets them
 //! ([`crate::scene`]); the renderer ([`crate::render()`]) reads them.
 
-use lobe::estimator::{Heuristic, Technique};
+use lobe::estimator::{Heuristic, Strategy};
 
 /// Render settings.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -12,7 +12,7 @@ pub struct RenderOptions {
     /// How each hit estimates its reflected light: a BSDF strategy (falling
     /// back to `brdf` on a material it does not apply to), `light`, or MIS
     /// on the material's best BSDF strategy.
-    pub technique: Technique,
+    pub strategy: Strategy,
     pub seed: u64,
     /// 1 = direct lighting; more adds bounces. At least 1.
     pub max_depth: u32,
@@ -24,7 +24,7 @@ impl Default for RenderOptions {
     fn default() -> Self {
         RenderOptions {
             spp: 64,
-            technique: Technique::mis(Heuristic::Balance),
+            strategy: Strategy::mis(Heuristic::Balance),
             seed: 1,
             max_depth: 1,
             threads: None,

@@ -10,7 +10,7 @@
 //! function, rounded to 8 bits. A grey radiance of 1 shows as 0.80 before
 //! the sRGB encoding (232 of 255), 0.18 (middle grey) as 0.27.
 
-use crate::render::Image;
+use crate::integrator::Image;
 use std::path::{Path, PathBuf};
 
 /// An image that could not be written.
@@ -67,7 +67,7 @@ impl ToneMap {
             }
         });
         let lum = 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
-        if !(lum > 0.0) {
+        if lum.is_nan() || lum <= 0.0 {
             return [0.0; 3];
         }
         let ratio = filmic(lum) / lum;
@@ -77,7 +77,8 @@ impl ToneMap {
     /// The 8-bit sRGB values of a linear RGB value.
     #[must_use]
     pub fn srgb8(&self, rgb: [f64; 3]) -> [u8; 3] {
-        self.display(rgb).map(|v| (srgb_encode(v) * 255.0).round() as u8)
+        self.display(rgb)
+            .map(|v| (srgb_encode(v) * 255.0).round() as u8)
     }
 }
 
@@ -135,8 +136,9 @@ impl Image {
             path: path.to_path_buf(),
             message,
         };
-        let img = image::RgbImage::from_raw(self.width as u32, self.height as u32, self.to_srgb8(tone))
-            .ok_or_else(|| err("the pixel buffer does not match the size".into()))?;
+        let img =
+            image::RgbImage::from_raw(self.width as u32, self.height as u32, self.to_srgb8(tone))
+                .ok_or_else(|| err("the pixel buffer does not match the size".into()))?;
         img.save_with_format(path, image::ImageFormat::Png)
             .map_err(|e| err(e.to_string()))
     }

@@ -35,9 +35,9 @@ use crate::envmap_io::load_envmap;
 use crate::geometry::{Hit, Plane, Ray, Sphere};
 use crate::mesh::Mesh;
 use crate::options::RenderOptions;
-use lobe::estimator::Technique;
 use glam::DVec3;
 use lobe::envmap::EnvMap;
+use lobe::estimator::Strategy;
 use lobe::{Material, MaterialDesc};
 use serde::{Deserialize, Serialize};
 use std::collections::HashMap;
@@ -618,7 +618,7 @@ fn build(desc: &SceneDesc, base: &Path) -> FieldResult<Scene> {
             ),
         ));
     }
-    let technique: Technique = r
+    let strategy: Strategy = r
         .strategy
         .parse()
         .map_err(|e: lobe::Error| (render_field("strategy"), e.to_string()))?;
@@ -626,7 +626,7 @@ fn build(desc: &SceneDesc, base: &Path) -> FieldResult<Scene> {
     let mut scene = Scene::new(camera, map);
     scene.options = RenderOptions {
         spp: r.spp,
-        technique,
+        strategy,
         seed: r.seed,
         max_depth: r.max_depth,
         threads: None,
@@ -797,7 +797,7 @@ strategy = "vndf"
         let s = parse_scene(GOOD, Path::new("scene.toml")).unwrap();
         assert_eq!(s.objects.len(), 2);
         assert_eq!(s.options.spp, 4);
-        assert_eq!(s.options.technique, Technique::Bsdf(lobe::Strategy::Vndf));
+        assert_eq!(s.options.strategy, Strategy::Bsdf(lobe::BsdfStrategy::Vndf));
         assert_eq!(s.camera.width, 32);
     }
 

@@ -2,14 +2,14 @@
 //! resampling, and a whole comparison under a fake clock.
 
 use glam::DVec3;
-use lobe::Strategy;
+use lobe::BsdfStrategy;
 use lobe::envmap::EnvMap;
-use lobe::estimator::{Heuristic, Technique};
+use lobe::estimator::{Heuristic, Strategy};
 use lobe::progress::{Clock, Progress};
 use lobe::{Material, Rgb};
 use lobe_render::compare::{
-    LogScale, REFERENCE_METHOD, Settings, default_methods, default_reference_spp, error_epsilon,
-    error_map, reference_seed, resample, rmse, run_comparison,
+    CompareSettings, LogScale, REFERENCE_METHOD, default_methods, default_reference_spp,
+    error_epsilon, error_map, reference_seed, resample, rmse, run_comparison,
 };
 use lobe_render::{Camera, Image, Object, Scene};
 use std::sync::Mutex;
@@ -131,15 +131,15 @@ fn a_comparison_under_a_fake_clock() {
     assert_eq!(
         default_methods(&scene),
         [
-            Technique::Bsdf(Strategy::Brdf),
-            Technique::Light,
-            Technique::mis(Heuristic::Balance)
+            Strategy::Bsdf(BsdfStrategy::Brdf),
+            Strategy::Light,
+            Strategy::mis(Heuristic::Balance)
         ]
     );
-    let settings = Settings {
+    let settings = CompareSettings {
         methods: vec![
-            Technique::Bsdf(Strategy::Cosine),
-            Technique::mis(Heuristic::Balance),
+            Strategy::Bsdf(BsdfStrategy::Cosine),
+            Strategy::mis(Heuristic::Balance),
         ],
         spp: 2,
         reference_spp: 16,
@@ -205,7 +205,7 @@ fn a_comparison_under_a_fake_clock() {
     // Without equal time: no equal-time row, three renders fewer.
     let plain = run_comparison(
         &scene,
-        &Settings {
+        &CompareSettings {
             equal_time: false,
             ..settings
         },

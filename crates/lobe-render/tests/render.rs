@@ -4,8 +4,8 @@
 
 use glam::DVec3;
 use lobe::envmap::EnvMap;
-use lobe::estimator::{Heuristic, Technique};
-use lobe::{Material, MaterialDesc, Rgb, Strategy};
+use lobe::estimator::{Heuristic, Strategy};
+use lobe::{BsdfStrategy, Material, MaterialDesc, Rgb};
 use lobe_render::{Camera, Image, Mesh, Object, RenderOptions, Scene, load_scene, render};
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -14,10 +14,10 @@ fn lambert(a: f64) -> Material {
     Material::lambert(Rgb::splat(a)).unwrap()
 }
 
-fn opts(method: Technique, spp: u64) -> RenderOptions {
+fn opts(method: Strategy, spp: u64) -> RenderOptions {
     RenderOptions {
         spp,
-        technique: method,
+        strategy: method,
         seed: 3,
         max_depth: 1,
         threads: None,
@@ -75,7 +75,7 @@ fn white_furnace_every_method() {
     let scene = furnace_scene(32, 24);
     let px = covered(&scene, 0);
     assert!(px.len() > 150, "{} covered pixels", px.len());
-    for method in Technique::all() {
+    for method in Strategy::all() {
         let img = render(&scene, &opts(method, 16), |_| {});
         assert_eq!(img.stats.nonfinite, 0);
         // The background is the environment, 1.
@@ -83,7 +83,7 @@ fn white_furnace_every_method() {
         // Cosine and brdf sampling of a Lambertian (and the strategies that
         // fall back to brdf) have weight f cos / p = 1 exactly, and nothing
         // shadows a lone convex sphere.
-        let exact = matches!(method, Technique::Bsdf(s) if s != Strategy::Uniform);
+        let exact = matches!(method, Strategy::Bsdf(s) if s != BsdfStrategy::Uniform);
         for c in 0..3 {
             let (m, se) = mean_se(&img, &px, |p| p[c]);
             if exact {
@@ -122,7 +122,11 @@ fn white_furnace_convex_mesh_is_exact() {
         Scene::new(camera, EnvMap::constant(Rgb::ONE)).with(Object::mesh(mesh, lambert(1.0)));
     let px = covered(&scene, 0);
     assert!(px.len() > 100);
-    let img = render(&scene, &opts(Technique::Bsdf(Strategy::Cosine), 8), |_| {});
+    let img = render(
+        &scene,
+        &opts(Strategy::Bsdf(BsdfStrategy::Cosine), 8),
+        |_| {},
+    );
     for &(x, y) in &px {
         let v = img.get(x, y);
         assert!(
@@ -151,10 +155,10 @@ fn white_furnace_with_bounces() {
     let mut px = covered(&scene, 0);
     px.extend(covered(&scene, 1));
     for method in [
-        Technique::Bsdf(Strategy::Cosine),
-        Technique::Light,
-        Technique::mis(Heuristic::Balance),
-        Technique::mis(Heuristic::Power),
+        Strategy::Bsdf(BsdfStrategy::Cosine),
+        Strategy::Light,
+        Strategy::mis(Heuristic::Balance),
+        Strategy::mis(Heuristic::Power),
     ] {
         let o = RenderOptions {
             max_depth: 32,
@@ -217,8 +221,8 @@ fn techniques_agree_pixel_by_pixel() {
         .with(Object::plane(DVec3::ZERO, DVec3::Y, lambert(0.5)).unwrap());
     let mut px = covered(&scene, 0);
     px.extend(covered(&scene, 1));
-    let reference = render(&scene, &opts(Technique::mis(Heuristic::Balance), 64), |_| {});
-    for method in Technique::all() {
+    let reference = render(&scene, &opts(Strategy::mis(Heuristic::Balance), 64), |_| {});
+    for method in Strategy::all() {
         let mut o = opts(method, 32);
         o.seed = 11;
         let img = render(&scene, &o, |_| {});
@@ -260,9 +264,9 @@ fn the_same_image_for_any_thread_count() {
         .with(Object::sphere(DVec3::new(-0.9, 0.4, 0.0), 0.4, ggx).unwrap())
         .with(Object::plane(DVec3::ZERO, DVec3::Y, lambert(0.5)).unwrap());
     for method in [
-        Technique::mis(Heuristic::Power),
-        Technique::Bsdf(Strategy::Vndf),
-        Technique::Light,
+        Strategy::mis(Heuristic::Power),
+        Strategy::Bsdf(BsdfStrategy::Vndf),
+        Strategy::Light,
     ] {
         let mut o = opts(method, 4);
         o.max_depth = 6;
@@ -315,7 +319,11 @@ fn right_and_top_of_the_scene_are_right_and_top_of_the_image() {
     let center = DVec3::new(0.9, 0.6, 0.0);
     let scene = Scene::new(camera, EnvMap::constant(Rgb::ONE))
         .with(Object::sphere(center, 0.3, lambert(0.0)).unwrap());
-    let img = render(&scene, &opts(Technique::Bsdf(Strategy::Cosine), 4), |_| {});
+    let img = render(
+        &scene,
+        &opts(Strategy::Bsdf(BsdfStrategy::Cosine), 4),
+        |_| {},
+    );
     let (mut sx, mut sy, mut n) = (0.0, 0.0, 0.0);
     for y in 0..img.height {
         for x in 0..img.width {
@@ -380,7 +388,7 @@ fn scene_files_load_and_their_errors_name_file_line_and_field() {
     assert_eq!(scene.objects.len(), 2);
     // vndf does not apply to Phong or Lambert: both fall back to brdf.
     assert_eq!(
-        lobe_render::fallbacks(&scene, scene.options.technique).len(),
+        lobe_render::fallbacks(&scene, scene.options.strategy).len(),
         2
     );
     let img = render(&scene, &scene.options, |_| {});
@@ -438,7 +446,7 @@ fn the_shipped_scenes_and_the_showcase_render() {
     for (a, b) in file.objects.iter().zip(&built.objects) {
         assert_eq!(a.material, b.material);
     }
-    let img = render(&built, &opts(Technique::mis(Heuristic::Power), 2), |_| {});
+    let img = render(&built, &opts(Strategy::mis(Heuristic::Power), 2), |_| {});
     assert!(
         img.pixels
             .iter()
@@ -454,10 +462,14 @@ fn progress_counts_samples_within_a_pixel() {
     use std::sync::atomic::{AtomicU64, Ordering};
     let scene = furnace_scene(2, 1);
     let (calls, total) = (AtomicU64::new(0), AtomicU64::new(0));
-    let _ = render(&scene, &opts(Technique::Bsdf(Strategy::Cosine), 10_000), |n| {
-        calls.fetch_add(1, Ordering::Relaxed);
-        total.fetch_add(n, Ordering::Relaxed);
-    });
+    let _ = render(
+        &scene,
+        &opts(Strategy::Bsdf(BsdfStrategy::Cosine), 10_000),
+        |n| {
+            calls.fetch_add(1, Ordering::Relaxed);
+            total.fetch_add(n, Ordering::Relaxed);
+        },
+    );
     assert_eq!(total.load(Ordering::Relaxed), 2 * 10_000);
     assert!(calls.load(Ordering::Relaxed) >= 6, "{calls:?}");
 }

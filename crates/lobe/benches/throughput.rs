@@ -14,7 +14,7 @@
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use glam::{DVec2, DVec3};
-use lobe::{Material, MaterialDesc, Rgb, Strategy};
+use lobe::{BsdfStrategy, Material, MaterialDesc, Rgb};
 use rand::RngExt;
 use std::f64::consts::PI;
 use std::hint::black_box;
@@ -95,7 +95,7 @@ fn material(json: &str) -> Material {
 /// and `pdf` that `sample` computed internally: a renderer calls `eval` and
 /// `pdf` from elsewhere (light sampling, MIS), not on the same values inline.
 #[inline(never)]
-fn sample_eval_pdf(m: &Material, strategy: Strategy, inputs: &[Input]) -> (Rgb, Rgb, f64) {
+fn sample_eval_pdf(m: &Material, strategy: BsdfStrategy, inputs: &[Input]) -> (Rgb, Rgb, f64) {
     let (mut weights, mut fs, mut pdfs) = (Rgb::ZERO, Rgb::ZERO, 0.0);
     for x in inputs {
         if let Some(s) = m.sample(strategy, x.wo, x.uc, x.u) {
@@ -110,7 +110,7 @@ fn sample_eval_pdf(m: &Material, strategy: Strategy, inputs: &[Input]) -> (Rgb, 
 
 /// `sample` alone (its result already carries `f` and `pdf`).
 #[inline(never)]
-fn sample_only(m: &Material, strategy: Strategy, inputs: &[Input]) -> Rgb {
+fn sample_only(m: &Material, strategy: BsdfStrategy, inputs: &[Input]) -> Rgb {
     let mut weights = Rgb::ZERO;
     for x in inputs {
         if let Some(s) = m.sample(strategy, x.wo, x.uc, x.u) {

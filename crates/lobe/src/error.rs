@@ -35,10 +35,9 @@ impl std::fmt::Display for Error {
                 f,
                 "field `{field}`: unknown value `{value}`, expected one of: {expected}"
             ),
-            Error::UnknownStrategy { value, expected } => write!(
-                f,
-                "unknown strategy `{value}`, expected one of: {expected}"
-            ),
+            Error::UnknownStrategy { value, expected } => {
+                write!(f, "unknown strategy `{value}`, expected one of: {expected}")
+            }
             Error::Unsupported { strategy, reason } => write!(
                 f,
                 "strategy `{strategy}` does not apply to this material ({reason})"

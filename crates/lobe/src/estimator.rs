@@ -22,7 +22,8 @@ pub use crate::sequence::CHUNK;
 use crate::sequence::{self, Sequence};
 use crate::stats::quadrature::{Tolerance, gauss_legendre_4x4, integrate_hemisphere};
 use crate::stats::ttest::Moments;
-use crate::{BsdfSample, Error, Frame, Material, Strategy};
+pub use crate::strategy::{Heuristic, Mis, MisForm, NON_BSDF_NAMES, Strategy};
+use crate::{BsdfSample, Error, Frame, Material};
 use glam::{DVec2, DVec3};
 
 /// Running sums of the sample values `f L cos / p` (zero for a failed sample).
@@ -73,169 +74,7 @@ impl Accumulator {
     }
 }
 
-/// How Multiple Importance Sampling weights its techniques (Veach 1997).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum Heuristic {
-    /// `w_t = n_t p_t / Σ n p`.
-    Balance,
-    /// `w_t = (n_t p_t)² / Σ (n p)²`.
-    Power,
-}
-
-impl Heuristic {
-    /// The weight of a technique whose (count-scaled) density is `a`
-    /// against another's `b`.
-    #[inline]
-    #[must_use]
-    pub fn weight(self, a: f64, b: f64) -> f64 {
-        match self {
-            Heuristic::Balance => a / (a + b),
-            Heuristic::Power => a * a / (a * a + b * b),
-        }
-    }
-}
-
-/// Multi-sample MIS draws `n_bsdf` and `n_light` samples for every estimate;
-/// one-sample MIS draws one, choosing the technique with probability
-/// `n_t / (n_bsdf + n_light)`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum MisForm {
-    MultiSample,
-    OneSample,
-}
-
-/// BSDF sampling combined with light sampling.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub struct Mis {
-    /// The BSDF strategy; `None`: the material's best
-    /// ([`Material::best_bsdf_strategy`]), chosen per material.
-    pub bsdf: Option<Strategy>,
-    pub heuristic: Heuristic,
-    pub form: MisForm,
-    pub n_bsdf: u32,
-    pub n_light: u32,
-}
-
-/// How the directions of an estimate are drawn.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum Technique {
-    /// BSDF sampling by a strategy.
-    Bsdf(Strategy),
-    /// Light sampling alone.
-    Light,
-    /// Both, combined by MIS.
-    Mis(Mis),
-}
-
-impl std::fmt::Display for Technique {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(&self.name())
-    }
-}
-
-impl From<Strategy> for Technique {
-    fn from(s: Strategy) -> Self {
-        Technique::Bsdf(s)
-    }
-}
-
-/// The names of the techniques that are not BSDF strategies.
-pub const NON_BSDF_NAMES: [&str; 5] = ["light", "mis", "mis-power", "mis-one", "mis-power-one"];
-
-impl Technique {
-    /// `mis` or `mis-power`: one sample of each technique, multi-sample, on
-    /// the material's best BSDF strategy.
-    #[must_use]
-    pub const fn mis(heuristic: Heuristic) -> Self {
-        Technique::Mis(Mis {
-            bsdf: None,
-            heuristic,
-            form: MisForm::MultiSample,
-            n_bsdf: 1,
-            n_light: 1,
-        })
-    }
-
-    /// Every technique by name: the BSDF strategies, `light`, `mis`,
-    /// `mis-power`, `mis-one`, `mis-power-one` (MIS on the material's best
-    /// BSDF strategy, one sample of each technique).
-    #[must_use]
-    pub fn all() -> Vec<Technique> {
-        let mut v: Vec<Technique> = Strategy::ALL.into_iter().map(Technique::Bsdf).collect();
-        v.push(Technique::Light);
-        for form in [MisForm::MultiSample, MisForm::OneSample] {
-            for heuristic in [Heuristic::Balance, Heuristic::Power] {
-                v.push(Technique::Mis(Mis {
-                    bsdf: None,
-                    heuristic,
-                    form,
-                    n_bsdf: 1,
-                    n_light: 1,
-                }));
-            }
-        }
-        v
-    }
-
-    /// Every accepted name, comma separated, for help and error messages.
-    #[must_use]
-    pub fn names() -> String {
-        format!("{}, {}", Strategy::names(), NON_BSDF_NAMES.join(", "))
-    }
-
-    /// The name used on the command line, in scene files and in tables.
-    #[must_use]
-    pub fn name(&self) -> String {
-        match self {
-            Technique::Bsdf(s) => s.name().to_string(),
-            Technique::Light => "light".into(),
-            Technique::Mis(m) => {
-                let mut n = String::from(if m.heuristic == Heuristic::Balance {
-                    "mis"
-                } else {
-                    "mis-power"
-                });
-                if m.form == MisForm::OneSample {
-                    n.push_str("-one");
-                }
-                n
-            }
-        }
-    }
-
-    /// Sequence points used by one estimate (`n_bsdf + n_light` for
-    /// multi-sample MIS, else 1).
-    #[must_use]
-    pub fn points_per_sample(&self) -> usize {
-        match self {
-            Technique::Mis(m) if m.form == MisForm::MultiSample => (m.n_bsdf + m.n_light) as usize,
-            _ => 1,
-        }
-    }
-
-    /// The light distribution this technique draws light samples from: the
-    /// plain one for light sampling alone, the MIS-compensated one inside
-    /// MIS. The one place where that choice is made.
-    #[must_use]
-    pub fn light_distribution(&self) -> LightDistribution {
-        match self {
-            Technique::Mis(_) => LightDistribution::Compensated,
-            _ => LightDistribution::Plain,
-        }
-    }
-
-    /// The BSDF strategy this technique samples `m` by, if any: its own for
-    /// a BSDF technique, the given or the material's best for MIS, none for
-    /// light sampling.
-    #[must_use]
-    pub fn bsdf_strategy(&self, m: &Material) -> Option<Strategy> {
-        match self {
-            Technique::Bsdf(s) => Some(*s),
-            Technique::Light => None,
-            Technique::Mis(mis) => Some(mis.bsdf.unwrap_or_else(|| m.best_bsdf_strategy())),
-        }
-    }
-
+impl Strategy {
     /// Validate this technique for `m` once, into an estimator of one
     /// shading point; the error says why a BSDF strategy does not apply.
     pub fn for_material<'m>(&self, m: &'m Material) -> Result<ShadingEstimator<'m>, Error> {
@@ -244,31 +83,17 @@ impl Technique {
             None => None,
         };
         let technique = match *self {
-            Technique::Mis(mis) => Technique::Mis(Mis {
+            Strategy::Mis(mis) => Strategy::Mis(Mis {
                 bsdf: sampler.map(|s| s.strategy()),
                 ..mis
             }),
             t => t,
         };
         Ok(ShadingEstimator {
-            technique,
+            strategy: technique,
             material: m,
             sampler,
         })
-    }
-}
-
-impl std::str::FromStr for Technique {
-    type Err = Error;
-    /// Any name of [`Technique::names`].
-    fn from_str(s: &str) -> Result<Self, Error> {
-        Technique::all()
-            .into_iter()
-            .find(|t| t.name() == s)
-            .ok_or_else(|| Error::UnknownStrategy {
-                value: s.into(),
-                expected: Technique::names(),
-            })
     }
 }
 
@@ -343,10 +168,10 @@ pub struct ShadingEstimate {
     pub bsdf: Option<DrawnBsdf>,
 }
 
-/// A [`Technique`] validated for one material ([`Technique::for_material`]).
+/// A [`Strategy`] validated for one material ([`Strategy::for_material`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ShadingEstimator<'m> {
-    technique: Technique,
+    strategy: Strategy,
     material: &'m Material,
     sampler: Option<BsdfSampler<'m>>,
 }
@@ -354,8 +179,8 @@ pub struct ShadingEstimator<'m> {
 impl<'m> ShadingEstimator<'m> {
     /// The technique, with its MIS BSDF strategy resolved.
     #[must_use]
-    pub fn technique(&self) -> Technique {
-        self.technique
+    pub fn strategy(&self) -> Strategy {
+        self.strategy
     }
 
     /// The BSDF sampler the technique uses (none for light sampling).
@@ -364,7 +189,7 @@ impl<'m> ShadingEstimator<'m> {
         self.sampler
     }
 
-    /// One estimate from `points`, [`Technique::points_per_sample`] of them,
+    /// One estimate from `points`, [`Strategy::points_per_sample`] of them,
     /// each `[uc, u₁, u₂]`. Multi-sample MIS takes its `n_bsdf` BSDF points
     /// first, then its `n_light` light points (which use `u` only);
     /// one-sample MIS chooses the technique with the point's `uc`.
@@ -377,21 +202,21 @@ impl<'m> ShadingEstimator<'m> {
         vis: &mut impl Visibility,
     ) -> ShadingEstimate {
         let m = self.material;
-        let dist = self.technique.light_distribution();
+        let dist = self.strategy.light_distribution();
         let mut first: Option<DrawnBsdf> = None;
-        let value = match (self.technique, self.sampler) {
-            (Technique::Bsdf(_), Some(s)) => {
+        let value = match (self.strategy, self.sampler) {
+            (Strategy::Bsdf(_), Some(s)) => {
                 let p = points[0];
                 match draw_bsdf(&s, sp, p, 1.0, vis, &mut first) {
                     Some((x, dir)) => x.weight * light.radiance(dir),
                     None => Rgb::ZERO,
                 }
             }
-            (Technique::Light, _) => {
+            (Strategy::Light, _) => {
                 let p = points[0];
                 light_value(m, None, sp, light, dist, p, vis, |_, _| (1.0, 1.0))
             }
-            (Technique::Mis(mis), Some(s)) => {
+            (Strategy::Mis(mis), Some(s)) => {
                 let (nb, nl) = (f64::from(mis.n_bsdf), f64::from(mis.n_light));
                 let h = mis.heuristic;
                 match mis.form {
@@ -433,10 +258,7 @@ impl<'m> ShadingEstimator<'m> {
             }
             (_, None) => unreachable!("a BSDF or MIS technique always has a sampler"),
         };
-        ShadingEstimate {
-            value,
-            bsdf: first,
-        }
+        ShadingEstimate { value, bsdf: first }
     }
 }
 
@@ -451,7 +273,11 @@ fn draw_bsdf(
     vis: &mut impl Visibility,
     first: &mut Option<DrawnBsdf>,
 ) -> Option<(BsdfSample, DVec3)> {
-    let uc = if uc_scale == 1.0 { p[0] } else { p[0] / uc_scale };
+    let uc = if uc_scale == 1.0 {
+        p[0]
+    } else {
+        p[0] / uc_scale
+    };
     let x = s.sample(sp.wo, uc, DVec2::new(p[1], p[2]))?;
     let dir = sp.frame.to_world(x.wi);
     let escaped = vis.escapes(dir);
@@ -510,7 +336,7 @@ fn light_value(
 /// different cost by efficiency, 1/(variance × time).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Plan {
-    pub technique: Technique,
+    pub strategy: Strategy,
     pub sequence: Sequence,
     /// Number of samples (of `points_per_sample` directions each).
     pub samples: usize,
@@ -520,9 +346,9 @@ pub struct Plan {
 impl Plan {
     /// `samples` independent samples with `seed`.
     #[must_use]
-    pub fn independent(technique: impl Into<Technique>, samples: usize, seed: u64) -> Self {
+    pub fn independent(strategy: impl Into<Strategy>, samples: usize, seed: u64) -> Self {
         Plan {
-            technique: technique.into(),
+            strategy: strategy.into(),
             sequence: Sequence::Independent,
             samples,
             seed,
@@ -552,7 +378,7 @@ pub fn estimate(
     light: &Light,
     plan: &Plan,
 ) -> Result<Accumulator, Error> {
-    let est = plan.technique.for_material(m)?;
+    let est = plan.strategy.for_material(m)?;
     let mut acc = Accumulator::default();
     for chunk in 0..plan.chunks() {
         acc.merge(&estimate_chunk(&est, sp, light, plan, chunk));
@@ -570,7 +396,7 @@ pub fn estimate_chunk(
     plan: &Plan,
     chunk: usize,
 ) -> Accumulator {
-    let k = plan.technique.points_per_sample();
+    let k = plan.strategy.points_per_sample();
     let first = chunk * CHUNK;
     let len = CHUNK.min(plan.estimates().saturating_sub(first));
     let mut points = vec![[0.0; 3]; len * k];

@@ -34,13 +34,13 @@
 //!
 //! ```
 //! # #[cfg(feature = "desc")] {
-//! use lobe::{Material, MaterialDesc, Strategy};
+//! use lobe::{Material, MaterialDesc, BsdfStrategy};
 //! use glam::{DVec2, DVec3};
 //! let m = MaterialDesc::from_json(r#"{"type":"cook-torrance","alpha":0.2}"#)?.build()?;
 //! let wo = DVec3::new(0.6, 0.0, 0.8);
-//! if let Some(s) = m.sample(Strategy::Vndf, wo, 0.5, DVec2::new(0.3, 0.7)) {
+//! if let Some(s) = m.sample(BsdfStrategy::Vndf, wo, 0.5, DVec2::new(0.3, 0.7)) {
 //!     // s.weight == f * cos / pdf
-//!     assert!((s.pdf - m.pdf(Strategy::Vndf, wo, s.wi)).abs() < 1e-9 * s.pdf);
+//!     assert!((s.pdf - m.pdf(BsdfStrategy::Vndf, wo, s.wi)).abs() < 1e-9 * s.pdf);
 //! }
 //! # }
 //! # Ok::<(), lobe::Error>(())
@@ -76,5 +76,5 @@ pub use light::Light;
 pub use material::{BsdfSampler, Glossy, Material};
 pub use math::Rgb;
 pub use microfacet::{Microfacet, Ndf, Shadowing};
-pub use sample::{BsdfSample, LobeKind};
-pub use strategy::Strategy;
+pub use sample::{BsdfSample, Component};
+pub use strategy::{BsdfStrategy, Strategy};

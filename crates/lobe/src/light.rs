@@ -11,7 +11,7 @@
 //! | `Env(map)` | the environment map | ∝ the map's luminance ([`EnvMap::sample`]), or MIS-compensated ([`EnvMap::sample_compensated`]) |
 //!
 //! Which of a light's two distributions a technique draws from is decided in
-//! one place, [`crate::estimator::Technique::light_distribution`]. Light
+//! one place, [`crate::estimator::Strategy::light_distribution`]. Light
 //! samples below a shading point's horizon are failed samples (they count,
 //! with value 0).
 

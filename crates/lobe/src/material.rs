@@ -3,15 +3,15 @@
 //!
 //! With two lobes, `sample` chooses the glossy lobe with probability
 //! `P = a_g / (a_g + a_d)` from the lobes' albedo estimates
-//! ([`crate::models::Lobe::albedo_hint`]) and the diffuse lobe otherwise,
+//! ([`crate::models::Bxdf::albedo_hint`]) and the diffuse lobe otherwise,
 //! and `pdf` is the mixture `P p_g + (1 − P) p_d` (one-sample MIS with the
 //! balance heuristic), so `pdf` is always the density that `sample` draws from.
 
 use crate::math::Rgb;
 pub use crate::models::Glossy;
-use crate::models::{Lambert, Lobe};
-use crate::sample::{BsdfSample, LobeKind};
-use crate::{Error, Strategy, warp};
+use crate::models::{Bxdf, Lambert};
+use crate::sample::{BsdfSample, Component};
+use crate::{BsdfStrategy, Error, warp};
 use glam::{DVec2, DVec3};
 
 /// A material: `f = diffuse.albedo/π + glossy`.
@@ -53,7 +53,7 @@ impl Material {
 
     /// `Ok` when `strategy` applies to this material, otherwise an error
     /// that says why.
-    pub fn check(&self, strategy: Strategy) -> crate::error::Result<()> {
+    pub fn check(&self, strategy: BsdfStrategy) -> crate::error::Result<()> {
         let r = match self.glossy {
             Glossy::None => self.diffuse.supports(strategy),
             g => g.supports(strategy),
@@ -64,10 +64,10 @@ impl Material {
         })
     }
 
-    /// The strategies that apply to this material, in [`Strategy::ALL`] order.
+    /// The strategies that apply to this material, in [`BsdfStrategy::ALL`] order.
     #[must_use]
-    pub fn strategies(&self) -> Vec<Strategy> {
-        Strategy::ALL
+    pub fn strategies(&self) -> Vec<BsdfStrategy> {
+        BsdfStrategy::ALL
             .into_iter()
             .filter(|&s| self.check(s).is_ok())
             .collect()
@@ -76,11 +76,11 @@ impl Material {
     /// The BSDF strategy to pair with light sampling in MIS: visible normals
     /// where the material has them, else the lecture's `brdf`.
     #[must_use]
-    pub fn best_bsdf_strategy(&self) -> Strategy {
-        if self.check(Strategy::Vndf).is_ok() {
-            Strategy::Vndf
+    pub fn best_bsdf_strategy(&self) -> BsdfStrategy {
+        if self.check(BsdfStrategy::Vndf).is_ok() {
+            BsdfStrategy::Vndf
         } else {
-            Strategy::Brdf
+            BsdfStrategy::Brdf
         }
     }
 
@@ -118,7 +118,7 @@ impl Material {
     /// Validate `strategy` for this material once, into a handle that
     /// samples and gives pdfs by it: the error says why a strategy does not
     /// apply (see [`Material::check`]).
-    pub fn sampler(&self, strategy: Strategy) -> crate::error::Result<BsdfSampler<'_>> {
+    pub fn sampler(&self, strategy: BsdfStrategy) -> crate::error::Result<BsdfSampler<'_>> {
         self.check(strategy)?;
         Ok(BsdfSampler {
             material: self,
@@ -131,14 +131,14 @@ impl Material {
     /// (checked in debug builds); [`Material::sampler`] validates it once.
     #[inline]
     #[must_use]
-    pub fn pdf(&self, strategy: Strategy, wo: DVec3, wi: DVec3) -> f64 {
+    pub fn pdf(&self, strategy: BsdfStrategy, wo: DVec3, wi: DVec3) -> f64 {
         debug_assert!(self.check(strategy).is_ok(), "{strategy} does not apply");
         if wo.z <= 0.0 || wi.z <= 0.0 {
             return 0.0;
         }
         match strategy {
-            Strategy::Uniform => warp::square_to_uniform_hemisphere_pdf(wi),
-            Strategy::Cosine => warp::square_to_cosine_hemisphere_pdf(wi),
+            BsdfStrategy::Uniform => warp::square_to_uniform_hemisphere_pdf(wi),
+            BsdfStrategy::Cosine => warp::square_to_cosine_hemisphere_pdf(wi),
             _ => {
                 let p = self.glossy_probability(wo);
                 let pg = if p > 0.0 {
@@ -162,16 +162,16 @@ impl Material {
     /// angle. Bit for bit the same numbers as the two calls.
     #[inline]
     #[must_use]
-    pub fn eval_pdf(&self, strategy: Strategy, wo: DVec3, wi: DVec3) -> (Rgb, f64) {
+    pub fn eval_pdf(&self, strategy: BsdfStrategy, wo: DVec3, wi: DVec3) -> (Rgb, f64) {
         debug_assert!(self.check(strategy).is_ok(), "{strategy} does not apply");
         if wo.z <= 0.0 || wi.z <= 0.0 {
             return (Rgb::ZERO, 0.0);
         }
         let fd = self.diffuse.eval(wo, wi);
         match strategy {
-            Strategy::Uniform | Strategy::Cosine => {
+            BsdfStrategy::Uniform | BsdfStrategy::Cosine => {
                 let f = self.glossy.eval(wo, wi) + fd;
-                let pdf = if strategy == Strategy::Uniform {
+                let pdf = if strategy == BsdfStrategy::Uniform {
                     warp::square_to_uniform_hemisphere_pdf(wi)
                 } else {
                     warp::square_to_cosine_hemisphere_pdf(wi)
@@ -202,25 +202,31 @@ impl Material {
     /// [`Material::sampler`] validates it once.
     #[inline]
     #[must_use]
-    pub fn sample(&self, strategy: Strategy, wo: DVec3, uc: f64, u: DVec2) -> Option<BsdfSample> {
+    pub fn sample(
+        &self,
+        strategy: BsdfStrategy,
+        wo: DVec3,
+        uc: f64,
+        u: DVec2,
+    ) -> Option<BsdfSample> {
         debug_assert!(self.check(strategy).is_ok(), "{strategy} does not apply");
         if wo.z <= 0.0 {
             return None;
         }
         let (wi, lobe) = match strategy {
-            Strategy::Uniform => (warp::square_to_uniform_hemisphere(u), LobeKind::Hemisphere),
-            Strategy::Cosine => (warp::square_to_cosine_hemisphere(u), LobeKind::Hemisphere),
+            BsdfStrategy::Uniform => (warp::square_to_uniform_hemisphere(u), Component::Hemisphere),
+            BsdfStrategy::Cosine => (warp::square_to_cosine_hemisphere(u), Component::Hemisphere),
             _ => {
                 let p = self.glossy_probability(wo);
                 if p >= 1.0 {
                     // One lobe: its own f and pdf, computed with the sample.
                     let (wi, f, pdf) = self.glossy.sample_eval(strategy, wo, u)?;
-                    return Self::finish(wi, f, pdf, LobeKind::Glossy);
+                    return Self::finish(wi, f, pdf, Component::Glossy);
                 }
                 if uc < p {
-                    (self.glossy.sample(strategy, wo, u)?, LobeKind::Glossy)
+                    (self.glossy.sample(strategy, wo, u)?, Component::Glossy)
                 } else {
-                    (self.diffuse.sample(strategy, wo, u)?, LobeKind::Diffuse)
+                    (self.diffuse.sample(strategy, wo, u)?, Component::Diffuse)
                 }
             }
         };
@@ -231,7 +237,7 @@ impl Material {
     }
 
     #[inline]
-    fn finish(wi: DVec3, f: Rgb, pdf: f64, lobe: LobeKind) -> Option<BsdfSample> {
+    fn finish(wi: DVec3, f: Rgb, pdf: f64, component: Component) -> Option<BsdfSample> {
         if !(pdf > 0.0 && pdf.is_finite() && wi.z > 0.0) {
             return None;
         }
@@ -240,7 +246,7 @@ impl Material {
             f,
             pdf,
             weight: f * (wi.z / pdf),
-            lobe,
+            component,
         })
     }
 }
@@ -250,14 +256,14 @@ impl Material {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BsdfSampler<'m> {
     material: &'m Material,
-    strategy: Strategy,
+    strategy: BsdfStrategy,
 }
 
 impl<'m> BsdfSampler<'m> {
     /// The strategy this handle samples by.
     #[inline]
     #[must_use]
-    pub fn strategy(&self) -> Strategy {
+    pub fn strategy(&self) -> BsdfStrategy {
         self.strategy
     }
 

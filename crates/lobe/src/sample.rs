@@ -5,7 +5,7 @@ use glam::DVec3;
 
 /// Which part of the material drew the direction.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum LobeKind {
+pub enum Component {
     /// The Lambertian term, by cosine sampling.
     Diffuse,
     /// The glossy (specular) lobe, by the strategy's own sampler.
@@ -27,5 +27,5 @@ pub struct BsdfSample {
     /// `f · cos θi / pdf`, the Monte Carlo weight (cosine included).
     pub weight: Rgb,
     /// The lobe that was chosen.
-    pub lobe: LobeKind,
+    pub component: Component,
 }

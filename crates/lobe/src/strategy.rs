@@ -1,10 +1,12 @@
 //! Sampling strategies, selected by name.
 
 use crate::Error;
+use crate::Material;
+use crate::light::LightDistribution;
 
 /// How a direction `wi` is drawn for a given `wo`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub enum Strategy {
+pub enum BsdfStrategy {
     /// Uniform over the upper hemisphere, `1/(2π)`: the lecture's baseline.
     Uniform,
     /// Cosine-weighted hemisphere, `cos θ/π`.
@@ -21,32 +23,32 @@ pub enum Strategy {
     BoundedVndf,
 }
 
-impl Strategy {
-    pub const ALL: [Strategy; 6] = [
-        Strategy::Uniform,
-        Strategy::Cosine,
-        Strategy::Brdf,
-        Strategy::Vndf,
-        Strategy::SphericalCaps,
-        Strategy::BoundedVndf,
+impl BsdfStrategy {
+    pub const ALL: [BsdfStrategy; 6] = [
+        BsdfStrategy::Uniform,
+        BsdfStrategy::Cosine,
+        BsdfStrategy::Brdf,
+        BsdfStrategy::Vndf,
+        BsdfStrategy::SphericalCaps,
+        BsdfStrategy::BoundedVndf,
     ];
 
     #[must_use]
     pub fn name(self) -> &'static str {
         match self {
-            Strategy::Uniform => "uniform",
-            Strategy::Cosine => "cosine",
-            Strategy::Brdf => "brdf",
-            Strategy::Vndf => "vndf",
-            Strategy::SphericalCaps => "spherical-caps",
-            Strategy::BoundedVndf => "bounded-vndf",
+            BsdfStrategy::Uniform => "uniform",
+            BsdfStrategy::Cosine => "cosine",
+            BsdfStrategy::Brdf => "brdf",
+            BsdfStrategy::Vndf => "vndf",
+            BsdfStrategy::SphericalCaps => "spherical-caps",
+            BsdfStrategy::BoundedVndf => "bounded-vndf",
         }
     }
 
     /// All names, comma separated, for error messages and help.
     #[must_use]
     pub fn names() -> String {
-        Strategy::ALL
+        BsdfStrategy::ALL
             .iter()
             .map(|s| s.name())
             .collect::<Vec<_>>()
@@ -54,20 +56,198 @@ impl Strategy {
     }
 }
 
-impl std::fmt::Display for Strategy {
+impl std::fmt::Display for BsdfStrategy {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.write_str(self.name())
     }
 }
 
-impl std::str::FromStr for Strategy {
+impl std::str::FromStr for BsdfStrategy {
     type Err = Error;
     fn from_str(s: &str) -> Result<Self, Error> {
-        Strategy::ALL
+        BsdfStrategy::ALL
             .into_iter()
             .find(|x| x.name() == s)
             .ok_or_else(|| Error::UnknownName {
                 field: "strategy".into(),
+                value: s.into(),
+                expected: BsdfStrategy::names(),
+            })
+    }
+}
+
+/// How Multiple Importance Sampling weights its techniques (Veach 1997).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Heuristic {
+    /// `w_t = n_t p_t / Σ n p`.
+    Balance,
+    /// `w_t = (n_t p_t)² / Σ (n p)²`.
+    Power,
+}
+
+impl Heuristic {
+    /// The weight of a technique whose (count-scaled) density is `a`
+    /// against another's `b`.
+    #[inline]
+    #[must_use]
+    pub fn weight(self, a: f64, b: f64) -> f64 {
+        match self {
+            Heuristic::Balance => a / (a + b),
+            Heuristic::Power => a * a / (a * a + b * b),
+        }
+    }
+}
+
+/// Multi-sample MIS draws `n_bsdf` and `n_light` samples for every estimate;
+/// one-sample MIS draws one, choosing the technique with probability
+/// `n_t / (n_bsdf + n_light)`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum MisForm {
+    MultiSample,
+    OneSample,
+}
+
+/// BSDF sampling combined with light sampling.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct Mis {
+    /// The BSDF strategy; `None`: the material's best
+    /// ([`Material::best_bsdf_strategy`]), chosen per material.
+    pub bsdf: Option<BsdfStrategy>,
+    pub heuristic: Heuristic,
+    pub form: MisForm,
+    pub n_bsdf: u32,
+    pub n_light: u32,
+}
+
+/// How the directions of an estimate are drawn.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Strategy {
+    /// BSDF sampling by a strategy.
+    Bsdf(BsdfStrategy),
+    /// Light sampling alone.
+    Light,
+    /// Both, combined by MIS.
+    Mis(Mis),
+}
+
+impl std::fmt::Display for Strategy {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.name())
+    }
+}
+
+impl From<BsdfStrategy> for Strategy {
+    fn from(s: BsdfStrategy) -> Self {
+        Strategy::Bsdf(s)
+    }
+}
+
+/// The names of the techniques that are not BSDF strategies.
+pub const NON_BSDF_NAMES: [&str; 5] = ["light", "mis", "mis-power", "mis-one", "mis-power-one"];
+
+impl Strategy {
+    /// `mis` or `mis-power`: one sample of each technique, multi-sample, on
+    /// the material's best BSDF strategy.
+    #[must_use]
+    pub const fn mis(heuristic: Heuristic) -> Self {
+        Strategy::Mis(Mis {
+            bsdf: None,
+            heuristic,
+            form: MisForm::MultiSample,
+            n_bsdf: 1,
+            n_light: 1,
+        })
+    }
+
+    /// Every technique by name: the BSDF strategies, `light`, `mis`,
+    /// `mis-power`, `mis-one`, `mis-power-one` (MIS on the material's best
+    /// BSDF strategy, one sample of each technique).
+    #[must_use]
+    pub fn all() -> Vec<Strategy> {
+        let mut v: Vec<Strategy> = BsdfStrategy::ALL.into_iter().map(Strategy::Bsdf).collect();
+        v.push(Strategy::Light);
+        for form in [MisForm::MultiSample, MisForm::OneSample] {
+            for heuristic in [Heuristic::Balance, Heuristic::Power] {
+                v.push(Strategy::Mis(Mis {
+                    bsdf: None,
+                    heuristic,
+                    form,
+                    n_bsdf: 1,
+                    n_light: 1,
+                }));
+            }
+        }
+        v
+    }
+
+    /// Every accepted name, comma separated, for help and error messages.
+    #[must_use]
+    pub fn names() -> String {
+        format!("{}, {}", BsdfStrategy::names(), NON_BSDF_NAMES.join(", "))
+    }
+
+    /// The name used on the command line, in scene files and in tables.
+    #[must_use]
+    pub fn name(&self) -> String {
+        match self {
+            Strategy::Bsdf(s) => s.name().to_string(),
+            Strategy::Light => "light".into(),
+            Strategy::Mis(m) => {
+                let mut n = String::from(if m.heuristic == Heuristic::Balance {
+                    "mis"
+                } else {
+                    "mis-power"
+                });
+                if m.form == MisForm::OneSample {
+                    n.push_str("-one");
+                }
+                n
+            }
+        }
+    }
+
+    /// Sequence points used by one estimate (`n_bsdf + n_light` for
+    /// multi-sample MIS, else 1).
+    #[must_use]
+    pub fn points_per_sample(&self) -> usize {
+        match self {
+            Strategy::Mis(m) if m.form == MisForm::MultiSample => (m.n_bsdf + m.n_light) as usize,
+            _ => 1,
+        }
+    }
+
+    /// The light distribution this technique draws light samples from: the
+    /// plain one for light sampling alone, the MIS-compensated one inside
+    /// MIS. The one place where that choice is made.
+    #[must_use]
+    pub fn light_distribution(&self) -> LightDistribution {
+        match self {
+            Strategy::Mis(_) => LightDistribution::Compensated,
+            _ => LightDistribution::Plain,
+        }
+    }
+
+    /// The BSDF strategy this technique samples `m` by, if any: its own for
+    /// a BSDF technique, the given or the material's best for MIS, none for
+    /// light sampling.
+    #[must_use]
+    pub fn bsdf_strategy(&self, m: &Material) -> Option<BsdfStrategy> {
+        match self {
+            Strategy::Bsdf(s) => Some(*s),
+            Strategy::Light => None,
+            Strategy::Mis(mis) => Some(mis.bsdf.unwrap_or_else(|| m.best_bsdf_strategy())),
+        }
+    }
+}
+
+impl std::str::FromStr for Strategy {
+    type Err = Error;
+    /// Any name of [`Strategy::names`].
+    fn from_str(s: &str) -> Result<Self, Error> {
+        Strategy::all()
+            .into_iter()
+            .find(|t| t.name() == s)
+            .ok_or_else(|| Error::UnknownStrategy {
                 value: s.into(),
                 expected: Strategy::names(),
             })

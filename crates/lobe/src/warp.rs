@@ -4,7 +4,7 @@
 //! `tests/chi2.rs` (`chi2_warps`; the disk lifted onto the hemisphere), and
 //! the samplers use the `_pdf` partners as their densities: the material's
 //! `uniform` and `cosine` strategies, Lambert's `brdf`, the Phong and
-//! Blinn-Phong lobes ([`cos_power_pdf`]) and the constant and lobe lights.
+//! Blinn-Phong lobes ([`cos_power_pdf`]) and the constant and beam lights.
 
 use crate::math::{INV_FOUR_PI, INV_PI, INV_TWO_PI, safe_sqrt};
 use glam::{DVec2, DVec3};
@@ -124,7 +124,7 @@ pub fn square_to_cos_power_pdf(w: DVec3, n: f64) -> f64 {
 /// The cos-power density `(n+1)/(2π) cosⁿθ` in solid angle, as a function
 /// of `cos θ` (the angle to the lobe's axis), zero for `cos θ ≤ 0`: the
 /// density of [`square_to_cos_power`] in a frame around any axis. The
-/// Phong and Blinn-Phong samplers and the analytic lobe light use it.
+/// Phong and Blinn-Phong samplers and the analytic beam light use it.
 #[inline]
 #[must_use]
 pub fn cos_power_pdf(cos_theta: f64, n: f64) -> f64 {

@@ -9,7 +9,7 @@ mod common;
 
 use common::{Case, plan};
 use glam::DVec2;
-use lobe::Strategy;
+use lobe::BsdfStrategy;
 use lobe::stats::chi2::{Chi2Config, chi2_test, sidak, success_probability};
 
 fn run(cases: Vec<Case>) {
@@ -52,7 +52,7 @@ fn run(cases: Vec<Case>) {
             // ∫ pdf dω over the sphere = probability that a sample is not lost.
             let p = m.glossy_probability(wo);
             let lobes: Vec<(f64, f64)> = match s {
-                Strategy::Uniform | Strategy::Cosine => vec![(1.0, 0.5)],
+                BsdfStrategy::Uniform | BsdfStrategy::Cosine => vec![(1.0, 0.5)],
                 _ => vec![(p, 0.5 * p), (1.0 - p, 0.5 * (1.0 + p))],
             };
             let kept = success_probability(
@@ -174,7 +174,7 @@ fn chi2_catches_a_wrong_pdf() {
     // The lecture's density over half vectors, used as if it were over wi.
     let r = chi2_test(
         &Chi2Config::default(),
-        |uc, u| m.sample(Strategy::Brdf, wo, uc, u).map(|x| x.wi),
+        |uc, u| m.sample(BsdfStrategy::Brdf, wo, uc, u).map(|x| x.wi),
         |wi| {
             let h = (wo + wi).normalize();
             if wi.z > 0.0 {

@@ -8,7 +8,7 @@ use glam::DVec3;
 use lobe::estimator::{Plan, ShadingPoint, estimate, reference};
 use lobe::math::luminance;
 use lobe::sequence::Sequence;
-use lobe::{Light, Rgb, Strategy};
+use lobe::{BsdfStrategy, Light, Rgb};
 
 fn lights() -> [Light; 2] {
     [
@@ -47,7 +47,12 @@ fn every_estimate_is_within_four_standard_errors() {
         for theta in [0.0, 45.0, 75.0] {
             let wo = common::wo(theta);
             for light in lights() {
-                let r = luminance(reference(&c.material, &ShadingPoint::local(wo), &light, 1e-9));
+                let r = luminance(reference(
+                    &c.material,
+                    &ShadingPoint::local(wo),
+                    &light,
+                    1e-9,
+                ));
                 for s in c.material.strategies() {
                     for seq in Sequence::ALL {
                         count += 1;
@@ -56,7 +61,7 @@ fn every_estimate_is_within_four_standard_errors() {
                             &ShadingPoint::local(wo),
                             &light,
                             &Plan {
-                                technique: s.into(),
+                                strategy: s.into(),
                                 sequence: seq,
                                 samples: 1 << 16,
                                 seed: count,
@@ -89,7 +94,7 @@ fn every_estimate_is_within_four_standard_errors() {
     );
 }
 
-fn variance(json: &str, theta: f64, s: Strategy) -> f64 {
+fn variance(json: &str, theta: f64, s: BsdfStrategy) -> f64 {
     let c = common::case(json);
     let wo = lobe::frame::wo_from_theta(theta, 0.0);
     let acc = estimate(
@@ -106,8 +111,8 @@ fn variance(json: &str, theta: f64, s: Strategy) -> f64 {
 fn phong_brdf_sampling_cuts_the_variance_tenfold() {
     let m = r#"{"type":"phong","exponent":100}"#;
     let (u, b) = (
-        variance(m, 30.0, Strategy::Uniform),
-        variance(m, 30.0, Strategy::Brdf),
+        variance(m, 30.0, BsdfStrategy::Uniform),
+        variance(m, 30.0, BsdfStrategy::Brdf),
     );
     assert!(b * 10.0 <= u, "uniform {u}, brdf {b}: only {:.1}x", u / b);
 }
@@ -116,8 +121,8 @@ fn phong_brdf_sampling_cuts_the_variance_tenfold() {
 fn visible_normals_beat_d_cos_at_grazing_views() {
     let m = r#"{"type":"cook-torrance","distribution":"ggx","alpha":0.1}"#;
     let (b, v) = (
-        variance(m, 70.0, Strategy::Brdf),
-        variance(m, 70.0, Strategy::Vndf),
+        variance(m, 70.0, BsdfStrategy::Brdf),
+        variance(m, 70.0, BsdfStrategy::Vndf),
     );
     assert!(v <= b, "vndf {v} > brdf {b}");
 }
@@ -126,7 +131,7 @@ fn visible_normals_beat_d_cos_at_grazing_views() {
 fn rmse_of(
     m: &lobe::Material,
     light: &Light,
-    t: lobe::estimator::Technique,
+    t: lobe::estimator::Strategy,
     seq: Sequence,
     n: usize,
     runs: u64,
@@ -136,7 +141,7 @@ fn rmse_of(
     let mut sq = 0.0;
     for run in 0..runs {
         let plan = Plan {
-            technique: t,
+            strategy: t,
             sequence: seq,
             samples: n,
             seed: 1000 + run,
@@ -153,7 +158,7 @@ fn rmse_of(
 /// sequence and under Sobol was no better than independent sampling.
 #[test]
 fn mis_gains_from_sobol_and_stratified_points_like_its_parts() {
-    use lobe::estimator::{Heuristic, Technique};
+    use lobe::estimator::{Heuristic, Strategy};
     let m = common::case(r#"{"type":"lambert"}"#).material;
     let light = Light::Beam {
         dir: DVec3::new(0.3, 0.0, 0.9).normalize(),
@@ -161,7 +166,10 @@ fn mis_gains_from_sobol_and_stratified_points_like_its_parts() {
         radiance: Rgb::ONE,
     };
     let n = 1 << 12;
-    for t in [Technique::mis(Heuristic::Balance), Technique::mis(Heuristic::Power)] {
+    for t in [
+        Strategy::mis(Heuristic::Balance),
+        Strategy::mis(Heuristic::Power),
+    ] {
         let ind = rmse_of(&m, &light, t, Sequence::Independent, n, 16);
         for seq in [Sequence::Sobol, Sequence::Stratified] {
             let q = rmse_of(&m, &light, t, seq, n, 16);

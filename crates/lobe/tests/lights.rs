@@ -6,13 +6,13 @@ mod common;
 
 use glam::DVec3;
 use lobe::envmap::EnvMap;
-use lobe::estimator::{Heuristic, MisForm, Plan, ShadingPoint, Technique, estimate, reference};
+use lobe::estimator::{Heuristic, MisForm, Plan, ShadingPoint, Strategy, estimate, reference};
 use lobe::light::LightDistribution;
 use lobe::math::luminance;
 use lobe::sequence::Sequence;
 use lobe::stats::chi2::{Chi2Config, chi2_test, chi2_test_cells};
 use lobe::stats::quadrature::{Estimate, Tolerance, integrate_sphere};
-use lobe::{Frame, Light, Rgb, Strategy};
+use lobe::{BsdfStrategy, Frame, Light, Rgb};
 use std::sync::Arc;
 
 fn maps() -> Vec<(&'static str, EnvMap)> {
@@ -124,7 +124,7 @@ fn rmse(
     m: &lobe::Material,
     sp: &ShadingPoint,
     light: &Light,
-    t: Technique,
+    t: Strategy,
     reference: f64,
     n: usize,
     runs: u64,
@@ -138,7 +138,7 @@ fn rmse(
                 sp,
                 light,
                 &Plan {
-                    technique: t,
+                    strategy: t,
                     sequence: Sequence::Independent,
                     samples: n,
                     seed: 100 + r,
@@ -174,10 +174,10 @@ fn mis_is_as_good_as_the_better_technique_on_a_sunny_sky() {
     ] {
         let c = common::case(json);
         let m = c.material;
-        let bsdf = if m.check(Strategy::Vndf).is_ok() {
-            Strategy::Vndf
+        let bsdf = if m.check(BsdfStrategy::Vndf).is_ok() {
+            BsdfStrategy::Vndf
         } else {
-            Strategy::Brdf
+            BsdfStrategy::Brdf
         };
         // View from the side the sun shines on, so that the highlight is in play.
         let wo = frame.to_local(DVec3::new(0.0, 0.6, 0.8).normalize());
@@ -185,11 +185,11 @@ fn mis_is_as_good_as_the_better_technique_on_a_sunny_sky() {
         let r = luminance(reference(&m, &sp, &light, 1e-7));
         let n = 4096;
         let runs = 64;
-        let (e_b, m_b, se_b) = rmse(&m, &sp, &light, Technique::Bsdf(bsdf), r, n, runs);
-        let (e_l, m_l, se_l) = rmse(&m, &sp, &light, Technique::Light, r, n, runs);
+        let (e_b, m_b, se_b) = rmse(&m, &sp, &light, Strategy::Bsdf(bsdf), r, n, runs);
+        let (e_l, m_l, se_l) = rmse(&m, &sp, &light, Strategy::Light, r, n, runs);
         for h in [Heuristic::Balance, Heuristic::Power] {
             for form in [MisForm::MultiSample, MisForm::OneSample] {
-                let t = Technique::Mis(lobe::estimator::Mis {
+                let t = Strategy::Mis(lobe::estimator::Mis {
                     bsdf: Some(bsdf),
                     heuristic: h,
                     form,

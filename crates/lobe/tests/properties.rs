@@ -9,7 +9,7 @@ use glam::{DVec2, DVec3};
 use lobe::math::{Rgb, luminance};
 use lobe::stats::quadrature::{Tolerance, integrate_hemisphere};
 use lobe::stats::ttest::{Moments, t_test};
-use lobe::{Material, Strategy};
+use lobe::{BsdfStrategy, Material};
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64;
 
@@ -136,7 +136,7 @@ fn lambert_furnace_is_exact() {
     let mut rng = Pcg64::seed_from_u64(9);
     for _ in 0..10_000 {
         let wo = random_wo(&mut rng);
-        for s in [Strategy::Cosine, Strategy::Brdf] {
+        for s in [BsdfStrategy::Cosine, BsdfStrategy::Brdf] {
             let x = c
                 .material
                 .sample(s, wo, rng.random(), DVec2::new(rng.random(), rng.random()))
@@ -193,7 +193,7 @@ fn every_strategy_is_unbiased() {
         for s in c.material.strategies() {
             // Material-blind strategies on very narrow lobes have heavy-tailed
             // weights whose sample variance is unreliable at this N.
-            let blind = matches!(s, Strategy::Uniform | Strategy::Cosine);
+            let blind = matches!(s, BsdfStrategy::Uniform | BsdfStrategy::Cosine);
             if blind
                 && (c.json.contains("0.02") || c.json.contains("000") || c.json.contains("0.05"))
             {
@@ -327,7 +327,6 @@ fn no_nan_at_the_edges() {
 mod prop {
     use super::*;
     use proptest::prelude::*;
-    use proptest::strategy::Strategy as _;
 
     fn direction() -> impl proptest::strategy::Strategy<Value = DVec3> {
         (
@@ -375,12 +374,15 @@ fn bad_parameters_are_refused_with_the_field_named() {
     assert!(e.contains("alpha_v"), "{e}");
     let e = "trowbridge".parse::<Ndf>().unwrap_err().to_string();
     assert!(e.contains("distribution") && e.contains("ggx"), "{e}");
-    let e = "importance".parse::<Strategy>().unwrap_err().to_string();
+    let e = "importance"
+        .parse::<BsdfStrategy>()
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("strategy") && e.contains("vndf"), "{e}");
     let m = common::case(r#"{"type":"phong"}"#).material;
-    assert!(m.check(Strategy::Vndf).is_err());
+    assert!(m.check(BsdfStrategy::Vndf).is_err());
     let m = common::case(r#"{"type":"cook-torrance","distribution":"beckmann"}"#).material;
-    assert!(m.check(Strategy::Vndf).is_ok() && m.check(Strategy::BoundedVndf).is_err());
+    assert!(m.check(BsdfStrategy::Vndf).is_ok() && m.check(BsdfStrategy::BoundedVndf).is_err());
 }
 
 /// `eval_pdf` is `(eval, pdf)` bit for bit, for every model and strategy,
@@ -424,7 +426,7 @@ fn eval_pdf_is_eval_and_pdf_bit_for_bit() {
 #[test]
 fn a_strategy_that_does_not_apply_has_no_sampler() {
     let m = common::case(r#"{"type":"phong","exponent":10}"#).material;
-    let e = m.sampler(Strategy::Vndf).unwrap_err().to_string();
+    let e = m.sampler(BsdfStrategy::Vndf).unwrap_err().to_string();
     assert!(e.contains("vndf") && e.contains("does not apply"), "{e}");
-    assert!(m.sampler(Strategy::Brdf).is_ok());
+    assert!(m.sampler(BsdfStrategy::Brdf).is_ok());
 }

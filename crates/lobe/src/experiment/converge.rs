@@ -19,7 +19,7 @@
 //! its inputs, so the numbers do not depend on the thread count.
 
 use super::map_indices;
-use crate::estimator::{Plan, ShadingPoint, Technique, estimate};
+use crate::estimator::{Plan, ShadingPoint, Strategy, estimate};
 use crate::progress::Progress;
 use crate::sequence::{Sequence, hash64};
 use crate::{Error, Light, Material};
@@ -42,7 +42,7 @@ pub struct CurveSettings {
 /// The RMSE of one technique × sequence at every `N`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Curve {
-    pub strategy: Technique,
+    pub strategy: Strategy,
     pub sequence: Sequence,
     /// `(N, RMSE)` for `N = 2^0 .. 2^K`.
     pub points: Vec<(usize, f64)>,
@@ -72,7 +72,7 @@ pub fn total_samples(series: usize, runs: usize, max_exp: u32) -> u64 {
 
 /// Every technique × sequence, technique-major.
 #[must_use]
-pub fn product(techniques: &[Technique], sequences: &[Sequence]) -> Vec<(Technique, Sequence)> {
+pub fn product(techniques: &[Strategy], sequences: &[Sequence]) -> Vec<(Strategy, Sequence)> {
     techniques
         .iter()
         .flat_map(|&s| sequences.iter().map(move |&q| (s, q)))
@@ -92,7 +92,7 @@ pub fn curves(
     sp: &ShadingPoint,
     light: &Light,
     target: f64,
-    series: &[(Technique, Sequence)],
+    series: &[(Strategy, Sequence)],
     settings: CurveSettings,
     progress: &dyn Progress,
 ) -> Result<Vec<Curve>, Error> {
@@ -120,7 +120,7 @@ pub fn curves(
         let (i, k, r) = tasks[t];
         let (strategy, sequence) = series[i];
         let plan = Plan {
-            technique: strategy,
+            strategy,
             sequence,
             samples: 1usize << k,
             seed: run_seed(seed, r, k),
@@ -179,10 +179,10 @@ pub fn fit_slope(points: &[(usize, f64)]) -> Option<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use glam::DVec3;
     use crate::estimator::reference;
     use crate::math::luminance;
-    use crate::{Rgb, Strategy};
+    use crate::{BsdfStrategy, Rgb};
+    use glam::DVec3;
 
     #[test]
     fn slope_of_an_exact_power_law() {
@@ -210,11 +210,11 @@ mod tests {
         assert_eq!(fit_start(11), 6);
         assert_eq!(total_samples(2, 3, 4), 31 * 6);
         let p = product(
-            &[Technique::Light, Strategy::Cosine.into()],
+            &[Strategy::Light, BsdfStrategy::Cosine.into()],
             &[Sequence::Independent, Sequence::Sobol],
         );
         assert_eq!(p.len(), 4);
-        assert_eq!(p[1], (Technique::Light, Sequence::Sobol));
+        assert_eq!(p[1], (Strategy::Light, Sequence::Sobol));
     }
 
     /// Independent sampling converges as `N^-1/2`; the zero-variance
@@ -231,7 +231,7 @@ mod tests {
         };
         let target = luminance(reference(&m, &sp, &light, REFERENCE_TOLERANCE));
         let series = product(
-            &[Strategy::Uniform.into(), Strategy::Cosine.into()],
+            &[BsdfStrategy::Uniform.into(), BsdfStrategy::Cosine.into()],
             &[Sequence::Independent],
         );
         let settings = CurveSettings {
@@ -256,10 +256,11 @@ mod tests {
             &sp,
             &furnace,
             target,
-            &[(Strategy::Cosine.into(), Sequence::Independent)],
+            &[(BsdfStrategy::Cosine.into(), Sequence::Independent)],
             settings,
             &(),
-        ).unwrap();
+        )
+        .unwrap();
         assert!(exact[0].points.iter().all(|p| p.1 < 1e-12), "{exact:?}");
     }
 }

@@ -10,7 +10,7 @@
 use super::map_indices;
 use crate::math::luminance;
 use crate::progress::Progress;
-use crate::{Material, Strategy};
+use crate::{BsdfStrategy, Material};
 use glam::{DVec2, DVec3};
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64;
@@ -58,7 +58,7 @@ pub fn disk_cell(x: f64, res: usize) -> usize {
 #[must_use]
 pub fn projected_histograms(
     material: &Material,
-    strategy: Strategy,
+    strategy: BsdfStrategy,
     wo: DVec3,
     samples: usize,
     seed: u64,
@@ -205,7 +205,7 @@ pub enum WeightPixel {
 #[must_use]
 pub fn weight_pixels(
     material: &Material,
-    strategy: Strategy,
+    strategy: BsdfStrategy,
     wo: DVec3,
     res: usize,
 ) -> Vec<WeightPixel> {
@@ -303,7 +303,15 @@ mod tests {
     fn expected_counts_are_accurate_at_the_rim() {
         let wo = DVec3::new(0.0, 0.0, 1.0);
         let res = 16;
-        let h = projected_histograms(&lambert(), Strategy::Uniform, wo, 1_000_000, 1, res, &());
+        let h = projected_histograms(
+            &lambert(),
+            BsdfStrategy::Uniform,
+            wo,
+            1_000_000,
+            1,
+            res,
+            &(),
+        );
         for i in 0..res {
             let column: f64 = (0..res).map(|j| h.expected[j * res + i]).sum();
             let exact = 1_000_000.0 / res as f64;
@@ -330,7 +338,7 @@ mod tests {
     fn histograms_agree_for_cosine_sampling() {
         let wo = DVec3::new(0.5, 0.0, 0.75f64.sqrt());
         let steps = Steps(std::sync::Mutex::new((0, 0)));
-        let h = projected_histograms(&lambert(), Strategy::Cosine, wo, 200_000, 3, 16, &steps);
+        let h = projected_histograms(&lambert(), BsdfStrategy::Cosine, wo, 200_000, 3, 16, &steps);
         assert_eq!(h.res, 16);
         assert_eq!((h.observed.len(), h.expected.len()), (256, 256));
         let (so, se): (f64, f64) = (h.observed.iter().sum(), h.expected.iter().sum());
@@ -338,7 +346,7 @@ mod tests {
         assert!((se / 200_000.0 - 1.0).abs() < 2e-3, "{se}");
         assert_eq!(*steps.0.lock().unwrap(), (200_000, 200_000));
         // The same seed gives the same counts.
-        let again = projected_histograms(&lambert(), Strategy::Cosine, wo, 200_000, 3, 16, &());
+        let again = projected_histograms(&lambert(), BsdfStrategy::Cosine, wo, 200_000, 3, 16, &());
         assert_eq!(again, h);
     }
 
@@ -348,8 +356,8 @@ mod tests {
     fn weights_of_lambert() {
         let wo = DVec3::Z;
         let res = 9;
-        let cos = weight_pixels(&lambert(), Strategy::Cosine, wo, res);
-        let uni = weight_pixels(&lambert(), Strategy::Uniform, wo, res);
+        let cos = weight_pixels(&lambert(), BsdfStrategy::Cosine, wo, res);
+        let uni = weight_pixels(&lambert(), BsdfStrategy::Uniform, wo, res);
         assert_eq!(cos.len(), 81);
         assert_eq!(cos[0], WeightPixel::Outside);
         let mut inside = 0;

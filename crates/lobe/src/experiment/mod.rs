@@ -52,7 +52,7 @@ pub fn estimate_chunked(
     plan: &Plan,
     progress: &dyn Progress,
 ) -> Result<Accumulator, Error> {
-    let est = plan.technique.for_material(m)?;
+    let est = plan.strategy.for_material(m)?;
     let parts = map_indices(plan.chunks(), |c| {
         let a = estimate_chunk(&est, sp, light, plan, c);
         progress.advance(a.count() as u64);
@@ -82,10 +82,10 @@ pub fn reference_rows(m: &Material, sp: &ShadingPoint, light: &Light, rel: f64) 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use glam::DVec3;
-    use crate::estimator::{Technique, estimate};
+    use crate::estimator::{Strategy, estimate};
     use crate::sequence::Sequence;
-    use crate::{Frame, Strategy};
+    use crate::{BsdfStrategy, Frame};
+    use glam::DVec3;
     use std::sync::Arc;
     use std::sync::atomic::{AtomicU64, Ordering};
 
@@ -107,7 +107,7 @@ mod tests {
         };
         for sequence in Sequence::ALL {
             let plan = Plan {
-                technique: Technique::Bsdf(Strategy::Uniform),
+                strategy: Strategy::Bsdf(BsdfStrategy::Uniform),
                 sequence,
                 samples: 3 * crate::estimator::CHUNK + 17,
                 seed: 5,

@@ -3,11 +3,11 @@
 //! `lobe estimate` prints).
 
 use super::{estimate_chunked, reference_rows};
-use crate::estimator::{Plan, ShadingPoint, Technique};
+use crate::estimator::{Plan, ShadingPoint, Strategy};
 use crate::math::luminance;
 use crate::progress::{Clock, Progress, timed};
 use crate::sequence::Sequence;
-use crate::{Error, Light, Material, Strategy};
+use crate::{BsdfStrategy, Error, Light, Material};
 
 /// Relative tolerance of the quadrature reference of [`run_table`].
 pub const REFERENCE_TOLERANCE: f64 = 1e-9;
@@ -26,7 +26,7 @@ pub struct TableSettings {
 #[derive(Debug, Clone, PartialEq)]
 #[cfg_attr(feature = "desc", derive(serde::Serialize))]
 pub struct Row {
-    /// The technique's name ([`Technique::name`]).
+    /// The technique's name ([`Strategy::name`]).
     pub name: String,
     pub samples: usize,
     /// The estimate of `L_o = ∫ f L cos dω` (RGB; the cosine is included).
@@ -74,7 +74,7 @@ pub fn run_table(
     m: &Material,
     sp: &ShadingPoint,
     light: &Light,
-    techniques: &[Technique],
+    techniques: &[Strategy],
     settings: TableSettings,
     progress: &dyn Progress,
     clock: &dyn Clock,
@@ -86,16 +86,16 @@ pub fn run_table(
     } = settings;
     let reference = reference_rows(m, sp, light, REFERENCE_TOLERANCE);
     let r_lum = luminance(reference);
-    let uniform = Technique::Bsdf(Strategy::Uniform);
-    let mut todo: Vec<Technique> = techniques.to_vec();
+    let uniform = Strategy::Bsdf(BsdfStrategy::Uniform);
+    let mut todo: Vec<Strategy> = techniques.to_vec();
     if !todo.contains(&uniform) {
         todo.push(uniform);
     }
     progress.start("estimating", (samples * todo.len()) as u64);
-    let mut rows: Vec<(Technique, Row)> = Vec::new();
+    let mut rows: Vec<(Strategy, Row)> = Vec::new();
     for &s in &todo {
         let plan = Plan {
-            technique: s,
+            strategy: s,
             sequence,
             samples,
             seed,
@@ -151,9 +151,9 @@ pub fn run_table(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use glam::DVec3;
     use crate::Rgb;
     use crate::estimator::{Heuristic, Mis, MisForm};
+    use glam::DVec3;
     use std::sync::Mutex;
     use std::time::Duration;
 
@@ -195,8 +195,8 @@ mod tests {
         let sp = ShadingPoint::local(wo);
         let light = Light::Constant(Rgb::ONE);
         let techniques = [
-            Technique::Bsdf(Strategy::Uniform),
-            Technique::Bsdf(Strategy::Cosine),
+            Strategy::Bsdf(BsdfStrategy::Uniform),
+            Strategy::Bsdf(BsdfStrategy::Cosine),
         ];
         let progress = Record::default();
         let t = run_table(
@@ -207,7 +207,8 @@ mod tests {
             settings(10_000),
             &progress,
             &Ticks(Mutex::new(0)),
-        ).unwrap();
+        )
+        .unwrap();
         for c in t.reference {
             assert!((c - 0.8).abs() < 1e-9, "{c}");
         }
@@ -242,14 +243,14 @@ mod tests {
             exponent: 20.0,
             radiance: Rgb::ONE,
         };
-        let mis = Technique::Mis(Mis {
-            bsdf: Some(Strategy::Cosine),
+        let mis = Strategy::Mis(Mis {
+            bsdf: Some(BsdfStrategy::Cosine),
             heuristic: Heuristic::Balance,
             form: MisForm::MultiSample,
             n_bsdf: 1,
             n_light: 1,
         });
-        let techniques = [Technique::Light, mis, Technique::Bsdf(Strategy::Cosine)];
+        let techniques = [Strategy::Light, mis, Strategy::Bsdf(BsdfStrategy::Cosine)];
         let t = run_table(
             &m,
             &sp,
@@ -258,18 +259,20 @@ mod tests {
             settings(8192),
             &(),
             &Ticks(Mutex::new(0)),
-        ).unwrap();
+        )
+        .unwrap();
         let names: Vec<&str> = t.strategies.iter().map(|r| r.name.as_str()).collect();
         assert_eq!(names, ["light", "mis", "cosine"]);
         let all = run_table(
             &m,
             &sp,
             &light,
-            &[Technique::Bsdf(Strategy::Uniform)],
+            &[Strategy::Bsdf(BsdfStrategy::Uniform)],
             settings(8192),
             &(),
             &Ticks(Mutex::new(0)),
-        ).unwrap();
+        )
+        .unwrap();
         let uniform = all.strategies[0].variance;
         for r in &t.strategies {
             assert_eq!(

@@ -26,9 +26,9 @@
 //! (Walter et al. 2007, eq. 14). The lecture gives `p_h` alone; used as if it
 //! were the density of `wi`, it makes the estimator biased.
 
-use super::{Lobe, ModelInfo, Param, Value};
+use super::{Bxdf, ModelInfo, Param, Value};
 use crate::math::{Rgb, luminance, reflect};
-use crate::{Strategy, warp};
+use crate::{BsdfStrategy, warp};
 use glam::{DVec2, DVec3};
 
 pub const KS: Param = super::phong::KS;
@@ -92,7 +92,7 @@ impl BlinnPhong {
     }
 }
 
-impl Lobe for BlinnPhong {
+impl Bxdf for BlinnPhong {
     #[inline]
     fn eval(&self, wo: DVec3, wi: DVec3) -> Rgb {
         let Some(h) = (wo + wi).try_normalize() else {
@@ -102,14 +102,14 @@ impl Lobe for BlinnPhong {
     }
 
     #[inline]
-    fn sample(&self, _strategy: Strategy, wo: DVec3, u: DVec2) -> Option<DVec3> {
+    fn sample(&self, _strategy: BsdfStrategy, wo: DVec3, u: DVec2) -> Option<DVec3> {
         let h = warp::square_to_cos_power(u, self.exponent);
         let wi = reflect(wo, h);
         (wi.z > 0.0 && wo.dot(h) > 0.0).then(|| wi.normalize())
     }
 
     #[inline]
-    fn pdf(&self, _strategy: Strategy, wo: DVec3, wi: DVec3) -> f64 {
+    fn pdf(&self, _strategy: BsdfStrategy, wo: DVec3, wi: DVec3) -> f64 {
         let Some(h) = (wo + wi).try_normalize() else {
             return 0.0;
         };
@@ -129,9 +129,9 @@ impl Lobe for BlinnPhong {
         }
     }
 
-    fn supports(&self, strategy: Strategy) -> Result<(), String> {
+    fn supports(&self, strategy: BsdfStrategy) -> Result<(), String> {
         match strategy {
-            Strategy::Uniform | Strategy::Cosine | Strategy::Brdf => Ok(()),
+            BsdfStrategy::Uniform | BsdfStrategy::Cosine | BsdfStrategy::Brdf => Ok(()),
             _ => Err("Blinn-Phong here is the lecture's model, not a microfacet one; use uniform, cosine or brdf, or cook-torrance with distribution blinn-phong".into()),
         }
     }

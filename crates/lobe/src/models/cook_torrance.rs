@@ -30,10 +30,10 @@
 //!
 //! The sampling densities use Smith's `G1` whatever `G` term `eval` uses.
 
-use super::{Lobe, ModelInfo, Param, Range, Value};
+use super::{Bxdf, ModelInfo, Param, Range, Value};
 use crate::math::{Rgb, luminance, reflect};
 use crate::microfacet::{MAX_ALPHA, MIN_ALPHA, Microfacet, Ndf, Shadowing};
-use crate::{Fresnel, Strategy};
+use crate::{Fresnel, BsdfStrategy};
 use glam::{DVec2, DVec3};
 
 pub const KS: Param = Param {
@@ -214,12 +214,12 @@ impl CookTorrance {
 impl CookTorrance {
     /// Draw the microfacet normal by `strategy` and reflect: `(wi, wm)`.
     #[inline]
-    fn sample_wm(&self, strategy: Strategy, wo: DVec3, u: DVec2) -> Option<(DVec3, DVec3)> {
+    fn sample_wm(&self, strategy: BsdfStrategy, wo: DVec3, u: DVec2) -> Option<(DVec3, DVec3)> {
         let mf = &self.microfacet;
         let wm = match strategy {
-            Strategy::Vndf => mf.sample_visible(wo, u)?,
-            Strategy::SphericalCaps => mf.sample_visible_caps(wo, u),
-            Strategy::BoundedVndf => mf.sample_visible_bounded(wo, u),
+            BsdfStrategy::Vndf => mf.sample_visible(wo, u)?,
+            BsdfStrategy::SphericalCaps => mf.sample_visible_caps(wo, u),
+            BsdfStrategy::BoundedVndf => mf.sample_visible_bounded(wo, u),
             _ => mf.sample_wm(u),
         };
         if wo.dot(wm) <= 0.0 {
@@ -231,7 +231,7 @@ impl CookTorrance {
     }
 }
 
-impl Lobe for CookTorrance {
+impl Bxdf for CookTorrance {
     #[inline]
     fn eval(&self, wo: DVec3, wi: DVec3) -> Rgb {
         let Some(h) = (wo + wi).try_normalize() else {
@@ -250,14 +250,14 @@ impl Lobe for CookTorrance {
     }
 
     #[inline]
-    fn sample(&self, strategy: Strategy, wo: DVec3, u: DVec2) -> Option<DVec3> {
+    fn sample(&self, strategy: BsdfStrategy, wo: DVec3, u: DVec2) -> Option<DVec3> {
         self.sample_wm(strategy, wo, u).map(|(wi, _)| wi)
     }
 
     /// The sampled `wm` is the half vector of `wo` and the reflected `wi`,
     /// so `D(wm)` and `Λ(wo)` serve `f` and the pdf at once.
     #[inline]
-    fn sample_eval(&self, strategy: Strategy, wo: DVec3, u: DVec2) -> Option<(DVec3, Rgb, f64)> {
+    fn sample_eval(&self, strategy: BsdfStrategy, wo: DVec3, u: DVec2) -> Option<(DVec3, Rgb, f64)> {
         let (wi, wm) = self.sample_wm(strategy, wo, u)?;
         let mf = &self.microfacet;
         let cos_oh = wo.dot(wm);
@@ -267,8 +267,8 @@ impl Lobe for CookTorrance {
         let inv4o = 0.25 / wo.z;
         let dg = d * g * inv4o / wi.z;
         let pdf = match strategy {
-            Strategy::Vndf | Strategy::SphericalCaps => Microfacet::pdf_visible_reflect(d, lo, wo),
-            Strategy::BoundedVndf => mf.pdf_reflect_bounded(wo, wi),
+            BsdfStrategy::Vndf | BsdfStrategy::SphericalCaps => Microfacet::pdf_visible_reflect(d, lo, wo),
+            BsdfStrategy::BoundedVndf => mf.pdf_reflect_bounded(wo, wi),
             _ => mf.pdf_wm(wm) * 0.25 / cos_oh,
         };
         if !(dg.is_finite() && pdf.is_finite()) {
@@ -278,9 +278,9 @@ impl Lobe for CookTorrance {
     }
 
     #[inline]
-    fn pdf(&self, strategy: Strategy, wo: DVec3, wi: DVec3) -> f64 {
+    fn pdf(&self, strategy: BsdfStrategy, wo: DVec3, wi: DVec3) -> f64 {
         let mf = &self.microfacet;
-        if strategy == Strategy::BoundedVndf {
+        if strategy == BsdfStrategy::BoundedVndf {
             return mf.pdf_reflect_bounded(wo, wi);
         }
         let Some(h) = (wo + wi).try_normalize() else {
@@ -291,7 +291,7 @@ impl Lobe for CookTorrance {
             return 0.0;
         }
         let p = match strategy {
-            Strategy::Vndf | Strategy::SphericalCaps => {
+            BsdfStrategy::Vndf | BsdfStrategy::SphericalCaps => {
                 Microfacet::pdf_visible_reflect(mf.d(h), mf.lambda(wo), wo)
             }
             _ => mf.pdf_wm(h) / (4.0 * cos_oh),
@@ -302,10 +302,10 @@ impl Lobe for CookTorrance {
     /// `eval` and `pdf` sharing the half vector, `D(h)` and `Λ(wo)`; the
     /// same numbers as the two calls.
     #[inline]
-    fn eval_pdf(&self, strategy: Strategy, wo: DVec3, wi: DVec3) -> (Rgb, f64) {
+    fn eval_pdf(&self, strategy: BsdfStrategy, wo: DVec3, wi: DVec3) -> (Rgb, f64) {
         let mf = &self.microfacet;
         let Some(h) = (wo + wi).try_normalize() else {
-            let p = if strategy == Strategy::BoundedVndf {
+            let p = if strategy == BsdfStrategy::BoundedVndf {
                 mf.pdf_reflect_bounded(wo, wi)
             } else {
                 0.0
@@ -314,7 +314,7 @@ impl Lobe for CookTorrance {
         };
         let cos_oh = wo.dot(h);
         if cos_oh <= 0.0 {
-            let p = if strategy == Strategy::BoundedVndf {
+            let p = if strategy == BsdfStrategy::BoundedVndf {
                 mf.pdf_reflect_bounded(wo, wi)
             } else {
                 0.0
@@ -330,8 +330,8 @@ impl Lobe for CookTorrance {
             Rgb::ZERO
         };
         let p = match strategy {
-            Strategy::BoundedVndf => mf.pdf_reflect_bounded(wo, wi),
-            Strategy::Vndf | Strategy::SphericalCaps => Microfacet::pdf_visible_reflect(d, lo, wo),
+            BsdfStrategy::BoundedVndf => mf.pdf_reflect_bounded(wo, wi),
+            BsdfStrategy::Vndf | BsdfStrategy::SphericalCaps => Microfacet::pdf_visible_reflect(d, lo, wo),
             _ => mf.pdf_wm(h) / (4.0 * cos_oh),
         };
         (f, if p.is_finite() { p } else { 0.0 })
@@ -341,15 +341,15 @@ impl Lobe for CookTorrance {
         luminance(self.ks * self.fresnel.eval(wo.z))
     }
 
-    fn supports(&self, strategy: Strategy) -> Result<(), String> {
+    fn supports(&self, strategy: BsdfStrategy) -> Result<(), String> {
         let ndf = self.microfacet.ndf();
         match strategy {
-            Strategy::Uniform | Strategy::Cosine | Strategy::Brdf => Ok(()),
-            Strategy::Vndf if ndf != Ndf::BlinnPhong => Ok(()),
-            Strategy::Vndf => {
+            BsdfStrategy::Uniform | BsdfStrategy::Cosine | BsdfStrategy::Brdf => Ok(()),
+            BsdfStrategy::Vndf if ndf != Ndf::BlinnPhong => Ok(()),
+            BsdfStrategy::Vndf => {
                 Err("visible-normal sampling needs distribution ggx or beckmann".into())
             }
-            Strategy::SphericalCaps | Strategy::BoundedVndf if ndf == Ndf::Ggx => Ok(()),
+            BsdfStrategy::SphericalCaps | BsdfStrategy::BoundedVndf if ndf == Ndf::Ggx => Ok(()),
             _ => Err(format!("{strategy} needs distribution ggx")),
         }
     }

@@ -10,9 +10,9 @@
 //! density `cos θi / π`, so the weight `f cos/pdf = albedo` is constant: a
 //! zero-variance estimator under constant light (the furnace test).
 
-use super::{Lobe, ModelInfo, Param, Range, Value};
+use super::{Bxdf, ModelInfo, Param, Range, Value};
 use crate::math::{INV_PI, Rgb};
-use crate::{Strategy, warp};
+use crate::{BsdfStrategy, warp};
 use glam::{DVec2, DVec3};
 
 pub const ALBEDO: Param = Param {
@@ -56,20 +56,20 @@ impl Lambert {
     }
 }
 
-impl Lobe for Lambert {
+impl Bxdf for Lambert {
     #[inline]
     fn eval(&self, _wo: DVec3, _wi: DVec3) -> Rgb {
         self.albedo * INV_PI
     }
 
     #[inline]
-    fn sample(&self, _strategy: Strategy, _wo: DVec3, u: DVec2) -> Option<DVec3> {
+    fn sample(&self, _strategy: BsdfStrategy, _wo: DVec3, u: DVec2) -> Option<DVec3> {
         let wi = warp::square_to_cosine_hemisphere(u);
         (wi.z > 0.0).then_some(wi)
     }
 
     #[inline]
-    fn pdf(&self, _strategy: Strategy, _wo: DVec3, wi: DVec3) -> f64 {
+    fn pdf(&self, _strategy: BsdfStrategy, _wo: DVec3, wi: DVec3) -> f64 {
         warp::square_to_cosine_hemisphere_pdf(wi)
     }
 
@@ -77,9 +77,9 @@ impl Lobe for Lambert {
         crate::math::luminance(self.albedo)
     }
 
-    fn supports(&self, strategy: Strategy) -> Result<(), String> {
+    fn supports(&self, strategy: BsdfStrategy) -> Result<(), String> {
         match strategy {
-            Strategy::Uniform | Strategy::Cosine | Strategy::Brdf => Ok(()),
+            BsdfStrategy::Uniform | BsdfStrategy::Cosine | BsdfStrategy::Brdf => Ok(()),
             _ => Err("a Lambertian term has no microfacets; use uniform, cosine or brdf".into()),
         }
     }

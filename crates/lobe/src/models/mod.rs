@@ -2,7 +2,7 @@
 //! ([`crate::Material`]) is a Lambertian term plus at most one glossy lobe.
 //!
 //! A model file holds everything about its model: the type, its
-//! [`Lobe`] implementation, its parameter table ([`Param`]s, with ranges and
+//! [`Bxdf`] implementation, its parameter table ([`Param`]s, with ranges and
 //! defaults, from which its doc table and the text of `lobe eval --help`
 //! are made), its range checks, and how it is built from a
 //! [`crate::MaterialDesc`]. It publishes all of that as one [`ModelInfo`]
@@ -10,7 +10,7 @@
 //! the end of this file ([`MODELS`], and the [`Glossy`] variant that the same
 //! line declares).
 
-use crate::Strategy;
+use crate::BsdfStrategy;
 use crate::math::Rgb;
 use glam::{DVec2, DVec3};
 use std::fmt::{self, Write as _};
@@ -19,22 +19,27 @@ pub mod lambert;
 pub use lambert::Lambert;
 
 /// One lobe of a material, evaluated and sampled by its own strategy
-/// (`Strategy::Brdf` and the microfacet strategies). `uniform` and `cosine`
+/// (`BsdfStrategy::Brdf` and the microfacet strategies). `uniform` and `cosine`
 /// are handled by [`crate::Material`] for every model.
 ///
 /// The caller guarantees `wo.z > 0` (and `wi.z > 0` for `eval` and `pdf`).
-pub trait Lobe {
+pub trait Bxdf {
     /// `f_r(wo, wi)` of this lobe, without the cosine.
     fn eval(&self, wo: DVec3, wi: DVec3) -> Rgb;
     /// Draw `wi` by the lobe's sampler for `strategy`; `None` for a failed
     /// sample (below the horizon).
-    fn sample(&self, strategy: Strategy, wo: DVec3, u: DVec2) -> Option<DVec3>;
+    fn sample(&self, strategy: BsdfStrategy, wo: DVec3, u: DVec2) -> Option<DVec3>;
     /// Density in solid angle of what `sample` returns.
-    fn pdf(&self, strategy: Strategy, wo: DVec3, wi: DVec3) -> f64;
+    fn pdf(&self, strategy: BsdfStrategy, wo: DVec3, wi: DVec3) -> f64;
     /// `sample`, and `eval` and `pdf` at the sampled direction, sharing what
     /// they have in common (a model may override it for speed).
     #[inline]
-    fn sample_eval(&self, strategy: Strategy, wo: DVec3, u: DVec2) -> Option<(DVec3, Rgb, f64)> {
+    fn sample_eval(
+        &self,
+        strategy: BsdfStrategy,
+        wo: DVec3,
+        u: DVec2,
+    ) -> Option<(DVec3, Rgb, f64)> {
         let wi = self.sample(strategy, wo, u)?;
         Some((wi, self.eval(wo, wi), self.pdf(strategy, wo, wi)))
     }
@@ -42,14 +47,14 @@ pub trait Lobe {
     /// may override it for speed; the numbers must be the same as the two
     /// calls).
     #[inline]
-    fn eval_pdf(&self, strategy: Strategy, wo: DVec3, wi: DVec3) -> (Rgb, f64) {
+    fn eval_pdf(&self, strategy: BsdfStrategy, wo: DVec3, wi: DVec3) -> (Rgb, f64) {
         (self.eval(wo, wi), self.pdf(strategy, wo, wi))
     }
     /// An estimate of the lobe's directional albedo (luminance), used to
     /// choose between lobes.
     fn albedo_hint(&self, wo: DVec3) -> f64;
     /// `Ok` when the lobe has its own sampler for `strategy`; otherwise why not.
-    fn supports(&self, strategy: Strategy) -> Result<(), String>;
+    fn supports(&self, strategy: BsdfStrategy) -> Result<(), String>;
 }
 
 /// What a key of a material description accepts.
@@ -305,7 +310,7 @@ pub const MAX_EXPONENT: f64 = 1e7;
 
 /// Declares the glossy models, one line each: the module, the type (which
 /// names the [`Glossy`] variant), and puts the module's `INFO` in [`MODELS`].
-/// [`Glossy`] implements [`Lobe`] by static dispatch over the variants.
+/// [`Glossy`] implements [`Bxdf`] by static dispatch over the variants.
 macro_rules! glossy_models {
     ($($module:ident :: $ty:ident),* $(,)?) => {
         $(pub mod $module; pub use $module::$ty;)*
@@ -333,7 +338,7 @@ macro_rules! glossy_models {
 
         /// `Glossy::None` is the lobe that reflects nothing and samples
         /// nothing.
-        impl Lobe for Glossy {
+        impl Bxdf for Glossy {
             #[inline]
             fn eval(&self, wo: DVec3, wi: DVec3) -> Rgb {
                 match self {
@@ -342,28 +347,28 @@ macro_rules! glossy_models {
                 }
             }
             #[inline]
-            fn sample(&self, strategy: Strategy, wo: DVec3, u: DVec2) -> Option<DVec3> {
+            fn sample(&self, strategy: BsdfStrategy, wo: DVec3, u: DVec2) -> Option<DVec3> {
                 match self {
                     Glossy::None => None,
                     $(Glossy::$ty(l) => l.sample(strategy, wo, u)),*
                 }
             }
             #[inline]
-            fn pdf(&self, strategy: Strategy, wo: DVec3, wi: DVec3) -> f64 {
+            fn pdf(&self, strategy: BsdfStrategy, wo: DVec3, wi: DVec3) -> f64 {
                 match self {
                     Glossy::None => 0.0,
                     $(Glossy::$ty(l) => l.pdf(strategy, wo, wi)),*
                 }
             }
             #[inline]
-            fn sample_eval(&self, strategy: Strategy, wo: DVec3, u: DVec2) -> Option<(DVec3, Rgb, f64)> {
+            fn sample_eval(&self, strategy: BsdfStrategy, wo: DVec3, u: DVec2) -> Option<(DVec3, Rgb, f64)> {
                 match self {
                     Glossy::None => None,
                     $(Glossy::$ty(l) => l.sample_eval(strategy, wo, u)),*
                 }
             }
             #[inline]
-            fn eval_pdf(&self, strategy: Strategy, wo: DVec3, wi: DVec3) -> (Rgb, f64) {
+            fn eval_pdf(&self, strategy: BsdfStrategy, wo: DVec3, wi: DVec3) -> (Rgb, f64) {
                 match self {
                     Glossy::None => (Rgb::ZERO, 0.0),
                     $(Glossy::$ty(l) => l.eval_pdf(strategy, wo, wi)),*
@@ -376,7 +381,7 @@ macro_rules! glossy_models {
                     $(Glossy::$ty(l) => l.albedo_hint(wo)),*
                 }
             }
-            fn supports(&self, strategy: Strategy) -> Result<(), String> {
+            fn supports(&self, strategy: BsdfStrategy) -> Result<(), String> {
                 match self {
                     Glossy::None => Err("no glossy lobe".into()),
                     $(Glossy::$ty(l) => l.supports(strategy)),*

@@ -28,9 +28,9 @@
 //! around the mirror direction. Directions below the horizon are failed
 //! samples; the pdf is that density on the upper hemisphere and 0 below.
 
-use super::{Lobe, MAX_EXPONENT, ModelInfo, Param, Range, Value};
+use super::{Bxdf, MAX_EXPONENT, ModelInfo, Param, Range, Value};
 use crate::math::{INV_TWO_PI, Rgb, luminance, mirror_z};
-use crate::{Frame, Strategy, warp};
+use crate::{Frame, BsdfStrategy, warp};
 use glam::{DVec2, DVec3};
 
 pub const KS: Param = Param {
@@ -108,21 +108,21 @@ impl Phong {
     }
 }
 
-impl Lobe for Phong {
+impl Bxdf for Phong {
     #[inline]
     fn eval(&self, wo: DVec3, wi: DVec3) -> Rgb {
         self.ks * (self.norm() * Self::cos_alpha(wo, wi).powf(self.exponent))
     }
 
     #[inline]
-    fn sample(&self, _strategy: Strategy, wo: DVec3, u: DVec2) -> Option<DVec3> {
+    fn sample(&self, _strategy: BsdfStrategy, wo: DVec3, u: DVec2) -> Option<DVec3> {
         let local = warp::square_to_cos_power(u, self.exponent);
         let wi = Frame::from_normal(mirror_z(wo)).to_world(local);
         (wi.z > 0.0).then_some(wi)
     }
 
     #[inline]
-    fn pdf(&self, _strategy: Strategy, wo: DVec3, wi: DVec3) -> f64 {
+    fn pdf(&self, _strategy: BsdfStrategy, wo: DVec3, wi: DVec3) -> f64 {
         warp::cos_power_pdf(mirror_z(wo).dot(wi), self.exponent)
     }
 
@@ -135,9 +135,9 @@ impl Lobe for Phong {
         }
     }
 
-    fn supports(&self, strategy: Strategy) -> Result<(), String> {
+    fn supports(&self, strategy: BsdfStrategy) -> Result<(), String> {
         match strategy {
-            Strategy::Uniform | Strategy::Cosine | Strategy::Brdf => Ok(()),
+            BsdfStrategy::Uniform | BsdfStrategy::Cosine | BsdfStrategy::Brdf => Ok(()),
             _ => Err("Phong has no microfacet distribution; use uniform, cosine or brdf".into()),
         }
     }

@@ -4,7 +4,7 @@
 #![allow(dead_code)]
 
 use glam::DVec3;
-use lobe::{Material, MaterialDesc, Strategy};
+use lobe::{BsdfStrategy, Material, MaterialDesc};
 
 /// One material of the grid, with a name for messages and failure files.
 pub struct Case {
@@ -93,11 +93,11 @@ pub fn all_cases() -> Vec<Case> {
 
 /// The (strategy, view) pairs tested for a material: the material-blind
 /// strategies `uniform` and `cosine` at two views, the others at every view.
-pub fn plan(m: &Material) -> Vec<(Strategy, f64)> {
+pub fn plan(m: &Material) -> Vec<(BsdfStrategy, f64)> {
     let mut v = Vec::new();
     for s in m.strategies() {
         match s {
-            Strategy::Uniform | Strategy::Cosine => v.extend([(s, 0.0), (s, 60.0)]),
+            BsdfStrategy::Uniform | BsdfStrategy::Cosine => v.extend([(s, 0.0), (s, 60.0)]),
             _ => v.extend(VIEWS.iter().map(|&t| (s, t))),
         }
     }

@@ -15,11 +15,11 @@
 //!   density ∝ the map's luminance, take it to the local frame; below the
 //!   horizon it is a failed sample; otherwise a shadow ray, and
 //!   `f L cos / p_light` when it escapes.
-//! * **MIS** (Veach's multi-sample form with one sample per technique):
+//! * **MIS** (Veach's multi-sample form with one sample per strategy):
 //!   both of the above, each weighted by the balance heuristic
 //!   `p_t / (p_b + p_l)` (`mis`) or the power heuristic
-//!   `p_t² / (p_b² + p_l²)` (`mis-power`), where the BSDF technique is
-//!   `vndf` when the material has it, else `brdf`, and the light technique
+//!   `p_t² / (p_b² + p_l²)` (`mis-power`), where the BSDF strategy is
+//!   `vndf` when the material has it, else `brdf`, and the light strategy
 //!   draws from the MIS-compensated distribution
 //!   ([`EnvMap::sample_compensated`], density ∝ `max(0, lum − mean)`), as
 //!   `lobe`'s estimator does ([`lobe::Light::sample_mis`]).
@@ -33,7 +33,7 @@
 //!
 //! # Paths (`max_depth > 1`)
 //!
-//! At every vertex, the same technique: light sampling adds next-event
+//! At every vertex, the same strategy: light sampling adds next-event
 //! estimation (MIS-weighted under `mis`/`mis-power`, unweighted under
 //! `light`), and the path goes on by BSDF sampling; a BSDF-sampled ray that
 //! escapes adds the environment, MIS-weighted under `mis`, in full under a
@@ -53,11 +53,11 @@ use crate::geometry::{Hit, spawn_ray};
 pub use crate::options::RenderOptions;
 use crate::scene::Scene;
 use glam::{DVec2, DVec3};
-use lobe::estimator::{DrawnBsdf, MisForm, ShadingEstimator, ShadingPoint, Technique, Visibility};
+use lobe::estimator::{DrawnBsdf, MisForm, ShadingEstimator, ShadingPoint, Strategy, Visibility};
 use lobe::light::Light;
 use lobe::math::Rgb;
 use lobe::sequence::hash64;
-use lobe::{BsdfSampler, Frame, Material, Strategy};
+use lobe::{BsdfSampler, BsdfStrategy, Frame, Material};
 use rand::RngExt;
 use rand_pcg::Pcg64;
 use rayon::prelude::*;
@@ -103,29 +103,29 @@ impl Image {
     }
 }
 
-/// How one object is shaded: the technique validated for its material, and
+/// How one object is shaded: the strategy validated for its material, and
 /// the BSDF sampler that continues its paths.
 #[derive(Debug, Clone, Copy)]
 struct ObjectShading<'m> {
     estimator: ShadingEstimator<'m>,
-    /// The technique's own BSDF sampler, or for `light` the material's best.
+    /// The strategy's own BSDF sampler, or for `light` the material's best.
     continuation: BsdfSampler<'m>,
 }
 
-/// The technique `technique` becomes on material `m`: a BSDF strategy that
+/// The strategy `strategy` becomes on material `m`: a BSDF strategy that
 /// does not apply falls back to `brdf`, which applies to every material.
 #[must_use]
-pub fn technique_for(technique: Technique, m: &Material) -> Technique {
-    match technique {
-        Technique::Bsdf(s) if m.check(s).is_err() => Technique::Bsdf(Strategy::Brdf),
+pub fn strategy_for(strategy: Strategy, m: &Material) -> Strategy {
+    match strategy {
+        Strategy::Bsdf(s) if m.check(s).is_err() => Strategy::Bsdf(BsdfStrategy::Brdf),
         t => t,
     }
 }
 
-fn object_shading(technique: Technique, m: &Material) -> ObjectShading<'_> {
-    let estimator = technique_for(technique, m)
+fn object_shading(strategy: Strategy, m: &Material) -> ObjectShading<'_> {
+    let estimator = strategy_for(strategy, m)
         .for_material(m)
-        .or_else(|_| Technique::Bsdf(Strategy::Brdf).for_material(m))
+        .or_else(|_| Strategy::Bsdf(BsdfStrategy::Brdf).for_material(m))
         .expect("brdf applies to every material");
     let continuation = estimator.sampler().unwrap_or_else(|| {
         m.sampler(m.best_bsdf_strategy())
@@ -142,14 +142,14 @@ fn object_shading(technique: Technique, m: &Material) -> ObjectShading<'_> {
 pub struct Fallback {
     pub object: usize,
     pub model: &'static str,
-    pub requested: Strategy,
-    pub used: Strategy,
+    pub requested: BsdfStrategy,
+    pub used: BsdfStrategy,
 }
 
-/// The objects on which `technique`'s BSDF strategy falls back to `brdf`.
+/// The objects on which `strategy`'s BSDF strategy falls back to `brdf`.
 #[must_use]
-pub fn fallbacks(scene: &Scene, technique: Technique) -> Vec<Fallback> {
-    let Technique::Bsdf(s) = technique else {
+pub fn fallbacks(scene: &Scene, strategy: Strategy) -> Vec<Fallback> {
+    let Strategy::Bsdf(s) = strategy else {
         return Vec::new();
     };
     scene
@@ -157,7 +157,7 @@ pub fn fallbacks(scene: &Scene, technique: Technique) -> Vec<Fallback> {
         .iter()
         .enumerate()
         .filter_map(|(i, o)| {
-            let Technique::Bsdf(used) = technique_for(technique, &o.material) else {
+            let Strategy::Bsdf(used) = strategy_for(strategy, &o.material) else {
                 return None;
             };
             (used != s).then(|| Fallback {
@@ -190,7 +190,7 @@ fn render_on_pool(scene: &Scene, opts: &RenderOptions, progress: &(dyn Fn(u64) +
     let shading: Vec<ObjectShading> = scene
         .objects
         .iter()
-        .map(|o| object_shading(opts.technique, &o.material))
+        .map(|o| object_shading(opts.strategy, &o.material))
         .collect();
     let light = Light::Env(scene.environment.clone());
     let ctx = Context {
@@ -345,16 +345,16 @@ impl Context<'_> {
             }
             let sp = ShadingPoint { frame, wo };
             let go_on = depth < self.max_depth;
-            let technique = est.technique();
+            let strategy = est.strategy();
             // The random numbers, light samples' first, then the BSDF
             // sample's (lobe choice, direction).
-            let k = technique.points_per_sample();
+            let k = strategy.points_per_sample();
             debug_assert!(k <= points.len());
-            match technique {
-                Technique::Light => {
+            match strategy {
+                Strategy::Light => {
                     points[0] = [0.0, rng.random(), rng.random()];
                 }
-                Technique::Mis(m) if m.form == MisForm::MultiSample => {
+                Strategy::Mis(m) if m.form == MisForm::MultiSample => {
                     points[1] = [0.0, rng.random(), rng.random()];
                     points[0] = [rng.random(), rng.random(), rng.random()];
                 }
