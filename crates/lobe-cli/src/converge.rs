@@ -186,7 +186,7 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
         );
     }
     let sequences = parse_sequences(&args.sequence)?;
-    let m = lobe::desc::load_material(&args.material)?;
+    let m = lobe::Material::load(&args.material)?;
     let wo = args.view.wo()?;
     let light = args.light.light()?;
     let strategies =

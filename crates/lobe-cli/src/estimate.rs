@@ -140,7 +140,7 @@ pub fn parse_sequence(spec: &str) -> Result<Sequence> {
 }
 
 pub fn run(args: &EstimateArgs) -> Result<()> {
-    let m = lobe::desc::load_material(&args.material)?;
+    let m = lobe::Material::load(&args.material)?;
     let wo = args.view.wo()?;
     let light = args.light.light()?;
     if args.samples < 2 {

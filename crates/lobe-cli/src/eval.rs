@@ -71,13 +71,13 @@ fn after_long_help() -> String {
          fresnel = {{ type = \"conductor\" }}\n\
          \n\
          {}",
-        lobe::desc::defaults()
+        lobe::models::defaults()
     )
 }
 
 /// Run `lobe eval`: stdin to stdout.
 pub fn run(args: &EvalArgs) -> Result<()> {
-    let material = lobe::desc::load_material(&args.material)?;
+    let material = lobe::Material::load(&args.material)?;
     let mut out = BufWriter::with_capacity(1 << 16, io::stdout().lock());
     let result = process(&material, io::stdin().lock(), &mut out);
     // Flush what was computed before any error, so that the lines before a bad
@@ -575,7 +575,7 @@ mod tests {
     use super::*;
 
     fn run_lines(material: &str, input: &str) -> Result<String, String> {
-        let m = lobe::desc::load_material(material).map_err(|e| e.to_string())?;
+        let m = lobe::Material::load(material).map_err(|e| e.to_string())?;
         let mut out = Vec::new();
         match process(&m, input.as_bytes(), &mut out) {
             Ok(()) => Ok(String::from_utf8(out).unwrap()),

@@ -14,7 +14,6 @@ use crate::figures;
 use anyhow::{Context, Result, anyhow, bail};
 use clap::Args;
 use glam::DVec3;
-use lobe::desc::load_material;
 use lobe::experiment::histogram::projected_histograms;
 use lobe::math::luminance;
 use lobe::stats::chi2::{Chi2Config, chi2_test};
@@ -92,7 +91,7 @@ pub fn run(args: &PlotArgs) -> Result<()> {
         "all" => vec![Kind::Polar, Kind::Histogram, Kind::Weights],
         k => bail!("--kind {k}: unknown kind, expected polar, histogram, weights or all"),
     };
-    let material = load_material(&args.material)?;
+    let material = lobe::Material::load(&args.material)?;
     let wo = args.view.wo()?;
     let needs_strategy = kinds.iter().any(|&k| k != Kind::Polar);
     let strategy = match (&args.strategy, needs_strategy) {

@@ -526,7 +526,7 @@ fn help_shows_examples_and_material_defaults() {
     let run = lobe(&["eval", "--help"], "");
     assert_eq!(run.code, Some(0));
     assert!(
-        run.stdout.contains(lobe::desc::defaults()),
+        run.stdout.contains(lobe::models::defaults()),
         "{}",
         run.stdout
     );

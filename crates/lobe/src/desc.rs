@@ -1,70 +1,12 @@
 //! Material descriptions: what a user writes in JSON or TOML, checked by
 //! each model's own file ([`crate::models`]: its keys, ranges and defaults,
-//! listed by [`defaults`]), with errors that name the field.
+//! listed by [`crate::models::defaults`]), with errors that name the field.
 
 use crate::Error;
 use crate::fresnel::Fresnel;
-use crate::material::Material;
 use crate::math::Rgb;
-use crate::models;
 use serde::de::{self, Deserializer, SeqAccess, Visitor};
 use serde::{Deserialize, Serialize};
-
-/// The material keys, their values and defaults, printed by `lobe eval --help`:
-/// made from each model's parameter table ([`crate::models::MODELS`]).
-#[must_use]
-pub fn defaults() -> &'static str {
-    static TEXT: std::sync::OnceLock<String> = std::sync::OnceLock::new();
-    TEXT.get_or_init(defaults_text)
-}
-
-fn defaults_text() -> String {
-    use std::fmt::Write as _;
-    let plain = |s: &str| s.replace('`', "");
-    let mut s = format!(
-        "Material keys (JSON or TOML); colours are a number or [r, g, b]:\n  \
-         {:<13} {}      (required)\n",
-        "type",
-        models::names(" | ")
-    );
-    for m in models::MODELS {
-        let _ = writeln!(s, "type {}:", m.name);
-        for p in m.params {
-            let _ = writeln!(
-                s,
-                "  {:<13} {}; default {}; {}",
-                p.name,
-                plain(&p.range_text()),
-                plain(&p.default.to_string()),
-                plain(p.meaning)
-            );
-        }
-    }
-    let rgb = |c: [f64; 3]| format!("[{},{},{}]", c[0], c[1], c[2]);
-    s.push_str("fresnel (cook-torrance), one of:");
-    for (object, says) in [
-        (r#"{"type":"none"}"#, "F = 1".to_string()),
-        (
-            r#"{"type":"schlick","f0":c}"#,
-            format!("default f0 {DEFAULT_F0}"),
-        ),
-        (
-            r#"{"type":"dielectric","eta":c}"#,
-            format!("default eta {DEFAULT_DIELECTRIC_ETA}"),
-        ),
-        (
-            r#"{"type":"conductor","eta":c,"k":c}"#,
-            format!(
-                "default gold, eta {} k {}",
-                rgb(DEFAULT_CONDUCTOR_ETA),
-                rgb(DEFAULT_CONDUCTOR_K)
-            ),
-        ),
-    ] {
-        let _ = write!(s, "\n  {object:<35} {says}");
-    }
-    s
-}
 
 pub const DEFAULT_F0: f64 = 0.04;
 pub const DEFAULT_DIELECTRIC_ETA: f64 = 1.5;
@@ -193,33 +135,7 @@ impl MaterialDesc {
         }
     }
 
-    /// Check every field and build the material: the model's own
-    /// [`crate::models::ModelInfo::from_desc`], once every key given is
-    /// known to belong to the model.
-    pub fn build(&self) -> Result<Material, Error> {
-        let kind = self.kind.as_str();
-        let Some(model) = models::find(kind) else {
-            return Err(Error::UnknownName {
-                field: "type".into(),
-                value: self.kind.clone(),
-                expected: models::names(", "),
-            });
-        };
-        for (name, present) in self.present_fields() {
-            if present && !model.keys().any(|k| k == name) {
-                return Err(Error::param(
-                    name,
-                    format!(
-                        "does not apply to type {kind} (its keys: {})",
-                        model.keys().collect::<Vec<_>>().join(", ")
-                    ),
-                ));
-            }
-        }
-        (model.from_desc)(self)
-    }
-
-    fn present_fields(&self) -> [(&'static str, bool); 12] {
+    pub(crate) fn present_fields(&self) -> [(&'static str, bool); 12] {
         [
             ("albedo", self.albedo.is_some()),
             ("ks", self.ks.is_some()),
@@ -237,11 +153,11 @@ impl MaterialDesc {
     }
 }
 
-/// Build a material from a command-line style argument: JSON text, or
-/// `@FILE` naming a `.toml` file (TOML) or any other file (JSON). Every
-/// error starts with `material` (or `material (file FILE)`) and names the
-/// field at fault.
-pub fn load_material(arg: &str) -> Result<Material, Error> {
+/// Parse a command-line style material argument: JSON text, or `@FILE`
+/// naming a `.toml` file (TOML) or any other file (JSON). Returns the
+/// description and where it came from (`material` or `material (file
+/// FILE)`), with which every error starts; [`crate::Material::load`] builds it.
+pub fn parse_material_arg(arg: &str) -> Result<(MaterialDesc, String), Error> {
     let fail = |m: String| Error::Parse(m);
     let (desc, origin) = match arg.strip_prefix('@') {
         Some("") => {
@@ -277,7 +193,7 @@ pub fn load_material(arg: &str) -> Result<Material, Error> {
             (desc, origin)
         }
     };
-    desc.build().map_err(|e| fail(format!("{origin}: {e}")))
+    Ok((desc, origin))
 }
 
 /// `field `a.b`: ` for an error below the top level, else nothing.
@@ -371,7 +287,7 @@ impl FresnelDesc {
         Ok(match self.kind.as_str() {
             "none" => Fresnel::None,
             "schlick" => Fresnel::Schlick {
-                f0: models::check_rgb(
+                f0: crate::math::check_rgb(
                     "fresnel.f0",
                     self.f0.map_or(Rgb::splat(DEFAULT_F0), Color::rgb),
                     1.0,
@@ -390,7 +306,7 @@ impl FresnelDesc {
                     self.eta
                         .map_or(Rgb::from_array(DEFAULT_CONDUCTOR_ETA), Color::rgb),
                 )?,
-                k: models::check_rgb(
+                k: crate::math::check_rgb(
                     "fresnel.k",
                     self.k
                         .map_or(Rgb::from_array(DEFAULT_CONDUCTOR_K), Color::rgb),
@@ -406,6 +322,7 @@ mod tests {
     use super::*;
     use crate::material::Glossy;
     use crate::microfacet::Shadowing;
+    use crate::models::{self, defaults};
 
     fn err(json: &str) -> String {
         match MaterialDesc::from_json(json).and_then(|d| d.build()) {
@@ -528,7 +445,7 @@ mod tests {
 
     #[test]
     fn loader_reads_inline_text_and_files() {
-        let m = load_material(r#"{"type":"phong","exponent":10}"#).unwrap();
+        let m = crate::Material::load(r#"{"type":"phong","exponent":10}"#).unwrap();
         assert_eq!(
             m.model_name(),
             MaterialDesc::from_json(r#"{"type":"phong","exponent":10}"#)
@@ -541,11 +458,11 @@ mod tests {
         std::fs::create_dir_all(&dir).unwrap();
         let toml_path = dir.join("m.toml");
         std::fs::write(&toml_path, "type = \"lambert\"\nalbedo = 0.5\n").unwrap();
-        let m = load_material(&format!("@{}", toml_path.display())).unwrap();
+        let m = crate::Material::load(&format!("@{}", toml_path.display())).unwrap();
         assert_eq!(m.diffuse.albedo, Rgb::splat(0.5));
         let json_path = dir.join("m.json");
         std::fs::write(&json_path, r#"{"type":"lambert","albedo":2}"#).unwrap();
-        let e = load_material(&format!("@{}", json_path.display()))
+        let e = crate::Material::load(&format!("@{}", json_path.display()))
             .unwrap_err()
             .to_string();
         assert!(
@@ -557,10 +474,10 @@ mod tests {
         );
         let _ = std::fs::remove_dir_all(&dir);
         assert_eq!(
-            load_material("@").unwrap_err().to_string(),
+            crate::Material::load("@").unwrap_err().to_string(),
             "material: `@` needs a file name (@FILE.json or @FILE.toml)"
         );
-        let e = load_material("@/nonexistent/lobe.json")
+        let e = crate::Material::load("@/nonexistent/lobe.json")
             .unwrap_err()
             .to_string();
         assert!(
@@ -569,9 +486,9 @@ mod tests {
             ),
             "{e}"
         );
-        let e = load_material("phong").unwrap_err().to_string();
+        let e = crate::Material::load("phong").unwrap_err().to_string();
         assert!(e.starts_with("material: not a JSON object (give JSON text, @FILE.json or @FILE.toml): invalid JSON"), "{e}");
-        let e = load_material(r#"{"type":"glass"}"#)
+        let e = crate::Material::load(r#"{"type":"glass"}"#)
             .unwrap_err()
             .to_string();
         assert!(e.starts_with("material: field `type`"), "{e}");

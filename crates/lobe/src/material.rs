@@ -41,6 +41,17 @@ impl Material {
         Ok(Material { diffuse, glossy })
     }
 
+    /// Build a material from a command-line style argument: JSON text, or
+    /// `@FILE` naming a `.toml` file (TOML) or any other file (JSON). Every
+    /// error starts with `material` (or `material (file FILE)`) and names
+    /// the field at fault.
+    #[cfg(feature = "desc")]
+    pub fn load(arg: &str) -> crate::error::Result<Self> {
+        let (desc, origin) = crate::desc::parse_material_arg(arg)?;
+        desc.build()
+            .map_err(|e| Error::Parse(format!("{origin}: {e}")))
+    }
+
     /// A short name of the model, for tables.
     #[must_use]
     pub fn model_name(&self) -> &'static str {

@@ -68,3 +68,16 @@ pub fn cos_sin_phi(w: DVec3) -> (f64, f64) {
 pub fn is_unit(w: DVec3) -> bool {
     (w.length_squared() - 1.0).abs() < 1e-6
 }
+
+/// Check an RGB parameter: every channel finite and in `[0, max]`.
+pub(crate) fn check_rgb(field: &str, c: Rgb, max: f64) -> crate::error::Result<Rgb> {
+    for v in c.to_array() {
+        if !v.is_finite() || v < 0.0 || v > max {
+            return Err(crate::Error::param(
+                field,
+                format!("{v} is out of range: each channel must be a number in [0, {max}]"),
+            ));
+        }
+    }
+    Ok(c)
+}

@@ -269,18 +269,7 @@ pub const KD: Param = Param {
     meaning: "diffuse colour, added as `kd/π`",
 };
 
-/// Check an RGB parameter: every channel finite and in `[0, max]`.
-pub(crate) fn check_rgb(field: &str, c: Rgb, max: f64) -> crate::error::Result<Rgb> {
-    for v in c.to_array() {
-        if !v.is_finite() || v < 0.0 || v > max {
-            return Err(crate::Error::param(
-                field,
-                format!("{v} is out of range: each channel must be a number in [0, {max}]"),
-            ));
-        }
-    }
-    Ok(c)
-}
+pub(crate) use crate::math::check_rgb;
 
 /// A colour key of a description, or its default.
 #[cfg(feature = "desc")]
@@ -432,5 +421,92 @@ mod tests {
         assert_eq!(Num(1e-4).to_string(), "1e-4");
         assert_eq!(Num(0.3).to_string(), "0.3");
         assert_eq!(Num(32.0).to_string(), "32");
+    }
+}
+
+#[cfg(feature = "desc")]
+/// The material keys, their values and defaults, printed by `lobe eval --help`:
+/// made from each model's parameter table ([`crate::models::MODELS`]).
+#[must_use]
+pub fn defaults() -> &'static str {
+    static TEXT: std::sync::OnceLock<String> = std::sync::OnceLock::new();
+    TEXT.get_or_init(defaults_text)
+}
+
+#[cfg(feature = "desc")]
+fn defaults_text() -> String {
+    use std::fmt::Write as _;
+    let plain = |s: &str| s.replace('`', "");
+    let mut s = format!(
+        "Material keys (JSON or TOML); colours are a number or [r, g, b]:\n  \
+         {:<13} {}      (required)\n",
+        "type",
+        names(" | ")
+    );
+    for m in MODELS {
+        let _ = writeln!(s, "type {}:", m.name);
+        for p in m.params {
+            let _ = writeln!(
+                s,
+                "  {:<13} {}; default {}; {}",
+                p.name,
+                plain(&p.range_text()),
+                plain(&p.default.to_string()),
+                plain(p.meaning)
+            );
+        }
+    }
+    let rgb = |c: [f64; 3]| format!("[{},{},{}]", c[0], c[1], c[2]);
+    s.push_str("fresnel (cook-torrance), one of:");
+    for (object, says) in [
+        (r#"{"type":"none"}"#, "F = 1".to_string()),
+        (
+            r#"{"type":"schlick","f0":c}"#,
+            format!("default f0 {}", crate::desc::DEFAULT_F0),
+        ),
+        (
+            r#"{"type":"dielectric","eta":c}"#,
+            format!("default eta {}", crate::desc::DEFAULT_DIELECTRIC_ETA),
+        ),
+        (
+            r#"{"type":"conductor","eta":c,"k":c}"#,
+            format!(
+                "default gold, eta {} k {}",
+                rgb(crate::desc::DEFAULT_CONDUCTOR_ETA),
+                rgb(crate::desc::DEFAULT_CONDUCTOR_K)
+            ),
+        ),
+    ] {
+        let _ = write!(s, "\n  {object:<35} {says}");
+    }
+    s
+}
+
+#[cfg(feature = "desc")]
+impl crate::desc::MaterialDesc {
+    /// Check every field and build the material: the model's own
+    /// [`crate::models::ModelInfo::from_desc`], once every key given is
+    /// known to belong to the model.
+    pub fn build(&self) -> Result<crate::Material, crate::Error> {
+        let kind = self.kind.as_str();
+        let Some(model) = find(kind) else {
+            return Err(crate::Error::UnknownName {
+                field: "type".into(),
+                value: self.kind.clone(),
+                expected: names(", "),
+            });
+        };
+        for (name, present) in self.present_fields() {
+            if present && !model.keys().any(|k| k == name) {
+                return Err(crate::Error::param(
+                    name,
+                    format!(
+                        "does not apply to type {kind} (its keys: {})",
+                        model.keys().collect::<Vec<_>>().join(", ")
+                    ),
+                ));
+            }
+        }
+        (model.from_desc)(self)
     }
 }
