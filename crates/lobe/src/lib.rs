@@ -34,14 +34,34 @@
 //!
 //! ```
 //! # #[cfg(feature = "desc")] {
-//! use lobe::{Material, MaterialDesc, BsdfStrategy};
-//! use glam::{DVec2, DVec3};
-//! let m = MaterialDesc::from_json(r#"{"type":"cook-torrance","alpha":0.2}"#)?.build()?;
-//! let wo = DVec3::new(0.6, 0.0, 0.8);
-//! if let Some(s) = m.sample(BsdfStrategy::Vndf, wo, 0.5, DVec2::new(0.3, 0.7)) {
-//!     // s.weight == f * cos / pdf
-//!     assert!((s.pdf - m.pdf(BsdfStrategy::Vndf, wo, s.wi)).abs() < 1e-9 * s.pdf);
+//! use lobe::glam::{DVec2, DVec3};
+//! use lobe::{BsdfStrategy, Material};
+//! let m = Material::load(r#"{"type":"cook-torrance","distribution":"ggx","alpha":0.2}"#)?;
+//! let vndf = m.sampler(BsdfStrategy::Vndf)?; // validated once: it has a pdf
+//! let wo = DVec3::new(0.6, 0.0, 0.8); // local frame, +z the normal
+//! if let Some(s) = vndf.sample(wo, 0.5, DVec2::new(0.3, 0.7)) {
+//!     // s.wi, s.f (no cosine), s.pdf (solid angle), s.weight = f·cos/pdf
+//!     let (f, pdf) = vndf.eval_pdf(wo, s.wi); // shared terms computed once
+//!     assert!((pdf - s.pdf).abs() < 1e-9 * s.pdf && f == s.f);
 //! }
+//! # }
+//! # Ok::<(), lobe::Error>(())
+//! ```
+//!
+//! One shading point under a light, by any strategy (`lobe estimate` is
+//! this plus formatting):
+//!
+//! ```
+//! # #[cfg(feature = "desc")] {
+//! use lobe::estimator::{Plan, ShadingPoint, estimate, reference};
+//! use lobe::{Light, Material, Rgb, Strategy};
+//! let m = Material::load(r#"{"type":"phong","exponent":100}"#)?;
+//! let sp = ShadingPoint::local(lobe::frame::wo_from_theta(30.0, 0.0));
+//! let light = Light::Constant(Rgb::ONE);
+//! let strategy: Strategy = "mis".parse()?;
+//! let acc = estimate(&m, &sp, &light, &Plan::independent(strategy, 1 << 16, 1))?;
+//! let exact = reference(&m, &sp, &light, 1e-9);
+//! assert!((acc.mean().x - exact.x).abs() < 5.0 * acc.std_error().x + 1e-12);
 //! # }
 //! # Ok::<(), lobe::Error>(())
 //! ```
