@@ -174,7 +174,9 @@ fn a_comparison_under_a_fake_clock() {
             .lock()
             .unwrap()
             .iter()
-            .all(|t| t.1 == 48 && t.2 == 48)
+            .zip([2u64, 2, 5, 16])
+            // Progress counts samples: 48 pixels × spp, all of them advanced.
+            .all(|(t, spp)| t.1 == 48 * spp && t.2 == 48 * spp)
     );
     assert_eq!(cmp.equal_samples[0].time_s, 3.0);
     assert_eq!(cmp.equal_samples[1].time_s, 7.0);
