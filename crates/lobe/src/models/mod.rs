@@ -386,48 +386,6 @@ glossy_models! {
     cook_torrance::CookTorrance,
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// The doc comment at the top of each model file shows its parameter
-    /// table: the one made from `INFO.params`.
-    #[test]
-    fn doc_tables_are_the_param_tables() {
-        // Every model's own file, found by its name (`blinn-phong` →
-        // `blinn_phong.rs`): no list to keep beside `MODELS`.
-        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("src/models");
-        let sources: Vec<(&str, String)> = MODELS
-            .iter()
-            .map(|m| {
-                let path = dir.join(format!("{}.rs", m.name.replace('-', "_")));
-                let src = std::fs::read_to_string(&path)
-                    .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-                (m.name, src)
-            })
-            .collect();
-        for (name, src) in &sources {
-            let doc: String = src
-                .lines()
-                .filter_map(|l| l.strip_prefix("//!"))
-                .map(|l| format!("{}\n", l.strip_prefix(' ').unwrap_or(l)))
-                .collect();
-            let table = find(name).unwrap().doc_table();
-            assert!(
-                doc.contains(&table),
-                "the doc table of {name} is not its parameter table; it should read:\n{table}"
-            );
-        }
-    }
-
-    #[test]
-    fn numbers_read_as_written() {
-        assert_eq!(Num(1e7).to_string(), "1e7");
-        assert_eq!(Num(1e-4).to_string(), "1e-4");
-        assert_eq!(Num(0.3).to_string(), "0.3");
-        assert_eq!(Num(32.0).to_string(), "32");
-    }
-}
 
 #[cfg(feature = "desc")]
 /// The material keys, their values and defaults, printed by `lobe eval --help`:
@@ -513,5 +471,48 @@ impl crate::desc::MaterialDesc {
             }
         }
         (model.from_desc)(self)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The doc comment at the top of each model file shows its parameter
+    /// table: the one made from `INFO.params`.
+    #[test]
+    fn doc_tables_are_the_param_tables() {
+        // Every model's own file, found by its name (`blinn-phong` →
+        // `blinn_phong.rs`): no list to keep beside `MODELS`.
+        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("src/models");
+        let sources: Vec<(&str, String)> = MODELS
+            .iter()
+            .map(|m| {
+                let path = dir.join(format!("{}.rs", m.name.replace('-', "_")));
+                let src = std::fs::read_to_string(&path)
+                    .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+                (m.name, src)
+            })
+            .collect();
+        for (name, src) in &sources {
+            let doc: String = src
+                .lines()
+                .filter_map(|l| l.strip_prefix("//!"))
+                .map(|l| format!("{}\n", l.strip_prefix(' ').unwrap_or(l)))
+                .collect();
+            let table = find(name).unwrap().doc_table();
+            assert!(
+                doc.contains(&table),
+                "the doc table of {name} is not its parameter table; it should read:\n{table}"
+            );
+        }
+    }
+
+    #[test]
+    fn numbers_read_as_written() {
+        assert_eq!(Num(1e7).to_string(), "1e7");
+        assert_eq!(Num(1e-4).to_string(), "1e-4");
+        assert_eq!(Num(0.3).to_string(), "0.3");
+        assert_eq!(Num(32.0).to_string(), "32");
     }
 }
