@@ -286,7 +286,9 @@ fn print_table(t: &Table, model: &str, wo: DVec3) {
         "efficiency"
     );
     for r in &t.strategies {
-        let red = if r.variance <= 0.0 {
+        let red = if !r.variance_reliable {
+            "unreliable".to_string()
+        } else if r.variance <= 0.0 {
             "zero var".to_string()
         } else {
             r.variance_reduction
@@ -308,7 +310,7 @@ fn print_table(t: &Table, model: &str, wo: DVec3) {
         );
     }
     println!(
-        "\nvariance: per sample, of the luminance of f·L·cos/p; vs uniform: uniform's exact variance / this one; efficiency: 1/(variance × time)"
+        "\nvariance: per sample, of the luminance of f·L·cos/p; vs uniform: uniform's exact variance / this one (unreliable: the estimate is more than 6 std. errors from the reference, so its variance is not to be trusted); efficiency: 1/(variance × time)"
     );
 }
 

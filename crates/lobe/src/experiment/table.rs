@@ -76,8 +76,13 @@ pub struct Row {
     pub relative_error: f64,
     /// Per-sample variance of the luminance of `f·L·cos/p`.
     pub variance: f64,
+    /// Whether this row's measured variance can be trusted: its estimate is
+    /// within 6 standard errors of the reference (a technique that never
+    /// sampled where the integrand lives, uniform sampling of a narrow lobe
+    /// say, measures a variance far too small and misses the reference).
+    pub variance_reliable: bool,
     /// The exact variance of uniform sampling ([`Table::uniform_variance`])
-    /// over this one; `None` when this one is zero or the exact variance is
+    /// over this one; `None` when this one is zero, or either variance is
     /// unreliable.
     pub variance_reduction: Option<f64>,
     /// Seconds the estimate took on the caller's clock.
@@ -202,6 +207,9 @@ pub fn run_table_with(
         } else {
             luminance(mean).abs()
         };
+        let abs_error = (luminance(mean) - r_lum).abs();
+        let variance_reliable =
+            abs_error <= 6.0 * luminance(stderr).abs() + 1e-7 * r_lum.abs().max(1e-12);
         rows.push(Row {
             name: s.name(),
             samples,
@@ -209,7 +217,8 @@ pub fn run_table_with(
             stderr: stderr.to_array(),
             relative_error,
             variance,
-            variance_reduction: (variance > 0.0 && exact_uniform.reliable)
+            variance_reliable,
+            variance_reduction: (variance > 0.0 && exact_uniform.reliable && variance_reliable)
                 .then(|| exact_uniform.variance / variance),
             time_s,
             efficiency: (variance > 0.0).then(|| 1.0 / (variance * time_s.max(1e-9))),
@@ -527,5 +536,50 @@ mod tests {
         )
         .unwrap_err();
         assert!(e.to_string().contains("replicas"), "{e}");
+    }
+
+    /// Issue 8, item 4: uniform sampling of a very narrow lobe (alpha
+    /// 1e-4, 1000 samples) never hits it; its measured variance is far too
+    /// small, so its ratio is flagged unreliable rather than printed as
+    /// 1.8e31x, and vndf's ratio is against the exact uniform variance.
+    #[test]
+    fn a_missed_narrow_lobe_is_an_unreliable_variance() {
+        let ct = crate::models::CookTorrance::new(
+            Rgb::ONE,
+            crate::Microfacet::new(crate::Ndf::Ggx, 1e-4, 1e-4).unwrap(),
+            crate::Shadowing::SmithCorrelated,
+            crate::Fresnel::None,
+        )
+        .unwrap();
+        let m = Material::with_diffuse(Rgb::ZERO, crate::Glossy::CookTorrance(ct)).unwrap();
+        let sp = ShadingPoint::local(DVec3::new(0.5, 0.0, 0.75f64.sqrt()));
+        let techniques = [
+            Strategy::Bsdf(BsdfStrategy::Uniform),
+            Strategy::Bsdf(BsdfStrategy::Vndf),
+        ];
+        let t = run_table(
+            &m,
+            &sp,
+            &Light::Constant(Rgb::ONE),
+            &techniques,
+            settings(1000),
+            &(),
+            &Ticks(Mutex::new(0)),
+        )
+        .unwrap();
+        assert!(t.uniform_variance.reliable, "{:?}", t.uniform_variance);
+        assert!(
+            t.uniform_variance.variance > 1e6,
+            "{:?}",
+            t.uniform_variance
+        );
+        let (u, v) = (&t.strategies[0], &t.strategies[1]);
+        assert!(
+            !u.variance_reliable && u.variance_reduction.is_none(),
+            "{u:?}"
+        );
+        assert!(v.variance_reliable, "{v:?}");
+        let r = v.variance_reduction.unwrap();
+        assert!(r > 1e6 && r.is_finite(), "{v:?}");
     }
 }
