@@ -219,7 +219,7 @@ pub fn is_envmap_path(spec: &str) -> bool {
 /// `min` to `max`. `what` names the unit in errors ("samples").
 pub fn parse_count(s: &str, min: u64, max: u64, what: &str) -> Result<u64, String> {
     let t = s.trim().replace('_', "");
-    let out_of_range = || format!("`{s}` is out of range: {what} must be from {min} to {max}");
+    let out_of_range = || format!("`{s}` is too large: {what} must be from {min} to {max}");
     let value: u64 = if let Some((b, e)) = t.split_once('^') {
         let (b, e): (u64, u32) = match (b.parse(), e.parse()) {
             (Ok(b), Ok(e)) => (b, e),
@@ -251,8 +251,13 @@ pub fn parse_count(s: &str, min: u64, max: u64, what: &str) -> Result<u64, Strin
         }
         x as u64
     };
-    if !(min..=max).contains(&value) {
+    if value > max {
         return Err(out_of_range());
+    }
+    if value < min {
+        return Err(format!(
+            "`{s}` is too small: {what} must be from {min} to {max}"
+        ));
     }
     Ok(value)
 }
