@@ -75,8 +75,9 @@ pub struct LightArgs {
     /// Lighting: `constant[:VALUE]` (the furnace, default 1);
     /// `beam[:K[:X,Y,Z[:VALUE]]]`, radiance VALUE·max(0, ω·d)^K toward the
     /// world direction d (default K = 8, d = 0,1,0.5 normalized, VALUE = 1);
-    /// `sky`, the built-in sky with a sun; or an equirectangular environment
-    /// map FILE.hdr / FILE.exr (Mitsuba's convention, world +Y up)
+    /// `sky[:ELEVATION[:AZIMUTH]]`, the built-in sky with a sun (default 35°
+    /// above the horizon, azimuth 40°); or an equirectangular environment
+    /// map FILE.hdr / FILE.exr, any case (Mitsuba's convention, world +Y up)
     #[arg(long, default_value = "constant", allow_hyphen_values = true)]
     pub light: String,
     /// World-space normal: local z
@@ -158,21 +159,141 @@ pub fn parse_light(spec: &str, frame: &Frame) -> Result<Light> {
                 radiance: Rgb::splat(v),
             })
         }
-        _ if spec == "sky" || spec.ends_with(".hdr") || spec.ends_with(".exr") => {
-            let (map, clamped) = lobe_render::load_envmap(std::path::Path::new(spec), 1.0, 0.0)?;
-            if clamped > 0 {
-                eprintln!(
-                    "lobe: warning: {spec}: {clamped} texels had negative or NaN values, clamped to 0"
+        "sky" if spec != "sky" => {
+            // `sky:ELEVATION[:AZIMUTH]`: the built-in sky with its sun elsewhere.
+            let (w, h, _, default_azimuth) = lobe_render::envmap_io::SKY;
+            let elevation = parts
+                .next()
+                .map_or(Ok(lobe_render::envmap_io::SKY.2), |s| {
+                    number("sun elevation", s)
+                })?;
+            let azimuth = match parts.next() {
+                None => default_azimuth,
+                Some(s) => s
+                    .parse::<f64>()
+                    .ok()
+                    .filter(|a| a.is_finite())
+                    .ok_or_else(|| {
+                        anyhow!(
+                            "--light {spec}: sun azimuth `{s}` is not a finite number of degrees"
+                        )
+                    })?,
+            };
+            if parts.next().is_some() || elevation > 90.0 {
+                bail!(
+                    "--light {spec}: expected sky[:ELEVATION[:AZIMUTH]], the sun's elevation in [0, 90] degrees above the horizon and its azimuth in degrees (0 is -Z)"
                 );
             }
-            Ok(Light::Env(std::sync::Arc::new(map)))
+            Ok(Light::Env(std::sync::Arc::new(lobe::envmap::EnvMap::sky(
+                w, h, elevation, azimuth,
+            ))))
+        }
+        _ if spec == "sky" || is_envmap_path(spec) => {
+            let loaded = lobe_render::load_envmap_checked(std::path::Path::new(spec), 1.0, 0.0)?;
+            for w in &loaded.warnings {
+                eprintln!("lobe: warning: {w}");
+            }
+            Ok(Light::Env(std::sync::Arc::new(loaded.map)))
         }
         "lobe" => bail!(
             "--light {spec}: the analytic light `lobe` is now called `beam` (beam[:K[:X,Y,Z[:VALUE]]])"
         ),
         _ => bail!(
-            "--light {spec}: unknown light `{kind}`, expected constant[:VALUE], beam[:K[:X,Y,Z[:VALUE]]], sky, or an environment map FILE.hdr / FILE.exr"
+            "--light {spec}: unknown light `{kind}`, expected constant[:VALUE], beam[:K[:X,Y,Z[:VALUE]]], sky[:ELEVATION[:AZIMUTH]], or an environment map FILE.hdr / FILE.exr (any case)"
         ),
+    }
+}
+
+/// Whether `spec` names an environment map file: `.hdr`, `.pic` or `.exr`,
+/// in any case.
+#[must_use]
+pub fn is_envmap_path(spec: &str) -> bool {
+    Path::new(spec)
+        .extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| ["hdr", "pic", "exr"].contains(&e.to_ascii_lowercase().as_str()))
+}
+
+/// Parse a count: digits (`65536`, `65_536`), a power `B^E` (`2^20`) or
+/// scientific notation (`1e6`, `1.5e3`) whose value is a whole number from
+/// `min` to `max`. `what` names the unit in errors ("samples").
+pub fn parse_count(s: &str, min: u64, max: u64, what: &str) -> Result<u64, String> {
+    let t = s.trim().replace('_', "");
+    let out_of_range = || format!("`{s}` is too large: {what} must be from {min} to {max}");
+    let value: u64 = if let Some((b, e)) = t.split_once('^') {
+        let (b, e): (u64, u32) = match (b.parse(), e.parse()) {
+            (Ok(b), Ok(e)) => (b, e),
+            _ => {
+                return Err(format!(
+                    "`{s}`: expected B^E with whole numbers B and E, e.g. 2^20"
+                ));
+            }
+        };
+        b.checked_pow(e).ok_or_else(out_of_range)?
+    } else if t.bytes().all(|c| c.is_ascii_digit()) && !t.is_empty() {
+        t.parse().map_err(|_| out_of_range())?
+    } else {
+        let x: f64 = t.parse().map_err(|_| {
+            format!(
+                "`{s}` is not a count of {what}: expected a whole number such as 65536, 1e6 or 2^20"
+            )
+        })?;
+        if !x.is_finite() || x < 0.0 {
+            return Err(format!(
+                "`{s}`: a count of {what} must be a finite number >= 0"
+            ));
+        }
+        if x.fract() != 0.0 {
+            return Err(format!("`{s}` = {x} is not a whole number of {what}"));
+        }
+        if x >= 18_446_744_073_709_551_615.0 {
+            return Err(out_of_range());
+        }
+        x as u64
+    };
+    if value > max {
+        return Err(out_of_range());
+    }
+    if value < min {
+        return Err(format!(
+            "`{s}` is too small: {what} must be from {min} to {max}"
+        ));
+    }
+    Ok(value)
+}
+
+/// [`parse_count`] of samples as a `usize` (clap value parser).
+pub fn samples_usize(s: &str) -> Result<usize, String> {
+    parse_count(s, 0, usize::MAX as u64, "samples").map(|v| v as usize)
+}
+
+/// [`parse_count`] of samples per pixel as a `u64` (clap value parser).
+pub fn spp_u64(s: &str) -> Result<u64, String> {
+    parse_count(s, 0, u64::MAX, "samples per pixel")
+}
+
+/// [`parse_count`] of samples per pixel as a `u32` (clap value parser).
+pub fn spp_u32(s: &str) -> Result<u32, String> {
+    parse_count(s, 0, u64::from(u32::MAX), "samples per pixel").map(|v| v as u32)
+}
+
+/// Load a material (JSON text, @file.json or @file.toml) and warn once on
+/// stderr when it reflects more light than it receives.
+pub fn load_material(spec: &str) -> Result<lobe::Material> {
+    let m = lobe::Material::load(spec)?;
+    warn_energy_gain(&m, "the material");
+    Ok(m)
+}
+
+/// Warn once on stderr when `m` reflects more than it receives: its largest
+/// directional albedo ([`lobe::experiment::variance::max_albedo`]) is above 1.
+pub fn warn_energy_gain(m: &lobe::Material, what: &str) {
+    let a = lobe::experiment::variance::max_albedo(m);
+    if a.gains_energy() {
+        eprintln!(
+            "lobe: warning: {what} reflects more light than it receives: its directional albedo is {:.3} at θo = {}° (above 1, so it gains energy; lower kd or ks)",
+            a.albedo, a.theta_deg
+        );
     }
 }
 

@@ -46,14 +46,15 @@ use std::path::{Path, PathBuf};
                   The renders are the same for a given seed and spp on any thread count; the equal-time \
                   spp depend on the measured times.",
     after_help = "Examples:\n  \
-                  lobe compare scene.toml --spp 16 --out cmp\n  \
-                  lobe compare scene.toml --strategies brdf,light,mis,mis-power --reference-spp 4096 --threads 2"
+                  lobe compare examples/scene.toml --spp 16 --out cmp\n  \
+                  lobe compare examples/scene.toml --strategy brdf,light,mis,mis-one --spp 4 --reference-spp 256 --threads 2"
 )]
 pub struct CompareArgs {
     /// The scene file (TOML; `lobe render --help` shows the format)
     pub scene: PathBuf,
-    /// Samples per pixel of the equal-samples row (default: the scene's render.spp)
-    #[arg(long)]
+    /// Samples per pixel of the equal-samples row (default: the scene's
+    /// render.spp): a whole number such as 64, 1e3 or 2^8
+    #[arg(long, value_parser = crate::common::spp_u32)]
     pub spp: Option<u32>,
     /// Seed of the random streams (default: the scene's render.seed)
     #[arg(long)]
@@ -66,29 +67,36 @@ pub struct CompareArgs {
     #[arg(long, value_name = "NAME")]
     pub out: Option<PathBuf>,
     /// Samples per pixel of the mis reference (default: 16 × spp, at least 1024)
-    #[arg(long, value_name = "R")]
+    #[arg(long, value_name = "R", value_parser = crate::common::spp_u32)]
     pub reference_spp: Option<u32>,
-    /// Comma-separated strategies: uniform, cosine, brdf, vndf, spherical-caps,
-    /// bounded-vndf, light, mis, mis-power (default: brdf, light, mis, and vndf
-    /// when an object's material has it)
-    #[arg(long, value_name = "LIST")]
+    /// Comma-separated strategies (default: brdf, light, mis, and vndf when
+    /// an object's material has it); `--strategies` is an old name of it
+    #[arg(long = "strategy", alias = "strategies", value_name = "LIST", help = strategy_help())]
     pub strategies: Option<String>,
     /// No progress bars and no notes
     #[arg(long, short)]
     pub quiet: bool,
 }
 
-/// Parse `--strategies`: a comma-separated list of method names, each once.
+/// The help of `--strategy`: every accepted name.
+fn strategy_help() -> String {
+    format!(
+        "Comma-separated strategies: {} (default: brdf, light, mis, and vndf when an object's material has it)",
+        Strategy::names()
+    )
+}
+
+/// Parse `--strategy`: a comma-separated list of method names, each once.
 pub fn parse_methods(spec: &str) -> Result<Vec<Strategy>> {
     let mut v = Vec::new();
     for name in spec.split(',').map(str::trim) {
         if name.is_empty() {
             bail!(
-                "--strategies {spec}: an empty name; expected a comma-separated list of: {}",
+                "--strategy {spec}: an empty name; expected a comma-separated list of: {}",
                 Strategy::names()
             );
         }
-        let m: Strategy = name.parse().map_err(|e| anyhow!("--strategies: {e}"))?;
+        let m: Strategy = name.parse().map_err(|e| anyhow!("--strategy: {e}"))?;
         if !v.contains(&m) {
             v.push(m);
         }

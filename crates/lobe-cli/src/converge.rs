@@ -42,7 +42,7 @@ pub const MAX_EXP: u32 = 20;
     after_help = "Examples:\n  \
                   lobe converge --material '{\"type\":\"phong\",\"exponent\":10}' --theta 30 --light beam:8 \\\n      \
                   --strategy cosine,brdf --out conv/phong\n  \
-                  lobe converge --material @ggx.toml --theta 75 --sequence independent,sobol --runs 64 --max-exp 18 --out ggx75"
+                  lobe converge --material @examples/ggx.toml --theta 75 --sequence independent,sobol --runs 16 --max-exp 12 --out ggx75"
 )]
 pub struct ConvergeArgs {
     /// Material: JSON text, @file.json or @file.toml (`lobe eval --help` lists the keys)
@@ -52,9 +52,7 @@ pub struct ConvergeArgs {
     pub view: ViewArgs,
     #[command(flatten)]
     pub light: LightArgs,
-    /// `all` (every strategy that applies) or a comma-separated list of:
-    /// uniform, cosine, brdf, vndf, spherical-caps, bounded-vndf
-    #[arg(long, default_value = "all")]
+    #[arg(long, default_value = "all", help = crate::estimate::strategy_help())]
     pub strategy: String,
     /// Comma-separated list of sample sequences: independent, stratified, sobol
     #[arg(long, default_value = "independent,stratified,sobol")]
@@ -186,7 +184,7 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
         );
     }
     let sequences = parse_sequences(&args.sequence)?;
-    let m = lobe::Material::load(&args.material)?;
+    let m = crate::common::load_material(&args.material)?;
     let wo = args.view.wo()?;
     let light = args.light.light()?;
     let strategies =

@@ -6,7 +6,8 @@ use anyhow::{Result, bail};
 use clap::Args;
 use glam::DVec3;
 use lobe::estimator::{Heuristic, Mis, MisForm, Strategy};
-use lobe::experiment::table::{Table, TableSettings, run_table};
+use lobe::experiment::table::{StderrMethod, TableOptions};
+use lobe::experiment::table::{Table, TableSettings, run_table_with};
 use lobe::progress::SystemClock;
 use lobe::sequence::Sequence;
 use lobe::{BsdfStrategy, Material};
@@ -19,28 +20,37 @@ use lobe::{BsdfStrategy, Material};
                   quadrature in f64 (relative tolerance 1e-9; never a long Monte Carlo run).\n\n\
                   Columns: the estimate and its standard error (RGB), the relative error of the \
                   estimate's luminance against the reference, the per-sample variance of the luminance \
-                  of f·L·cos/p, the variance reduction against `uniform` (uniform's variance over this \
-                  one, measured in the same run with the same N), the wall time, and the efficiency \
-                  1/(variance × time).",
+                  of f·L·cos/p, the variance reduction against `uniform` (the exact variance of uniform \
+                  sampling, 2π ∫ lum(f L cos)² dω − μ² by quadrature, over this one's), the wall time, \
+                  and the efficiency 1/(variance × time).\n\n\
+                  Standard errors: on the independent sequence, the sample standard deviation over √N. \
+                  Under stratified and Sobol points, whose samples are not independent, the N samples are \
+                  cut into R (--replicas, default 16) independently randomized replicas of N/R points; the \
+                  estimate is the mean of the replica means and its standard error their standard \
+                  deviation over √R. The table and the JSON (`stderr_method`, `replicas`) say which.",
     after_help = "Examples:\n  \
                   lobe estimate --material '{\"type\":\"phong\",\"exponent\":100}' --theta 30 --samples 65536\n  \
-                  lobe estimate --material @ggx.toml --theta 70 --light beam:16:1,1,0 --strategy brdf,vndf --json\n  \
+                  lobe estimate --material @examples/ggx.toml --theta 70 --light beam:16:1,1,0 --strategy brdf,vndf --json\n  \
                   lobe estimate --material '{\"type\":\"lambert\"}' --wo 0.3,0,1 --sequence sobol"
 )]
 pub struct EstimateArgs {
     /// Material: JSON text, @file.json or @file.toml (`lobe eval --help` lists the keys)
-    #[arg(long)]
+    #[arg(long, short = 'm', value_name = "JSON|@FILE")]
     pub material: String,
     #[command(flatten)]
     pub view: ViewArgs,
     #[command(flatten)]
     pub light: LightArgs,
-    /// Samples per strategy
-    #[arg(long, short = 'n', default_value_t = 65536)]
+    /// Samples per strategy: a whole number such as 65536, 1e6 or 2^20
+    #[arg(long, short = 'n', default_value_t = 65536, value_parser = crate::common::samples_usize)]
     pub samples: usize,
-    /// `all` or a comma-separated list: uniform, cosine, brdf, vndf, spherical-caps, bounded-vndf
-    #[arg(long, default_value = "all")]
+    #[arg(long, default_value = "all", help = strategy_help())]
     pub strategy: String,
+    /// Independently randomized replicas whose spread gives the standard
+    /// error under stratified and Sobol points (N/R points each; not used
+    /// on the independent sequence)
+    #[arg(long, short = 'r', default_value_t = lobe::experiment::table::REPLICAS)]
+    pub replicas: usize,
     /// Seed of the sample sequence
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
@@ -61,6 +71,15 @@ pub struct EstimateArgs {
     /// No progress bars
     #[arg(long, short)]
     pub quiet: bool,
+}
+
+/// The help of `--strategy`: every accepted name.
+#[must_use]
+pub fn strategy_help() -> String {
+    format!(
+        "`all` or a comma-separated list of: {} (all: every BSDF strategy that applies, light, mis, mis-power)",
+        Strategy::names()
+    )
 }
 
 /// Parse `all` or a list of technique names: the BSDF strategies
@@ -140,7 +159,7 @@ pub fn parse_sequence(spec: &str) -> Result<Sequence> {
 }
 
 pub fn run(args: &EstimateArgs) -> Result<()> {
-    let m = lobe::Material::load(&args.material)?;
+    let m = crate::common::load_material(&args.material)?;
     let wo = args.view.wo()?;
     let light = args.light.light()?;
     if args.samples < 2 {
@@ -165,17 +184,36 @@ pub fn run(args: &EstimateArgs) -> Result<()> {
     let (n_bsdf, n_light) = parse_mis_samples(&args.mis_samples)?;
     let strategies = parse_strategies(&args.strategy, &m, mis_bsdf, n_bsdf, n_light)?;
     let sequence = parse_sequence(&args.sequence)?;
+    if sequence != Sequence::Independent {
+        if args.replicas < 2 {
+            bail!(
+                "--replicas {}: a standard error from replicas needs at least 2 of them",
+                args.replicas
+            );
+        }
+        if args.samples < args.replicas {
+            bail!(
+                "--samples {}: under the {sequence} sequence the standard error comes from --replicas {} independently randomized replicas, so at least {} samples are needed",
+                args.samples,
+                args.replicas,
+                args.replicas
+            );
+        }
+    }
     let bar = Bar::new(args.quiet);
     let sp = args.light.shading_point(&light, wo)?;
-    let table = run_table(
+    let table = run_table_with(
         &m,
         &sp,
         &light,
         &strategies,
-        TableSettings {
-            sequence,
-            samples: args.samples,
-            seed: args.seed,
+        TableOptions {
+            settings: TableSettings {
+                sequence,
+                samples: args.samples,
+                seed: args.seed,
+            },
+            replicas: args.replicas,
         },
         &bar,
         &SystemClock::new(),
@@ -217,7 +255,25 @@ fn print_table(t: &Table, model: &str, wo: DVec3) {
         wo.z.acos().to_degrees(),
         t.sequence
     );
-    println!("reference {} by {}\n", rgb(t.reference), t.reference_method);
+    println!("reference {} by {}", rgb(t.reference), t.reference_method);
+    match (t.stderr_method, t.replicas) {
+        (StderrMethod::Replicas, Some(r)) => println!(
+            "std. error: the spread of {r} independently randomized replicas of {} points (std. dev. of the replica means / √{r}); estimate: their mean",
+            replica_size(n, r)
+        ),
+        _ => println!("std. error: independent samples (sample std. dev. / √N)"),
+    }
+    let u = &t.uniform_variance;
+    if u.reliable {
+        println!(
+            "vs uniform: against uniform's exact variance {:.4e} ({})\n",
+            u.variance, u.method
+        );
+    } else {
+        println!(
+            "vs uniform: unreliable (the quadrature of uniform's variance did not converge)\n"
+        );
+    }
     println!(
         "{:<15} {:>26} {:>26} {:>10} {:>11} {:>10} {:>9} {:>11}",
         "strategy",
@@ -230,9 +286,14 @@ fn print_table(t: &Table, model: &str, wo: DVec3) {
         "efficiency"
     );
     for r in &t.strategies {
-        let red = r
-            .variance_reduction
-            .map_or("zero var".to_string(), |x| format!("{x:.1}x"));
+        let red = if !r.variance_reliable {
+            "unreliable".to_string()
+        } else if r.variance <= 0.0 {
+            "zero var".to_string()
+        } else {
+            r.variance_reduction
+                .map_or("unreliable".to_string(), format_ratio)
+        };
         let eff = r
             .efficiency
             .map_or("inf".to_string(), |x| format!("{x:.3e}"));
@@ -249,6 +310,26 @@ fn print_table(t: &Table, model: &str, wo: DVec3) {
         );
     }
     println!(
-        "\nvariance: per sample, of the luminance of f·L·cos/p; vs uniform: uniform's variance / this one; efficiency: 1/(variance × time)"
+        "\nvariance: per sample, of the luminance of f·L·cos/p; vs uniform: uniform's exact variance / this one (unreliable: the estimate is more than 6 std. errors from the reference, so its variance is not to be trusted); efficiency: 1/(variance × time)"
     );
+}
+
+/// `N/R` as printed: one number when the replicas are equal, else a range.
+fn replica_size(n: usize, r: usize) -> String {
+    if n.is_multiple_of(r) {
+        (n / r).to_string()
+    } else {
+        format!("{}–{}", n / r, n / r + 1)
+    }
+}
+
+/// A variance ratio: `12.3x`, or in scientific notation past 10⁶ and
+/// below 0.1 (`1.83e31x`, `2.50e-3x`).
+#[must_use]
+pub fn format_ratio(x: f64) -> String {
+    if (0.1..1e6).contains(&x) {
+        format!("{x:.1}x")
+    } else {
+        format!("{x:.2e}x")
+    }
 }

@@ -50,7 +50,11 @@ fn long_about() -> String {
          \n\
          Directions are in the local shading frame (+z is the normal), point away from\n\
          the surface, and must be unit vectors: |length - 1| <= {UNIT_TOLERANCE:e}. u1, u2 and uc\n\
-         are in [0, 1); uc chooses the lobe of a two-lobe material and defaults to 0.5.\n\
+         are in [0, 1). uc chooses the lobe of a two-lobe material (a diffuse term kd and\n\
+         a glossy lobe): it is required there, for every strategy but uniform and cosine,\n\
+         and must be an independent uniform number like u1 and u2 (a fixed uc always takes\n\
+         the same lobe, which biases any average of the weights). A single-lobe material\n\
+         does not use it and may omit it.\n\
          Strategies: {}.\n\
          Empty lines are skipped. Numbers are printed so that they parse back to the same\n\
          f64. A bad line, or a result that is not finite, stops with an error that names\n\
@@ -63,9 +67,10 @@ fn after_long_help() -> String {
     format!(
         "Examples:\n  \
          echo '{{\"wo\":[0.6,0,0.8],\"wi\":[0,0,1]}}' | lobe eval --material '{{\"type\":\"cook-torrance\",\"alpha\":0.2}}'\n  \
-         echo '{{\"wo\":[0.6,0,0.8],\"u\":[0.3,0.7],\"strategy\":\"vndf\"}}' | lobe eval -m @gold.toml\n\
+         echo '{{\"wo\":[0.6,0,0.8],\"u\":[0.3,0.7],\"uc\":0.4,\"strategy\":\"vndf\"}}' | lobe eval -m @examples/gold.toml\n  \
+         echo '{{\"wo\":[0.6,0,0.8],\"u\":[0.3,0.7],\"uc\":0.4,\"strategy\":\"vndf\"}}' | lobe eval -m @examples/ggx.toml\n\
          \n\
-         A TOML material file (gold.toml):\n  \
+         A TOML material file (examples/gold.toml):\n  \
          type = \"cook-torrance\"\n  \
          alpha = 0.2\n  \
          fresnel = {{ type = \"conductor\" }}\n\
@@ -77,7 +82,7 @@ fn after_long_help() -> String {
 
 /// Run `lobe eval`: stdin to stdout.
 pub fn run(args: &EvalArgs) -> Result<()> {
-    let material = lobe::Material::load(&args.material)?;
+    let material = crate::common::load_material(&args.material)?;
     let mut out = BufWriter::with_capacity(1 << 16, io::stdout().lock());
     let result = process(&material, io::stdin().lock(), &mut out);
     // Flush what was computed before any error, so that the lines before a bad
@@ -479,8 +484,7 @@ enum Request {
 impl Query {
     /// Check the keys present, the vectors and the strategy.
     fn check(self, material: &Material, strategies: &[BsdfStrategy]) -> Result<Request, String> {
-        const KINDS: &str =
-            "an eval line has wo and wi; a sample line has wo, u, strategy and optionally uc";
+        const KINDS: &str = "an eval line has wo and wi; a sample line has wo, u, strategy, and uc where the material has two lobes";
         let wo = self
             .wo
             .ok_or_else(|| format!("field \"wo\": missing ({KINDS})"))?;
@@ -509,8 +513,6 @@ impl Query {
         for x in u {
             unit_interval(Key::U, x)?;
         }
-        let uc = self.uc.unwrap_or(0.5);
-        unit_interval(Key::Uc, uc)?;
         if !strategies.contains(&strategy) {
             let reason = match material.check(strategy) {
                 Err(e) => e.to_string(),
@@ -518,6 +520,17 @@ impl Query {
             };
             return Err(format!("field \"strategy\": {reason}"));
         }
+        let uc = match self.uc {
+            Some(uc) => uc,
+            None if material.chooses_lobe(strategy) => {
+                return Err(format!(
+                    "field \"uc\": missing; this material has two lobes (a diffuse term and a glossy lobe) and strategy `{strategy}` chooses between them with uc, so give an independent uniform number in [0, 1) (a fixed uc always takes the same lobe and biases the mean weight)"
+                ));
+            }
+            // Not used: one lobe, or a strategy that does not choose one.
+            None => 0.5,
+        };
+        unit_interval(Key::Uc, uc)?;
         Ok(Request::Sample {
             strategy,
             wo,
@@ -648,5 +661,25 @@ mod tests {
         assert!(unit_vector(Key::Wo, [1e300, 1e300, 0.0]).is_err());
         let w = [0.6, 0.0, 0.8];
         assert_eq!(unit_vector(Key::Wo, w).unwrap().to_array(), w);
+    }
+
+    /// Issue 8: a sample line without `uc` on a two-lobe material is an
+    /// error naming the field (it used to default to 0.5, always taking the
+    /// same lobe); a single-lobe material, or a strategy that does not
+    /// choose a lobe, may omit it.
+    #[test]
+    fn uc_is_required_where_it_chooses_a_lobe() {
+        let two = r#"{"type":"cook-torrance","alpha":0.6,"kd":0.5,"ks":0.5}"#;
+        let line = r#"{"wo":[0.5,0,0.8660254037844386],"u":[0.3,0.7],"strategy":"vndf"}"#;
+        let e = run_lines(two, line).unwrap_err();
+        assert!(e.starts_with("stdin line 1: field \"uc\": missing"), "{e}");
+        assert!(e.contains("two lobes"), "{e}");
+        let with_uc =
+            r#"{"wo":[0.5,0,0.8660254037844386],"u":[0.3,0.7],"uc":0.9,"strategy":"vndf"}"#;
+        assert!(run_lines(two, with_uc).is_ok());
+        let cosine = r#"{"wo":[0.5,0,0.8660254037844386],"u":[0.3,0.7],"strategy":"cosine"}"#;
+        assert!(run_lines(two, cosine).is_ok());
+        let one = r#"{"type":"cook-torrance","alpha":0.6}"#;
+        assert!(run_lines(one, line).is_ok());
     }
 }

@@ -9,6 +9,7 @@
 //!
 //! The figures themselves are drawn by [`crate::figures`].
 
+use crate::common::load_material;
 use crate::common::{Bar, ViewArgs, progress};
 use crate::figures;
 use anyhow::{Context, Result, anyhow, bail};
@@ -44,7 +45,7 @@ const POLAR_VIEWS: [f64; 4] = [0.0, 30.0, 60.0, 80.0];
     after_help = "Examples:\n  \
         lobe plot --material '{\"type\":\"cook-torrance\",\"alpha\":0.3}' --theta 60 --strategy vndf --out figs\n  \
         lobe plot --material '{\"type\":\"phong\",\"exponent\":50}' --strategy uniform --kind weights --out figs\n  \
-        lobe plot --material @gold.toml --wo 0.5,0.2,0.8 --strategy brdf --kind histogram --samples 100000 --out figs"
+        lobe plot --material @examples/gold.toml --wo 0.5,0.2,0.8 --strategy brdf --kind histogram --samples 100000 --out figs"
 )]
 pub struct PlotArgs {
     /// Material: JSON text, @FILE.json or @FILE.toml (keys: see `lobe eval --help`)
@@ -61,8 +62,9 @@ pub struct PlotArgs {
     /// Directory to write the PNG files to (created if missing)
     #[arg(long, short)]
     pub out: PathBuf,
-    /// Samples drawn for the histogram and the chi-square test
-    #[arg(long, short = 'n', default_value_t = 1_000_000)]
+    /// Samples drawn for the histogram and the chi-square test: a whole
+    /// number such as 100000, 1e6 or 2^20
+    #[arg(long, short = 'n', default_value_t = 1_000_000, value_parser = crate::common::samples_usize)]
     pub samples: usize,
     /// Seed of the random stream of the histogram and the chi-square test
     #[arg(long, default_value_t = 1)]
@@ -91,7 +93,7 @@ pub fn run(args: &PlotArgs) -> Result<()> {
         "all" => vec![Kind::Polar, Kind::Histogram, Kind::Weights],
         k => bail!("--kind {k}: unknown kind, expected polar, histogram, weights or all"),
     };
-    let material = lobe::Material::load(&args.material)?;
+    let material = load_material(&args.material)?;
     let wo = args.view.wo()?;
     let needs_strategy = kinds.iter().any(|&k| k != Kind::Polar);
     let strategy = match (&args.strategy, needs_strategy) {

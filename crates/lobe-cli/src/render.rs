@@ -24,18 +24,17 @@ use std::time::Instant;
                   a filmic curve (ACES fit) on luminance that keeps each pixel's hue, sRGB-encoded, \
                   8 bits). Every pixel has its own random stream, so the image is the same for any \
                   --threads.",
-    after_help = "Example:\n  lobe render scene.toml --spp 16 --strategy mis-power --out preview",
+    after_help = "Example:\n  lobe render examples/scene.toml --spp 16 --strategy mis-power --out preview",
     after_long_help = SCENE_HELP
 )]
 pub struct RenderArgs {
     /// The scene file (TOML; `lobe render --help` shows the format)
     pub scene: PathBuf,
-    /// Samples per pixel, 1 to 2^64 − 1 (overrides the scene's render.spp)
-    #[arg(long)]
+    /// Samples per pixel, 1 to 2^64 − 1, such as 64, 1e3 or 2^10 (overrides
+    /// the scene's render.spp)
+    #[arg(long, value_parser = crate::common::spp_u64)]
     pub spp: Option<u64>,
-    /// uniform, cosine, brdf, vndf, spherical-caps, bounded-vndf, light, mis or
-    /// mis-power (overrides the scene's render.strategy)
-    #[arg(long)]
+    #[arg(long, help = strategy_help())]
     pub strategy: Option<String>,
     /// Seed of the random streams (overrides the scene's render.seed)
     #[arg(long)]
@@ -91,9 +90,17 @@ Scene file (TOML; unknown keys are errors; paths are relative to the scene file)
 Materials take the keys of `lobe eval --help`.
 
 Examples:
-  lobe render scene.toml
-  lobe render scene.toml --spp 16 --strategy light --out light-16
-  lobe render scene.toml --threads 1 --seed 7 --quiet";
+  lobe render examples/scene.toml
+  lobe render examples/scene.toml --spp 16 --strategy light --out light-16
+  lobe render examples/scene.toml --threads 1 --seed 7 --quiet";
+
+/// The help of `--strategy`: every accepted name.
+fn strategy_help() -> String {
+    format!(
+        "One of: {} (overrides the scene's render.strategy)",
+        Strategy::names()
+    )
+}
 
 /// Run `lobe render`.
 pub fn run(args: &RenderArgs) -> Result<()> {

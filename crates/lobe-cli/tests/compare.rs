@@ -244,9 +244,13 @@ fn help_has_an_example() {
     let o = lobe(&["compare", "--help"]);
     assert!(o.status.success());
     let s = String::from_utf8_lossy(&o.stdout);
-    assert!(s.contains("lobe compare scene.toml"), "{s}");
+    // Issue 8: the examples name the shipped scene, and the flag is
+    // `--strategy` as in every other command (`--strategies` is a hidden
+    // alias).
+    assert!(s.contains("lobe compare examples/scene.toml"), "{s}");
     assert!(
-        s.contains("--reference-spp") && s.contains("--strategies"),
+        s.contains("--reference-spp") && s.contains("--strategy "),
         "{s}"
     );
+    assert!(!s.contains("--strategies"), "{s}");
 }

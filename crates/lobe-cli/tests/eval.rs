@@ -46,7 +46,14 @@ fn eval(material: &str, input: &str) -> Run {
 /// The output lines, parsed; panics with stderr unless the run succeeded.
 fn ok_lines(run: &Run) -> Vec<Value> {
     assert_eq!(run.code, Some(0), "stderr: {}", run.stderr);
-    assert!(run.stderr.is_empty(), "stderr: {}", run.stderr);
+    // Issue 8: a material that gains energy is warned about (one line).
+    assert!(
+        run.stderr
+            .lines()
+            .all(|l| l.starts_with("lobe: warning: ") && l.contains("reflects more light")),
+        "stderr: {}",
+        run.stderr
+    );
     run.stdout
         .lines()
         .map(|l| serde_json::from_str(l).unwrap_or_else(|e| panic!("{l}: {e}")))
@@ -280,19 +287,65 @@ fn failed_samples_give_null() {
 }
 
 #[test]
-fn empty_lines_are_skipped_and_uc_defaults() {
+fn empty_lines_are_skipped_and_uc_is_required_with_two_lobes() {
     let input = "\n{\"wo\":[0,0,1],\"wi\":[0,0,1]}\n\n  \n{\"wo\":[0,0,1],\"u\":[0.1,0.2],\"strategy\":\"cosine\"}\r\n\n";
     let lines = ok_lines(&eval(CT_KD, input));
     assert_eq!(lines.len(), 2);
-    let with_uc = ok_lines(&eval(
+    // Issue 8: uc no longer defaults to 0.5 where it chooses a lobe (a fixed
+    // uc always takes the same lobe, a silent bias): an error naming it.
+    let run = eval(
         CT_KD,
+        r#"{"wo":[0.6,0,0.8],"u":[0.1,0.2],"strategy":"brdf"}"#,
+    );
+    assert_eq!(run.code, Some(1));
+    assert!(
+        run.stderr.contains("stdin line 1: field \"uc\": missing")
+            && run.stderr.contains("two lobes"),
+        "{}",
+        run.stderr
+    );
+    // A single-lobe material may omit it: it does not change the sample.
+    let one = r#"{"type":"cook-torrance","alpha":0.3}"#;
+    let with_uc = ok_lines(&eval(
+        one,
         r#"{"wo":[0.6,0,0.8],"u":[0.1,0.2],"uc":0.5,"strategy":"brdf"}"#,
     ));
     let without = ok_lines(&eval(
-        CT_KD,
+        one,
         r#"{"wo":[0.6,0,0.8],"u":[0.1,0.2],"strategy":"brdf"}"#,
     ));
     assert_eq!(with_uc, without);
+}
+
+/// Issue 8: the issue's example, with `uc` drawn like `u`: the mean weight
+/// of a two-lobe material is its albedo (0.798), not the 0.938 that the
+/// old default `uc = 0.5` gave.
+#[test]
+fn random_uc_gives_the_albedo() {
+    let m = r#"{"type":"cook-torrance","alpha":0.6,"kd":0.5,"ks":0.5}"#;
+    let mut rng = 0x2545_f491_4f6c_dd1du64;
+    let mut next = || {
+        rng ^= rng << 13;
+        rng ^= rng >> 7;
+        rng ^= rng << 17;
+        (rng >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let mut input = String::new();
+    for _ in 0..40_000 {
+        input += &format!(
+            "{{\"wo\":[0.5,0,0.8660254037844386],\"u\":[{},{}],\"uc\":{},\"strategy\":\"vndf\"}}\n",
+            next(),
+            next(),
+            next()
+        );
+    }
+    let lines = ok_lines(&eval(m, &input));
+    let mean: f64 = lines
+        .iter()
+        .map(|l| l["weight"][0].as_f64().unwrap())
+        .sum::<f64>()
+        / lines.len() as f64;
+    assert!((mean - 0.798).abs() < 0.01, "mean weight {mean}");
 }
 
 #[test]

@@ -82,6 +82,54 @@ pub fn load_envmap(path: &Path, scale: f64, rotation_y: f64) -> Result<(EnvMap, 
     EnvMap::new(w, h, texels, scale, rotation_y).map_err(map_err)
 }
 
+/// An environment map with the warnings of its loading ([`load_envmap_checked`]).
+#[derive(Debug, Clone)]
+pub struct LoadedEnvMap {
+    pub map: EnvMap,
+    /// Texels whose negative or NaN channels were clamped to 0.
+    pub clamped: usize,
+    /// What the caller should print, one sentence each, naming the file:
+    /// clamped texels, and a map that is not 2:1 (an equirectangular map
+    /// spans 360° by 180°, so any other aspect stretches it).
+    pub warnings: Vec<String>,
+}
+
+/// The warning for a map of `width × height` texels that is not 2:1, if it
+/// is not.
+#[must_use]
+pub fn aspect_warning(path: &Path, width: usize, height: usize) -> Option<String> {
+    (width != 2 * height).then(|| {
+        format!(
+            "{}: the environment map is {width}×{height}, not 2:1; an equirectangular map spans 360°×180°, so it is stretched (is it a cube map, a crop or a light probe?)",
+            path.display()
+        )
+    })
+}
+
+/// [`load_envmap`] with its warnings, for the caller to print:
+/// [`LoadedEnvMap::warnings`].
+pub fn load_envmap_checked(
+    path: &Path,
+    scale: f64,
+    rotation_y: f64,
+) -> Result<LoadedEnvMap, LoadError> {
+    let (map, clamped) = load_envmap(path, scale, rotation_y)?;
+    let mut warnings = Vec::new();
+    if clamped > 0 {
+        warnings.push(format!(
+            "{}: {clamped} texels with negative or NaN channels were clamped to 0",
+            path.display()
+        ));
+    }
+    let (w, h) = map.size();
+    warnings.extend(aspect_warning(path, w, h));
+    Ok(LoadedEnvMap {
+        map,
+        clamped,
+        warnings,
+    })
+}
+
 /// The `compression` attribute of an OpenEXR header, by name.
 fn exr_compression(bytes: &[u8]) -> Result<Option<&'static str>, String> {
     if bytes.len() < 8 || bytes[..4] != [0x76, 0x2f, 0x31, 0x01] {
@@ -242,5 +290,31 @@ mod tests {
             let (m, _) = load_envmap(&p, 1.0, 0.0).unwrap();
             assert_eq!(m.size(), (1024, 512));
         }
+    }
+
+    #[test]
+    fn a_map_that_is_not_two_to_one_is_a_warning() {
+        let img = image::Rgb32FImage::from_fn(8, 8, |_, _| image::Rgb([1.0, 1.0, 1.0]));
+        let p = tmp("square.HDR");
+        img.save_with_format(&p, image::ImageFormat::Hdr).unwrap();
+        let loaded = load_envmap_checked(&p, 1.0, 0.0).unwrap();
+        assert_eq!(loaded.warnings.len(), 1, "{:?}", loaded.warnings);
+        assert!(
+            loaded.warnings[0].contains("8×8, not 2:1"),
+            "{:?}",
+            loaded.warnings
+        );
+        let img = image::Rgb32FImage::from_fn(8, 4, |_, _| image::Rgb([1.0, 1.0, 1.0]));
+        let p = tmp("wide.Exr");
+        img.save_with_format(&p, image::ImageFormat::OpenExr)
+            .unwrap();
+        assert!(
+            load_envmap_checked(&p, 1.0, 0.0)
+                .unwrap()
+                .warnings
+                .is_empty()
+        );
+        let sky = load_envmap_checked(Path::new("sky"), 1.0, 0.0).unwrap();
+        assert!(sky.warnings.is_empty());
     }
 }

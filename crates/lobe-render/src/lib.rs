@@ -45,7 +45,7 @@ pub mod output;
 pub mod scene;
 
 pub use camera::{Camera, CameraError};
-pub use envmap_io::{LoadError, load_envmap};
+pub use envmap_io::{LoadError, LoadedEnvMap, load_envmap, load_envmap_checked};
 pub use geometry::{Hit, Ray};
 pub use integrator::{Image, RenderStats, fallbacks, render, strategy_for};
 pub use mesh::{Mesh, MeshError};

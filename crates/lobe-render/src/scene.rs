@@ -31,7 +31,7 @@
 //! ```
 
 use crate::camera::{Camera, CameraError};
-use crate::envmap_io::load_envmap;
+use crate::envmap_io::load_envmap_checked;
 use crate::geometry::{Hit, Plane, Ray, Sphere};
 use crate::mesh::Mesh;
 use crate::options::RenderOptions;
@@ -595,14 +595,10 @@ fn build(desc: &SceneDesc, base: &Path) -> FieldResult<Scene> {
     } else {
         base.join(&e.path)
     };
-    let (map, clamped) = load_envmap(&env_path, e.scale, e.rotation_y)
+    let loaded = load_envmap_checked(&env_path, e.scale, e.rotation_y)
         .map_err(|err| (env_field("path"), err.to_string()))?;
-    if clamped > 0 {
-        warnings.push(format!(
-            "{}: {clamped} texels with negative or NaN channels were clamped to 0",
-            env_path.display()
-        ));
-    }
+    warnings.extend(loaded.warnings);
+    let map = loaded.map;
 
     let r = &desc.render;
     let render_field = |k: &str| FieldPath::of(&["render", k]);

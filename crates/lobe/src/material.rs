@@ -95,6 +95,17 @@ impl Material {
         }
     }
 
+    /// Whether `sample(strategy, ..)` uses `uc` to choose between two lobes:
+    /// the material has a diffuse term and a glossy lobe, and the strategy
+    /// samples them (not `uniform` or `cosine`). Where it does not, `uc` does
+    /// not change the sample.
+    #[must_use]
+    pub fn chooses_lobe(&self, strategy: BsdfStrategy) -> bool {
+        !matches!(strategy, BsdfStrategy::Uniform | BsdfStrategy::Cosine)
+            && !matches!(self.glossy, Glossy::None)
+            && self.has_diffuse()
+    }
+
     /// Probability of choosing the glossy lobe for `wo`.
     #[inline]
     #[must_use]

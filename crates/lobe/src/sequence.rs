@@ -89,6 +89,17 @@ pub fn stream_seed(seed: u64, stream: usize) -> u64 {
     }
 }
 
+/// The seed of replica `replica` of an estimate seeded with `seed`: an
+/// independent randomization of the whole sequence (its own scramble,
+/// permutation and jitter), for error estimates from independent replicas
+/// of a stratified or Sobol estimate. A domain apart from [`stream_seed`]:
+/// no replica shares a seed with a stream of another (or of itself), so the
+/// MIS streams inside a replica stay independent of every other replica.
+#[must_use]
+pub fn replica_seed(seed: u64, replica: usize) -> u64 {
+    hash64(hash64(seed ^ 0x5245_504c_4943_4153) ^ hash64(0x7265_706c_6963_6100 ^ replica as u64))
+}
+
 /// Fill `out` with the points `first .. first + out.len()` of an `n`-point
 /// sequence; `chunk` names the chunk (for the independent streams).
 pub fn fill(seq: Sequence, seed: u64, n: usize, chunk: usize, first: usize, out: &mut [[f64; 3]]) {

@@ -7,6 +7,8 @@
 //!   (`lobe converge`).
 //! * [`histogram`]: sample histograms and sample weights over the projected
 //!   hemisphere (`lobe plot`).
+//! * [`variance`]: exact variances by quadrature (the baseline of "vs
+//!   uniform") and the largest directional albedo of a material.
 //!
 //! Progress and time reach these functions only through the
 //! [`Progress`](crate::progress::Progress) and [`Clock`](crate::progress::Clock)
@@ -18,6 +20,7 @@
 pub mod converge;
 pub mod histogram;
 pub mod table;
+pub mod variance;
 
 use crate::estimator::{
     Accumulator, Plan, ShadingPoint, estimate_chunk, reference, reference_env_row,

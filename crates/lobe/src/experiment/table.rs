@@ -2,15 +2,20 @@
 //! samples, sequence and seed, against a quadrature reference (what
 //! `lobe estimate` prints).
 
-use super::{estimate_chunked, reference_rows};
-use crate::estimator::{Plan, ShadingPoint, Strategy};
-use crate::math::luminance;
+use super::variance::{UniformVariance, uniform_variance};
+use super::{estimate_chunked, map_indices, reference_rows};
+use crate::estimator::{Accumulator, Plan, ShadingPoint, Strategy};
+use crate::math::{Rgb, luminance};
 use crate::progress::{Clock, Progress, timed};
-use crate::sequence::Sequence;
-use crate::{BsdfStrategy, Error, Light, Material};
+use crate::sequence::{Sequence, replica_seed};
+use crate::{Error, Light, Material};
 
 /// Relative tolerance of the quadrature reference of [`run_table`].
 pub const REFERENCE_TOLERANCE: f64 = 1e-9;
+
+/// Independently randomized replicas of a stratified or Sobol estimate
+/// whose spread gives its standard error ([`run_table`]).
+pub const REPLICAS: usize = 16;
 
 /// How every technique of a table is run.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -22,6 +27,39 @@ pub struct TableSettings {
     pub seed: u64,
 }
 
+/// [`TableSettings`] with the number of replicas of a stratified or Sobol
+/// estimate ([`run_table_with`]); from `TableSettings`, [`REPLICAS`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TableOptions {
+    pub settings: TableSettings,
+    /// Under stratified and Sobol sequences, the `samples` are cut into this
+    /// many independently randomized replicas of `samples / replicas` points
+    /// (at least 2; ignored on the independent sequence).
+    pub replicas: usize,
+}
+
+impl From<TableSettings> for TableOptions {
+    fn from(settings: TableSettings) -> Self {
+        TableOptions {
+            settings,
+            replicas: REPLICAS,
+        }
+    }
+}
+
+/// How the standard errors of a table were computed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "desc", derive(serde::Serialize))]
+#[cfg_attr(feature = "desc", serde(rename_all = "kebab-case"))]
+pub enum StderrMethod {
+    /// Independent samples: the sample standard deviation over `√N`.
+    IndependentSamples,
+    /// The spread of independently randomized replicas: the standard
+    /// deviation of the replica means over `√R`; the estimate is the mean
+    /// of the replica means.
+    Replicas,
+}
+
 /// One technique's result.
 #[derive(Debug, Clone, PartialEq)]
 #[cfg_attr(feature = "desc", derive(serde::Serialize))]
@@ -31,14 +69,21 @@ pub struct Row {
     pub samples: usize,
     /// The estimate of `L_o = ∫ f L cos dω` (RGB; the cosine is included).
     pub mean: [f64; 3],
-    /// Standard error of the mean, per channel.
+    /// Standard error of the mean, per channel ([`Table::stderr_method`]).
     pub stderr: [f64; 3],
     /// Relative error of the luminance of the mean against the reference's
     /// (the absolute error when the reference is zero).
     pub relative_error: f64,
     /// Per-sample variance of the luminance of `f·L·cos/p`.
     pub variance: f64,
-    /// Uniform's variance over this one; `None` when this one is zero.
+    /// Whether this row's measured variance can be trusted: its estimate is
+    /// within 6 standard errors of the reference (a technique that never
+    /// sampled where the integrand lives, uniform sampling of a narrow lobe
+    /// say, measures a variance far too small and misses the reference).
+    pub variance_reliable: bool,
+    /// The exact variance of uniform sampling ([`Table::uniform_variance`])
+    /// over this one; `None` when this one is zero, or either variance is
+    /// unreliable.
     pub variance_reduction: Option<f64>,
     /// Seconds the estimate took on the caller's clock.
     pub time_s: f64,
@@ -56,20 +101,20 @@ pub struct Table {
     pub reference_method: &'static str,
     /// The sequence's name.
     pub sequence: String,
+    /// How the standard errors were computed.
+    pub stderr_method: StderrMethod,
+    /// The replicas of [`StderrMethod::Replicas`] (`None` for independent
+    /// samples).
+    pub replicas: Option<usize>,
+    /// The baseline of every variance reduction: the exact per-sample
+    /// variance of uniform sampling, by quadrature.
+    pub uniform_variance: UniformVariance,
     /// One row per requested technique, in the requested order.
     pub strategies: Vec<Row>,
 }
 
-/// Estimates `L_o(wo) = ∫ f_r(wo, wi) L(wi) cos θi dωi` with every technique
-/// of `techniques` (same samples, sequence and seed) and compares each with
-/// the quadrature reference ([`REFERENCE_TOLERANCE`]). The variance
-/// reduction is against `uniform` BSDF sampling, which is run too (and left
-/// out of the rows) when it is not in the list.
-///
-/// Progress: one task `estimating` of `samples × techniques` steps (one per
-/// sample). Each row's time is measured on `clock`; every other number
-/// depends only on the arguments, not on the thread count. The error says
-/// why a technique does not apply to `m`.
+/// [`run_table_with`] with [`REPLICAS`] replicas under stratified and Sobol
+/// sequences.
 pub fn run_table(
     m: &Material,
     sp: &ShadingPoint,
@@ -79,62 +124,105 @@ pub fn run_table(
     progress: &dyn Progress,
     clock: &dyn Clock,
 ) -> Result<Table, Error> {
+    run_table_with(m, sp, light, techniques, settings.into(), progress, clock)
+}
+
+/// Estimates `L_o(wo) = ∫ f_r(wo, wi) L(wi) cos θi dωi` with every technique
+/// of `techniques` (same samples, sequence and seed) and compares each with
+/// the quadrature reference ([`REFERENCE_TOLERANCE`]). The variance
+/// reduction is against the exact variance of `uniform` BSDF sampling by
+/// quadrature ([`uniform_variance`]), never a measured one (which misses a
+/// narrow lobe that `N` uniform samples never hit).
+///
+/// Standard errors: on the independent sequence, from the samples
+/// ([`StderrMethod::IndependentSamples`]). Under stratified and Sobol
+/// sequences the samples are not independent and that formula is wrong by
+/// orders of magnitude; instead the `N` samples are cut into
+/// `options.replicas` independently randomized replicas
+/// ([`crate::sequence::replica_seed`]) of `N/R` points each (the first
+/// `N mod R` replicas one more), the estimate is the mean of the replica
+/// means and its standard error the standard deviation of those means over
+/// `√R` ([`StderrMethod::Replicas`]).
+///
+/// Progress: one task `estimating` of `samples × techniques` steps (one per
+/// sample). Each row's time is measured on `clock`; every other number
+/// depends only on the arguments, not on the thread count. The error says
+/// why a technique does not apply to `m`, or that there are too few samples
+/// for the replicas.
+pub fn run_table_with(
+    m: &Material,
+    sp: &ShadingPoint,
+    light: &Light,
+    techniques: &[Strategy],
+    options: TableOptions,
+    progress: &dyn Progress,
+    clock: &dyn Clock,
+) -> Result<Table, Error> {
     let TableSettings {
         sequence,
         samples,
         seed,
-    } = settings;
+    } = options.settings;
+    let replicas = (sequence != Sequence::Independent).then_some(options.replicas);
+    if let Some(r) = replicas {
+        if r < 2 {
+            return Err(Error::param(
+                "replicas",
+                format!("{r}: a standard error from replicas needs at least 2 of them"),
+            ));
+        }
+        if samples < r {
+            return Err(Error::param(
+                "samples",
+                format!(
+                    "{samples}: the standard error under the {sequence} sequence comes from {r} replicas, so at least {r} samples are needed"
+                ),
+            ));
+        }
+    }
     let reference = reference_rows(m, sp, light, REFERENCE_TOLERANCE);
     let r_lum = luminance(reference);
-    let uniform = Strategy::Bsdf(BsdfStrategy::Uniform);
-    let mut todo: Vec<Strategy> = techniques.to_vec();
-    if !todo.contains(&uniform) {
-        todo.push(uniform);
-    }
-    progress.start("estimating", (samples * todo.len()) as u64);
-    let mut rows: Vec<(Strategy, Row)> = Vec::new();
-    for &s in &todo {
-        let plan = Plan {
-            strategy: s,
-            sequence,
-            samples,
-            seed,
-        };
-        let (acc, time_s) = timed(clock, || estimate_chunked(m, sp, light, &plan, progress));
-        let acc = acc?;
-        let mean = acc.mean();
-        let variance = acc.lum.variance();
+    let exact_uniform = uniform_variance(m, sp, light, r_lum);
+    progress.start("estimating", (samples * techniques.len()) as u64);
+    let mut rows = Vec::new();
+    for &s in techniques {
+        let (result, time_s) = timed(clock, || -> Result<_, Error> {
+            Ok(match replicas {
+                None => {
+                    let plan = Plan {
+                        strategy: s,
+                        sequence,
+                        samples,
+                        seed,
+                    };
+                    let acc = estimate_chunked(m, sp, light, &plan, progress)?;
+                    (acc.mean(), acc.std_error(), acc.lum.variance())
+                }
+                Some(r) => replicated(m, sp, light, s, options.settings, r, progress)?,
+            })
+        });
+        let (mean, stderr, variance) = result?;
         let relative_error = if r_lum != 0.0 {
             (luminance(mean) - r_lum).abs() / r_lum.abs()
         } else {
             luminance(mean).abs()
         };
-        rows.push((
-            s,
-            Row {
-                name: s.name(),
-                samples,
-                mean: mean.to_array(),
-                stderr: acc.std_error().to_array(),
-                relative_error,
-                variance,
-                variance_reduction: None,
-                time_s,
-                efficiency: (variance > 0.0).then(|| 1.0 / (variance * time_s.max(1e-9))),
-            },
-        ));
-    }
-    let uniform = rows
-        .iter()
-        .find(|(s, _)| *s == uniform)
-        .map_or(f64::NAN, |(_, r)| r.variance);
-    let mut out = Vec::new();
-    for (s, mut row) in rows {
-        if !techniques.contains(&s) {
-            continue;
-        }
-        row.variance_reduction = (row.variance > 0.0).then(|| uniform / row.variance);
-        out.push(row);
+        let abs_error = (luminance(mean) - r_lum).abs();
+        let variance_reliable =
+            abs_error <= 6.0 * luminance(stderr).abs() + 1e-7 * r_lum.abs().max(1e-12);
+        rows.push(Row {
+            name: s.name(),
+            samples,
+            mean: mean.to_array(),
+            stderr: stderr.to_array(),
+            relative_error,
+            variance,
+            variance_reliable,
+            variance_reduction: (variance > 0.0 && exact_uniform.reliable && variance_reliable)
+                .then(|| exact_uniform.variance / variance),
+            time_s,
+            efficiency: (variance > 0.0).then(|| 1.0 / (variance * time_s.max(1e-9))),
+        });
     }
     Ok(Table {
         reference: reference.to_array(),
@@ -144,14 +232,59 @@ pub fn run_table(
             "deterministic adaptive quadrature (Gauss-Kronrod, f64, relative tolerance 1e-9)"
         },
         sequence: sequence.name().to_string(),
-        strategies: out,
+        stderr_method: if replicas.is_some() {
+            StderrMethod::Replicas
+        } else {
+            StderrMethod::IndependentSamples
+        },
+        replicas,
+        uniform_variance: exact_uniform,
+        strategies: rows,
     })
+}
+
+/// `(mean, standard error, per-sample luminance variance)` of `s` from `r`
+/// independently randomized replicas of the settings' sequence: the mean of
+/// the replica means and the spread of those means (see [`run_table_with`]).
+fn replicated(
+    m: &Material,
+    sp: &ShadingPoint,
+    light: &Light,
+    s: Strategy,
+    settings: TableSettings,
+    r: usize,
+    progress: &dyn Progress,
+) -> Result<(Rgb, Rgb, f64), Error> {
+    let (base, extra) = (settings.samples / r, settings.samples % r);
+    let parts = map_indices(r, |k| {
+        let plan = Plan {
+            strategy: s,
+            sequence: settings.sequence,
+            samples: base + usize::from(k < extra),
+            seed: replica_seed(settings.seed, k),
+        };
+        estimate_chunked(m, sp, light, &plan, progress)
+    });
+    let mut all = Accumulator::default();
+    let mut means = Vec::with_capacity(r);
+    for p in parts {
+        let p = p?;
+        means.push(p.mean());
+        all.merge(&p);
+    }
+    let rf = r as f64;
+    let mean = means.iter().fold(Rgb::ZERO, |a, &b| a + b) / rf;
+    let ss = means
+        .iter()
+        .fold(Rgb::ZERO, |a, &b| a + (b - mean) * (b - mean));
+    let stderr = (ss / (rf * (rf - 1.0))).powf(0.5);
+    Ok((mean, stderr, all.lum.variance()))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::Rgb;
+    use crate::BsdfStrategy;
     use crate::estimator::{Heuristic, Mis, MisForm};
     use glam::DVec3;
     use std::sync::Mutex;
@@ -216,7 +349,17 @@ mod tests {
         assert_eq!(t.strategies.len(), 2);
         let (u, c) = (&t.strategies[0], &t.strategies[1]);
         assert_eq!((u.name.as_str(), c.name.as_str()), ("uniform", "cosine"));
-        assert_eq!(u.variance_reduction, Some(1.0));
+        // Against the exact variance ρ²/3 of uniform sampling (before: the
+        // measured one, which made this exactly 1).
+        let exact = 0.8f64.powi(2) / 3.0;
+        assert!((t.uniform_variance.variance - exact).abs() < 1e-9);
+        assert_eq!(
+            u.variance_reduction,
+            Some(t.uniform_variance.variance / u.variance)
+        );
+        assert!((u.variance_reduction.unwrap() - 1.0).abs() < 0.05, "{u:?}");
+        assert_eq!(t.stderr_method, StderrMethod::IndependentSamples);
+        assert_eq!(t.replicas, None);
         assert!(u.variance > 0.0 && u.relative_error < 0.02, "{u:?}");
         assert!(u.stderr[0] > 0.0);
         assert!(c.variance < 1e-20, "{c:?}");
@@ -231,8 +374,9 @@ mod tests {
         assert_eq!(p.1, 20_000);
     }
 
-    /// Uniform is run for the variance reduction though not listed; the
-    /// rows keep the requested order.
+    /// The variance reduction is against the exact variance of uniform
+    /// sampling (before: a measured one, from uniform run though not listed);
+    /// the rows keep the requested order.
     #[test]
     fn variance_reduction_without_uniform_in_the_list() {
         let m = Material::lambert(Rgb::splat(0.5)).unwrap();
@@ -273,7 +417,9 @@ mod tests {
             &Ticks(Mutex::new(0)),
         )
         .unwrap();
-        let uniform = all.strategies[0].variance;
+        let uniform = all.uniform_variance.variance;
+        assert!(all.uniform_variance.reliable);
+        assert!((all.strategies[0].variance / uniform - 1.0).abs() < 0.1);
         for r in &t.strategies {
             assert_eq!(
                 r.variance_reduction,
@@ -285,5 +431,155 @@ mod tests {
         }
         // Sampling the sharp light beats uniform sampling.
         assert!(t.strategies[0].variance_reduction.unwrap() > 2.0);
+    }
+
+    fn lum(c: [f64; 3]) -> f64 {
+        luminance(Rgb::from_array(c))
+    }
+
+    /// Under Sobol, the reported standard error (from 16 replicas) is within
+    /// a factor 3 of the actual RMSE over seeds on a smooth integrand, and
+    /// far below the independent-samples formula, which overstates it.
+    #[test]
+    fn sobol_standard_error_matches_the_actual_error() {
+        let m = Material::lambert(Rgb::splat(0.7)).unwrap();
+        let sp = ShadingPoint::local(DVec3::new(0.5, 0.0, 0.75f64.sqrt()));
+        let light = Light::Beam {
+            dir: DVec3::new(0.3, 0.2, 1.0).normalize(),
+            exponent: 4.0,
+            radiance: Rgb::ONE,
+        };
+        let cosine = [Strategy::Bsdf(BsdfStrategy::Cosine)];
+        let n = 4096;
+        let (mut sq_err, mut sq_se, mut iid_se) = (0.0, 0.0, 0.0);
+        let seeds = 48;
+        for seed in 0..seeds {
+            let settings = TableSettings {
+                sequence: Sequence::Sobol,
+                samples: n,
+                seed,
+            };
+            let t = run_table(
+                &m,
+                &sp,
+                &light,
+                &cosine,
+                settings,
+                &(),
+                &Ticks(Mutex::new(0)),
+            )
+            .unwrap();
+            assert_eq!(t.stderr_method, StderrMethod::Replicas);
+            assert_eq!(t.replicas, Some(REPLICAS));
+            let r = &t.strategies[0];
+            sq_err += (lum(r.mean) - lum(t.reference)).powi(2);
+            sq_se += lum(r.stderr).powi(2);
+            iid_se += (r.variance / n as f64).sqrt();
+        }
+        let rmse = (sq_err / f64::from(seeds as u32)).sqrt();
+        let se = (sq_se / f64::from(seeds as u32)).sqrt();
+        let iid = iid_se / f64::from(seeds as u32);
+        assert!(
+            se < 3.0 * rmse && rmse < 3.0 * se,
+            "reported {se:e}, actual {rmse:e}"
+        );
+        assert!(
+            se < 0.1 * iid,
+            "reported {se:e}, independent formula {iid:e}"
+        );
+    }
+
+    /// On the independent sequence the table is the plain estimate, bit
+    /// for bit (the replicas are for stratified and Sobol only).
+    #[test]
+    fn independent_rows_are_the_plain_estimate() {
+        let m = Material::lambert(Rgb::splat(0.6)).unwrap();
+        let sp = ShadingPoint::local(DVec3::new(0.2, 0.1, 0.95f64.sqrt()));
+        let light = Light::Constant(Rgb::ONE);
+        let s = Strategy::Bsdf(BsdfStrategy::Uniform);
+        let t = run_table(
+            &m,
+            &sp,
+            &light,
+            &[s],
+            settings(10_000),
+            &(),
+            &Ticks(Mutex::new(0)),
+        )
+        .unwrap();
+        let acc =
+            crate::estimator::estimate(&m, &sp, &light, &Plan::independent(s, 10_000, 1)).unwrap();
+        let r = &t.strategies[0];
+        assert_eq!(r.mean, acc.mean().to_array());
+        assert_eq!(r.stderr, acc.std_error().to_array());
+        assert_eq!(r.variance, acc.lum.variance());
+    }
+
+    /// Too few samples for the replicas is an error that says so.
+    #[test]
+    fn too_few_samples_for_the_replicas() {
+        let m = Material::lambert(Rgb::splat(0.6)).unwrap();
+        let sp = ShadingPoint::local(DVec3::Z);
+        let settings = TableSettings {
+            sequence: Sequence::Stratified,
+            samples: 8,
+            seed: 1,
+        };
+        let e = run_table(
+            &m,
+            &sp,
+            &Light::Constant(Rgb::ONE),
+            &[Strategy::Bsdf(BsdfStrategy::Cosine)],
+            settings,
+            &(),
+            &Ticks(Mutex::new(0)),
+        )
+        .unwrap_err();
+        assert!(e.to_string().contains("replicas"), "{e}");
+    }
+
+    /// Issue 8, item 4: uniform sampling of a very narrow lobe (alpha
+    /// 1e-4, 1000 samples) never hits it; its measured variance is far too
+    /// small, so its ratio is flagged unreliable rather than printed as
+    /// 1.8e31x, and vndf's ratio is against the exact uniform variance.
+    #[test]
+    fn a_missed_narrow_lobe_is_an_unreliable_variance() {
+        let ct = crate::models::CookTorrance::new(
+            Rgb::ONE,
+            crate::Microfacet::new(crate::Ndf::Ggx, 1e-4, 1e-4).unwrap(),
+            crate::Shadowing::SmithCorrelated,
+            crate::Fresnel::None,
+        )
+        .unwrap();
+        let m = Material::with_diffuse(Rgb::ZERO, crate::Glossy::CookTorrance(ct)).unwrap();
+        let sp = ShadingPoint::local(DVec3::new(0.5, 0.0, 0.75f64.sqrt()));
+        let techniques = [
+            Strategy::Bsdf(BsdfStrategy::Uniform),
+            Strategy::Bsdf(BsdfStrategy::Vndf),
+        ];
+        let t = run_table(
+            &m,
+            &sp,
+            &Light::Constant(Rgb::ONE),
+            &techniques,
+            settings(1000),
+            &(),
+            &Ticks(Mutex::new(0)),
+        )
+        .unwrap();
+        assert!(t.uniform_variance.reliable, "{:?}", t.uniform_variance);
+        assert!(
+            t.uniform_variance.variance > 1e6,
+            "{:?}",
+            t.uniform_variance
+        );
+        let (u, v) = (&t.strategies[0], &t.strategies[1]);
+        assert!(
+            !u.variance_reliable && u.variance_reduction.is_none(),
+            "{u:?}"
+        );
+        assert!(v.variance_reliable, "{v:?}");
+        let r = v.variance_reduction.unwrap();
+        assert!(r > 1e6 && r.is_finite(), "{v:?}");
     }
 }
