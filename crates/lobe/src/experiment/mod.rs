@@ -6,7 +6,10 @@
 //! * [`converge`]: RMSE against the number of samples, with fitted slopes
 //!   (`lobe converge`).
 //! * [`histogram`]: sample histograms and sample weights over the projected
-//!   hemisphere (`lobe plot`).
+//!   hemisphere, and the fraction of failed samples (`lobe plot`,
+//!   `lobe report`).
+//! * [`polar`]: the integrand and each strategy's pdf in the plane of
+//!   incidence (`lobe plot --kind polar`, `lobe report`).
 //!
 //! Progress and time reach these functions only through the
 //! [`Progress`](crate::progress::Progress) and [`Clock`](crate::progress::Clock)
@@ -17,6 +20,7 @@
 
 pub mod converge;
 pub mod histogram;
+pub mod polar;
 pub mod table;
 
 use crate::estimator::{
