@@ -467,7 +467,11 @@ fn run_job(
                 &(),
             )?;
             let file = format!("{}-convergence.png", model.id);
-            let title = format!("{}: RMSE of {} runs", caption(model), st.runs);
+            let title = format!(
+                "{}, light: white furnace: RMSE of {} runs",
+                caption(model),
+                st.runs
+            );
             figures::convergence_plot(&dir.join(&file), &title, &converge::plot_series(&curves))
                 .with_context(|| format!("cannot write {file}"))?;
             Ok(Done::Convergence(
