@@ -116,7 +116,8 @@ pub fn plot_series(curves: &[Curve]) -> Vec<Series> {
     curves
         .iter()
         .map(|c| Series {
-            label: label(c),
+            strategy: c.strategy.name(),
+            sequence: c.sequence.name().to_string(),
             points: c.points.iter().map(|&(n, e)| (n as f64, e)).collect(),
             slope: c.slope,
         })
@@ -238,8 +239,9 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
         .with_context(|| format!("cannot write {}", csv_path.display()))?;
     let theta = wo.z.clamp(-1.0, 1.0).acos().to_degrees();
     let title = format!(
-        "{}, θo = {theta:.0}°: RMSE of {} runs",
+        "{}, θo = {theta:.0}°, light {}: RMSE of {} runs",
         m.model_name(),
+        args.light.light,
         setup.runs
     );
     let plot = plot_series(&curves);

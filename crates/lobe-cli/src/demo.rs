@@ -5,9 +5,10 @@
 //!    furnace, uniform hemisphere sampling against the importance samplers
 //!    at the same number of samples ([`lobe::experiment::table::run_table`]).
 //! 2. The showcase: a row of spheres, two of each model, on a grey ground
-//!    under the built-in sky, rendered with BSDF sampling, light sampling
-//!    and MIS at equal samples next to a reference, drawn as the grid of
-//!    `lobe compare` with error maps and RMSE.
+//!    under the built-in sky, path traced (up to [`MAX_DEPTH`] bounces)
+//!    with BSDF sampling, light sampling and MIS at equal samples next to a
+//!    reference, drawn as the grid of `lobe compare` with error maps and
+//!    RMSE, and a caption that says what each row shows.
 
 use crate::common::Bar;
 use crate::compare::{
@@ -38,8 +39,9 @@ use std::time::Instant;
                   and prints the relative error, the per-sample variance and the variance reduction.\n\n\
                   Then it renders the showcase: eight spheres (Phong n=20 and 300, Blinn-Phong n=80 and \
                   1200, GGX alpha=0.3 and 0.06, Beckmann gold alpha=0.3 and 0.06) on a grey ground under \
-                  the built-in sky, with brdf, light and mis at 16 samples per pixel next to a mis \
-                  reference at 256, and writes DIR/showcase.png (the renders with their error maps and \
+                  the built-in sky, by path tracing (up to 3 bounces, so that the sharp spheres mirror \
+                  the ground) with brdf, light and mis at 16 samples per pixel next to a mis \
+                  reference at 768, and writes DIR/showcase.png (the renders with their error maps and \
                   RMSE, as `lobe compare` draws them), DIR/showcase.json (the numbers) and each render \
                   as DIR/<strategy>.png.",
     after_help = "Examples:\n  lobe demo\n  lobe demo --out /tmp/demo --quiet"
@@ -55,6 +57,14 @@ pub struct DemoArgs {
     #[arg(long, short)]
     pub quiet: bool,
 }
+
+/// Samples per pixel of the showcase's reference (MIS).
+const REFERENCE_SPP: u32 = 768;
+
+/// Bounces of the showcase's paths: enough for the sharp spheres to mirror
+/// the ground and their neighbours (the integrator's next-event estimation
+/// at every vertex, Russian roulette after the third bounce).
+const MAX_DEPTH: u32 = 3;
 
 /// Sizes of the run.
 struct DemoSizes {
@@ -81,7 +91,7 @@ impl DemoSizes {
                 width: 640,
                 height: 200,
                 spp: 16,
-                reference_spp: 256,
+                reference_spp: REFERENCE_SPP,
             }
         }
     }
@@ -283,6 +293,18 @@ fn showcase_scene(width: u32, height: u32) -> Result<(Scene, Vec<Label>)> {
     Ok((scene, labels))
 }
 
+/// What each row of the showcase shows, under the figure.
+fn showcase_caption(s: &CompareSettings) -> Vec<String> {
+    vec![
+        format!(
+            "Rows: the reference (mis, {} spp), then each strategy at {} spp, its error map on the right; paths of up to {} bounces.",
+            s.reference_spp, s.spp, s.max_depth
+        ),
+        "brdf samples the BSDF only: it rarely finds the small sun, so the ground shows the blue sky with sun fireflies.".to_string(),
+        "light samples the sky and sun only: clean on the diffuse ground, noisy on glossy lobes, worst on sharp gold; mis weights both (balance heuristic).".to_string(),
+    ]
+}
+
 fn showcase(plan: &DemoSizes, dir: &Path, quiet: bool) -> Result<()> {
     let (scene, labels) = showcase_scene(plan.width, plan.height)?;
     let settings = CompareSettings {
@@ -294,7 +316,7 @@ fn showcase(plan: &DemoSizes, dir: &Path, quiet: bool) -> Result<()> {
         spp: plan.spp,
         reference_spp: plan.reference_spp,
         seed: 1,
-        max_depth: 1,
+        max_depth: MAX_DEPTH,
         threads: None,
         equal_time: false,
     };
@@ -306,25 +328,28 @@ fn showcase(plan: &DemoSizes, dir: &Path, quiet: bool) -> Result<()> {
         "broad and a sharp lobe each) on a grey ground under the built-in sky with its sun, rendered by"
     );
     println!(
-        "BSDF sampling (brdf), light sampling and MIS at {} spp; the reference is MIS at {} spp.",
-        settings.spp, settings.reference_spp
+        "BSDF sampling (brdf), light sampling and MIS at {} spp, paths of up to {} bounces; the reference",
+        settings.spp, settings.max_depth
     );
+    println!("is MIS at {} spp.", settings.reference_spp);
     std::fs::create_dir_all(dir)
         .with_context(|| format!("{}: cannot create the directory", dir.display()))?;
     let cmp = run_with_progress(&scene, &settings, quiet);
     let png = dir.join("showcase.png");
     let json = dir.join("showcase.json");
-    let figure = write_grid(
+    let mut figure = write_grid(
         &png,
         &FigureSpec {
             title: format!(
-                "lobe demo: BSDF sampling, light sampling and MIS at {} spp under the built-in sky ({}×{}, direct light)",
-                settings.spp, plan.width, plan.height
+                "lobe demo: BSDF sampling, light sampling and MIS at {} spp under the built-in sky ({}×{}, paths of up to {} bounces)",
+                settings.spp, plan.width, plan.height, settings.max_depth
             ),
             cmp: &cmp,
             labels,
         },
     )?;
+    let caption = showcase_caption(&settings);
+    (figure.width, figure.height) = crate::figures::append_caption(&png, &caption)?;
     write_json(
         &json,
         &summary("built-in showcase", &settings, &cmp, figure),

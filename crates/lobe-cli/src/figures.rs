@@ -14,6 +14,7 @@
 use anyhow::{Result, anyhow, bail};
 use glam::{DVec2, DVec3};
 use lobe::experiment::histogram::{WeightPixel, weight_pixels};
+use lobe::experiment::polar::{CurveKind, PolarCurves};
 use lobe::{BsdfStrategy, Material};
 use plotters::coord::Shift;
 use plotters::coord::ranged1d::{DefaultFormatting, KeyPointHint, Ranged};
@@ -22,8 +23,6 @@ use plotters::style::text_anchor::{HPos, Pos, VPos};
 use std::path::Path;
 use std::sync::OnceLock;
 
-/// Size in pixels of a line plot (convergence).
-pub const LINE_SIZE: (u32, u32) = (800, 500);
 /// Size in pixels of a polar plot.
 pub const POLAR_SIZE: (u32, u32) = (800, 500);
 /// Size in pixels of a warp-test histogram (two maps side by side).
@@ -46,8 +45,11 @@ static FONT_BYTES: &[u8] = include_bytes!("../assets/DejaVuSans.ttf");
 /// One curve of a convergence plot.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Series {
-    /// Legend text, e.g. the strategy name.
-    pub label: String,
+    /// The strategy: it chooses the colour, the same in every panel.
+    pub strategy: String,
+    /// The sample sequence: it chooses the panel, the line style and the
+    /// marker.
+    pub sequence: String,
     /// `(N, RMSE)` pairs. Points with `N ≤ 0` or `RMSE ≤ 0` (or not finite)
     /// cannot go on log axes and are left out.
     pub points: Vec<(f64, f64)>,
@@ -57,13 +59,17 @@ pub struct Series {
 }
 
 /// Draws RMSE against the number of samples on log-log axes (`log₂ N` on x,
-/// `log₁₀ RMSE` on y): one coloured line with markers per series, a legend
-/// with each label and its fitted slope, and a dashed reference line of
-/// slope −1/2 through the first point of the first series.
+/// `log₁₀ RMSE` on y) as small multiples: one panel per sample sequence
+/// (up to three side by side, on shared axes), one colour per strategy (the
+/// same strategy has the same colour in every panel and every figure), one
+/// line style and marker per sequence, a dashed grey line of slope −1/2 in
+/// each panel, and under each panel, outside its plotting area, a legend of
+/// its curves with their fitted slopes. The image grows with the number of
+/// panels and of curves per panel, so that every label fits.
 ///
-/// Writes an SVG if `path` ends in `.svg`, a PNG (800×500) if it ends in
-/// `.png`. Series without any plottable point (e.g. RMSE = 0 everywhere, as
-/// for a zero-variance estimator) are listed in the legend as not shown.
+/// Writes an SVG if `path` ends in `.svg`, a PNG if it ends in `.png`.
+/// Series without any plottable point (e.g. RMSE = 0 everywhere, as for a
+/// zero-variance estimator) are listed in the legend as not shown.
 ///
 /// # Errors
 ///
@@ -72,11 +78,15 @@ pub fn convergence_plot(path: &Path, title: &str, series: &[Series]) -> Result<(
     save_figure(path, &Convergence { title, series })
 }
 
-/// Draws a polar plot of a BRDF in the plane of incidence: the upper half
-/// disk, the angle θi measured from the normal (straight up), negative angles
-/// on the viewer's side (left), positive on the mirror side (right). Each
-/// curve is `(label, [(θi in radians in [−π/2, π/2], value)])`; the radius is
-/// the value divided by the maximum over all curves, as a caption says.
+/// Draws curves in the plane of incidence on one polar plot: the upper half
+/// disk, the angle θi measured from the normal (straight up), negative
+/// angles on the viewer's side (left), positive on the mirror side (right),
+/// with a ray toward the viewer at θi = −θo. Every curve is drawn on the
+/// same radial scale (`scale`), so that a pdf can be read against the
+/// integrand `f·cos θi / albedo` (cosine included): where the pdf lies
+/// inside the integrand, samples are rare and their weights large. The
+/// integrand is drawn thick and dark, each pdf in its strategy's colour;
+/// the legend (beside the plot) gives each curve's maximum in 1/sr.
 /// Negative or non-finite values are drawn as zero.
 ///
 /// Writes an SVG if `path` ends in `.svg`, a PNG (800×500) if `.png`.
@@ -84,34 +94,7 @@ pub fn convergence_plot(path: &Path, title: &str, series: &[Series]) -> Result<(
 /// # Errors
 ///
 /// An unknown extension, or the file cannot be written.
-#[allow(dead_code)] // the API the figures were specified with; callers use polar_plot_scaled
-pub fn polar_plot(path: &Path, title: &str, curves: &[(String, Vec<(f64, f64)>)]) -> Result<()> {
-    polar_plot_scaled(path, title, curves, PolarScale::Global)
-}
-
-/// How [`polar_plot_scaled`] turns values into radii.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum PolarScale {
-    /// Every curve divided by the maximum over all curves: the curves
-    /// compare in size.
-    Global,
-    /// Every curve divided by its own maximum: every lobe's shape is
-    /// visible even when one curve is far larger (f_r at grazing angles).
-    PerCurve,
-}
-
-/// [`polar_plot`] with a choice of normalization. Either way the legend
-/// gives each curve's maximum and the caption says how radii were scaled.
-///
-/// # Errors
-///
-/// An unknown extension, or the file cannot be written.
-pub fn polar_plot_scaled(
-    path: &Path,
-    title: &str,
-    curves: &[(String, Vec<(f64, f64)>)],
-    scale: PolarScale,
-) -> Result<()> {
+pub fn polar_plot(path: &Path, title: &str, curves: &PolarCurves, scale: PolarScale) -> Result<()> {
     save_figure(
         path,
         &Polar {
@@ -120,6 +103,34 @@ pub fn polar_plot_scaled(
             scale,
         },
     )
+}
+
+/// How [`polar_plot`] turns values (1/sr) into radii; one scale serves
+/// every curve.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PolarScale {
+    /// The radius is the value over the maximum of all curves.
+    Linear,
+    /// The radius is `1 + log₁₀(value / maximum) / POLAR_DECADES`: the
+    /// outer ring is the maximum of all curves, the centre
+    /// [`POLAR_DECADES`] decades below it. Shows a diffuse term or a
+    /// pdf's tail next to a sharp peak.
+    Log,
+}
+
+/// Decades shown by [`PolarScale::Log`].
+pub const POLAR_DECADES: f64 = 4.0;
+
+impl std::str::FromStr for PolarScale {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "linear" => Ok(PolarScale::Linear),
+            "log" => Ok(PolarScale::Log),
+            _ => Err(format!("unknown scale '{s}', expected linear or log")),
+        }
+    }
 }
 
 /// Draws Nori's warp-test picture: the observed and the expected sample
@@ -256,6 +267,48 @@ pub(crate) fn write_png(path: &Path, rgb: &[u8], size: (u32, u32)) -> Result<()>
     .map_err(|e| anyhow!("cannot write {}: {e}", path.display()))
 }
 
+/// Adds a white strip under the PNG at `path` holding `lines` of caption
+/// text (left-aligned, each shrunk to fit the width), rewrites the file and
+/// returns the new size.
+///
+/// # Errors
+///
+/// The file cannot be read, decoded or written.
+pub fn append_caption(path: &Path, lines: &[String]) -> Result<(u32, u32)> {
+    register_fonts()?;
+    let img = image::open(path)
+        .map_err(|e| anyhow!("cannot read {}: {e}", path.display()))?
+        .to_rgb8();
+    let (w, h) = img.dimensions();
+    let line_h = 22;
+    let strip = line_h * lines.len() as u32 + 14;
+    let size = (w, h + strip);
+    let mut buffer = vec![255u8; w as usize * size.1 as usize * 3];
+    buffer[..img.as_raw().len()].copy_from_slice(img.as_raw());
+    {
+        let root = BitMapBackend::with_buffer(&mut buffer, size).into_drawing_area();
+        let draw = || -> DResult<BitMapBackend<'_>> {
+            for (k, line) in lines.iter().enumerate() {
+                let fs = fit_size(&root, line, 16.0, w.saturating_sub(32))?;
+                put_text(
+                    &root,
+                    line,
+                    (16, (h + 6 + line_h * k as u32) as i32),
+                    fs,
+                    TEXT,
+                    (HPos::Left, VPos::Top),
+                )?;
+            }
+            Ok(())
+        };
+        draw().map_err(|e| anyhow!("drawing {}: {e}", path.display()))?;
+        root.present()
+            .map_err(|e| anyhow!("drawing {}: {e}", path.display()))?;
+    }
+    write_png(path, &buffer, size)?;
+    Ok(size)
+}
+
 /// Registers the embedded DejaVu Sans once; plotters' ab_glyph text needs it.
 pub(crate) fn register_fonts() -> Result<()> {
     static DONE: OnceLock<bool> = OnceLock::new();
@@ -307,16 +360,6 @@ fn save_figure(path: &Path, fig: &impl Figure) -> Result<()> {
 // Small helpers: colours, text, numbers
 // ---------------------------------------------------------------------------
 
-/// Okabe–Ito colours (distinguishable by colour-blind readers), yellow left out.
-const PALETTE: [RGBColor; 7] = [
-    RGBColor(0, 114, 178),
-    RGBColor(213, 94, 0),
-    RGBColor(0, 158, 115),
-    RGBColor(204, 121, 167),
-    RGBColor(230, 159, 0),
-    RGBColor(86, 180, 233),
-    RGBColor(0, 0, 0),
-];
 const GRID: RGBColor = RGBColor(215, 215, 215);
 const LIGHT_GRID: RGBColor = RGBColor(238, 238, 238);
 const TEXT: RGBColor = RGBColor(30, 30, 30);
@@ -552,6 +595,31 @@ struct Convergence<'a> {
     series: &'a [Series],
 }
 
+/// Plot area of one panel of a convergence figure (axes included).
+const PANEL_W: i32 = 430;
+/// Plot area of a convergence figure with one panel.
+const SINGLE_PANEL_W: i32 = 700;
+const PANEL_H: i32 = 380;
+/// Height of one legend entry.
+const ENTRY_H: i32 = 21;
+/// Height of the title and the key line under it.
+const CONVERGENCE_HEADER_H: i32 = 66;
+/// Panels side by side at most.
+const PANELS_PER_ROW: usize = 3;
+
+/// The panels (sequences, in order of first appearance) and the series of
+/// each (indices into the series).
+fn panels(series: &[Series]) -> Vec<(String, Vec<usize>)> {
+    let mut out: Vec<(String, Vec<usize>)> = Vec::new();
+    for (k, s) in series.iter().enumerate() {
+        match out.iter_mut().find(|(q, _)| *q == s.sequence) {
+            Some((_, v)) => v.push(k),
+            None => out.push((s.sequence.clone(), vec![k])),
+        }
+    }
+    out
+}
+
 /// The outline, in pixel offsets, of marker shape `k % 4`: a disk (a
 /// 12-gon), a triangle, a square, a diamond.
 fn marker_shape(k: usize) -> Vec<(i32, i32)> {
@@ -571,13 +639,110 @@ fn marker_shape(k: usize) -> Vec<(i32, i32)> {
     }
 }
 
+/// The dash length and gap of the line of panel (sequence) `k`: solid,
+/// dashed, dotted, dash-dot-like.
+fn dash(k: usize) -> Option<(u32, u32)> {
+    match k % 4 {
+        0 => None,
+        1 => Some((9, 5)),
+        2 => Some((2, 4)),
+        _ => Some((14, 4)),
+    }
+}
+
+/// Draws `pts` (in chart coordinates) as a line in the style of sequence `k`.
+fn styled_line<DB: DrawingBackend, X: Ranged<ValueType = f64>, Y: Ranged<ValueType = f64>>(
+    chart: &mut ChartContext<'_, DB, Cartesian2d<X, Y>>,
+    pts: &[(f64, f64)],
+    color: RGBColor,
+    k: usize,
+) -> DResult<DB> {
+    match dash(k) {
+        None => {
+            chart.draw_series(LineSeries::new(pts.iter().copied(), color.stroke_width(2)))?;
+        }
+        Some((size, gap)) => {
+            chart.draw_series(DashedLineSeries::new(
+                pts.iter().copied(),
+                size,
+                gap,
+                color.stroke_width(2),
+            ))?;
+        }
+    }
+    Ok(())
+}
+
+impl Convergence<'_> {
+    /// Columns and rows of panels, the width of a panel and the height of a
+    /// panel's legend.
+    fn grid(&self) -> (usize, usize, i32, i32) {
+        let panels = panels(self.series);
+        let n = panels.len().max(1);
+        let cols = n.min(PANELS_PER_ROW);
+        let rows = n.div_ceil(PANELS_PER_ROW);
+        let w = if n == 1 { SINGLE_PANEL_W } else { PANEL_W };
+        let entries = panels.iter().map(|(_, v)| v.len()).max().unwrap_or(0) as i32;
+        (cols, rows, w, entries * ENTRY_H + 14)
+    }
+}
+
+/// The x and y ranges (log₂ N, log₁₀ RMSE), rounded out to whole units,
+/// over every plotted point.
+fn log_ranges(logged: &[Vec<(f64, f64)>]) -> ((f64, f64), (f64, f64)) {
+    let all: Vec<(f64, f64)> = logged.iter().flatten().copied().collect();
+    let (mut x0, mut x1, mut y0, mut y1) = (0.0f64, 20.0f64, -6.0f64, 0.0f64);
+    if !all.is_empty() {
+        x0 = all.iter().map(|p| p.0).fold(f64::INFINITY, f64::min);
+        x1 = all.iter().map(|p| p.0).fold(f64::NEG_INFINITY, f64::max);
+        y0 = all.iter().map(|p| p.1).fold(f64::INFINITY, f64::min);
+        y1 = all.iter().map(|p| p.1).fold(f64::NEG_INFINITY, f64::max);
+    }
+    let (xa, mut xb) = (x0.floor(), x1.ceil());
+    if xb < xa + 1.0 {
+        xb = xa + 1.0;
+    }
+    let (ya, mut yb) = (y0.floor(), y1.ceil());
+    if yb < ya + 1.0 {
+        yb = ya + 1.0;
+    }
+    ((xa, xb), (ya, yb))
+}
+
 impl Figure for Convergence<'_> {
     fn size(&self) -> (u32, u32) {
-        LINE_SIZE
+        let (cols, rows, w, legend_h) = self.grid();
+        (
+            (cols as i32 * w + 24) as u32,
+            (CONVERGENCE_HEADER_H + rows as i32 * (PANEL_H + legend_h) + 8) as u32,
+        )
     }
 
+    #[allow(clippy::too_many_lines)]
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DResult<DB> {
         root.fill(&WHITE)?;
+        let (width, _) = root.dim_in_pixel();
+        let title_size = fit_size(root, self.title, 22.0, width.saturating_sub(30))?;
+        put_text(
+            root,
+            self.title,
+            (width as i32 / 2, 8),
+            title_size,
+            TEXT,
+            (HPos::Center, VPos::Top),
+        )?;
+        let key = "one panel per sample sequence, one colour per strategy; \
+                   grey dashes: slope −1/2 (RMSE ∝ 1/√N, plain Monte Carlo)";
+        let key_size = fit_size(root, key, 15.0, width.saturating_sub(30))?;
+        put_text(
+            root,
+            key,
+            (width as i32 / 2, 40),
+            key_size,
+            DIM_TEXT,
+            (HPos::Center, VPos::Top),
+        )?;
+
         let logged: Vec<Vec<(f64, f64)>> = self
             .series
             .iter()
@@ -589,212 +754,210 @@ impl Figure for Convergence<'_> {
                     .collect()
             })
             .collect();
-        let all: Vec<(f64, f64)> = logged.iter().flatten().copied().collect();
-        let (mut x0, mut x1, mut y0, mut y1) = (0.0f64, 20.0f64, -6.0f64, 0.0f64);
-        if !all.is_empty() {
-            x0 = all.iter().map(|p| p.0).fold(f64::INFINITY, f64::min);
-            x1 = all.iter().map(|p| p.0).fold(f64::NEG_INFINITY, f64::max);
-            y0 = all.iter().map(|p| p.1).fold(f64::INFINITY, f64::min);
-            y1 = all.iter().map(|p| p.1).fold(f64::NEG_INFINITY, f64::max);
-        }
-        let (xa, mut xb) = (x0.floor(), x1.ceil());
-        if xb < xa + 1.0 {
-            xb = xa + 1.0;
-        }
-        let (ya, mut yb) = (y0.floor(), y1.ceil());
-        if yb < ya + 1.0 {
-            yb = ya + 1.0;
-        }
-        let x_range = (xa - 0.3)..(xb + 0.3);
+        let ((xa, xb), (ya, yb)) = log_ranges(&logged);
         let y_pad = 0.04 * (yb - ya);
+        let x_range = (xa - 0.3)..(xb + 0.3);
         let y_range = (ya - y_pad)..(yb + y_pad);
-        let x_step = ((xb - xa) / 12.0).ceil().max(1.0);
+        let x_step = ((xb - xa) / 8.0).ceil().max(1.0);
         let x_ticks: Vec<f64> = (0..)
-            .map(|k| (xa / x_step).ceil() * x_step + k as f64 * x_step)
+            .map(|k| (xa / x_step).ceil() * x_step + f64::from(k) * x_step)
             .take_while(|&x| x <= xb + 1e-9)
             .collect();
         let y_step = ((yb - ya) / 10.0).ceil().max(1.0);
         let y_ticks: Vec<f64> = (0..)
-            .map(|k| (ya / y_step).ceil() * y_step + k as f64 * y_step)
+            .map(|k| (ya / y_step).ceil() * y_step + f64::from(k) * y_step)
             .take_while(|&y| y <= yb + 1e-9)
             .collect();
         let y_light: Vec<f64> = ((ya as i64)..(yb as i64))
             .flat_map(|d| (1..10).map(move |m| d as f64 + f64::log10(f64::from(m))))
             .collect();
 
-        let (w, _) = root.dim_in_pixel();
-        let size = fit_size(root, self.title, 22.0, w.saturating_sub(30))?;
-        let mut chart = ChartBuilder::on(root)
-            .caption(self.title, font(size).color(&TEXT))
-            .margin(12)
-            .margin_right(24)
-            .x_label_area_size(50)
-            .y_label_area_size(70)
-            .build_cartesian_2d(
-                TickedAxis {
-                    range: x_range,
-                    bold: x_ticks,
-                    light: Vec::new(),
-                },
-                TickedAxis {
-                    range: y_range,
-                    bold: y_ticks,
-                    light: y_light,
-                },
-            )?;
-        chart
-            .configure_mesh()
-            .x_desc("samples N (log₂ scale)")
-            .y_desc("RMSE (log₁₀ scale)")
-            .x_label_formatter(&|v| power_label(2, *v))
-            .y_label_formatter(&|v| power_label(10, *v))
-            .label_style(font(15.0).color(&TEXT))
-            .axis_desc_style(font(16.0).color(&TEXT))
-            .bold_line_style(GRID)
-            .light_line_style(LIGHT_GRID)
-            .draw()?;
+        let (_, _, panel_w, legend_h) = self.grid();
+        let mut panels = panels(self.series);
+        if panels.is_empty() {
+            panels.push((String::new(), Vec::new()));
+        }
+        let names: Vec<&str> = self.series.iter().map(|s| s.strategy.as_str()).collect();
+        for (p, (sequence, members)) in panels.iter().enumerate() {
+            let (col, row) = ((p % PANELS_PER_ROW) as i32, (p / PANELS_PER_ROW) as i32);
+            let x0 = 12 + col * panel_w;
+            let y0 = CONVERGENCE_HEADER_H + row * (PANEL_H + legend_h);
+            let (fw, fh) = root.dim_in_pixel();
+            let area = root.margin(y0, fh as i32 - y0 - PANEL_H, x0, fw as i32 - x0 - panel_w);
+            let caption = if sequence.is_empty() {
+                String::new()
+            } else {
+                format!("{sequence} samples")
+            };
+            let mut chart = ChartBuilder::on(&area)
+                .caption(caption, font(17.0).color(&TEXT))
+                .margin(6)
+                .margin_right(16)
+                .x_label_area_size(44)
+                .y_label_area_size(62)
+                .build_cartesian_2d(
+                    TickedAxis {
+                        range: x_range.clone(),
+                        bold: x_ticks.clone(),
+                        light: Vec::new(),
+                    },
+                    TickedAxis {
+                        range: y_range.clone(),
+                        bold: y_ticks.clone(),
+                        light: y_light.clone(),
+                    },
+                )?;
+            chart
+                .configure_mesh()
+                .x_desc("samples N")
+                .y_desc("RMSE")
+                .x_label_formatter(&|v| power_label(2, *v))
+                .y_label_formatter(&|v| power_label(10, *v))
+                .label_style(font(14.0).color(&TEXT))
+                .axis_desc_style(font(15.0).color(&TEXT))
+                .bold_line_style(GRID)
+                .light_line_style(LIGHT_GRID)
+                .draw()?;
+            if members.is_empty() {
+                let (pw, ph) = chart.plotting_area().dim_in_pixel();
+                let base = chart.plotting_area().get_base_pixel();
+                put_text(
+                    root,
+                    "no data",
+                    (base.0 + pw as i32 / 2, base.1 + ph as i32 / 2),
+                    18.0,
+                    DIM_TEXT,
+                    (HPos::Center, VPos::Center),
+                )?;
+                continue;
+            }
 
-        // Reference slope −1/2: log10 RMSE = c − ½ log10(2) log2 N, through
-        // the first plotted point of the first series.
-        let mut lines: Vec<Vec<(f64, f64)>> = Vec::new();
-        let mut labels: Vec<String> = Vec::new();
-        if let Some(&(ax, ay)) = logged.iter().find_map(|s| s.first()) {
-            let slope = -0.5 * std::f64::consts::LOG10_2;
-            let (xr, yr) = (xa - 0.3..xb + 0.3, ya - y_pad..yb + y_pad);
-            // Clip the line to the plotting range.
-            let x_at = |y: f64| ax + (y - ay) / slope;
-            let lo = xr.start.max(x_at(yr.end));
-            let hi = xr.end.min(x_at(yr.start));
-            if lo < hi {
-                let pts = vec![(lo, ay + slope * (lo - ax)), (hi, ay + slope * (hi - ax))];
-                let label = "reference: slope −1/2 (RMSE ∝ 1/√N)".to_string();
-                chart
-                    .draw_series(DashedLineSeries::new(
-                        pts.clone(),
+            // Slope −1/2 through the first plotted point of the panel,
+            // clipped to the plotting range.
+            if let Some(&(ax, ay)) = members.iter().find_map(|&k| logged[k].first()) {
+                let slope = -0.5 * std::f64::consts::LOG10_2;
+                let x_at = |y: f64| ax + (y - ay) / slope;
+                let lo = x_range.start.max(x_at(y_range.end));
+                let hi = x_range.end.min(x_at(y_range.start));
+                if lo < hi {
+                    chart.draw_series(DashedLineSeries::new(
+                        [(lo, ay + slope * (lo - ax)), (hi, ay + slope * (hi - ax))],
                         8,
                         6,
-                        RGBColor(110, 110, 110).stroke_width(2),
-                    ))?
-                    .label(label.clone())
-                    .legend(|(x, y)| {
-                        PathElement::new(
-                            vec![(x - 10, y), (x + 10, y)],
-                            RGBColor(110, 110, 110).stroke_width(2),
-                        )
-                    });
-                lines.push(pts);
-                labels.push(label);
-            }
-        }
-
-        for (k, (s, pts)) in self.series.iter().zip(&logged).enumerate() {
-            let color = PALETTE[k % PALETTE.len()];
-            let label = match (pts.is_empty(), s.slope) {
-                (true, _) => format!("{}: no point with RMSE > 0 (not shown)", s.label),
-                (false, Some(m)) if m.is_finite() => {
-                    format!(
-                        "{}  (slope {})",
-                        s.label,
-                        format!("{m:+.2}").replace('-', "−")
-                    )
+                        RGBColor(150, 150, 150).stroke_width(2),
+                    ))?;
                 }
-                (false, _) => s.label.clone(),
-            };
-            chart
-                .draw_series(LineSeries::new(pts.iter().copied(), color.stroke_width(2)))?
-                .label(label.clone())
-                .legend(move |at| {
-                    EmptyElement::at(at)
-                        + PathElement::new(vec![(-10, 0), (10, 0)], color.stroke_width(2))
-                        + Polygon::new(marker_shape(k), color.filled())
-                });
-            chart
-                .draw_series(pts.iter().map(|&p| {
-                    EmptyElement::at(p) + Polygon::new(marker_shape(k), color.filled())
+            }
+            for &k in members {
+                let color = strategy_color(&names, k);
+                styled_line(&mut chart, &logged[k], color, p)?;
+                chart.draw_series(logged[k].iter().map(|&pt| {
+                    EmptyElement::at(pt) + Polygon::new(marker_shape(p), color.filled())
                 }))?;
-            lines.push(pts.clone());
-            labels.push(label);
-        }
-
-        // The legend goes in the corner that hides the fewest points of the
-        // lines.
-        let legend_font = font(15.0).color(&TEXT);
-        let mut text_w = 0;
-        let mut text_h = 0;
-        for l in &labels {
-            let (tw, th) = root.estimate_text_size(l, &legend_font)?;
-            text_w = text_w.max(tw as i32);
-            text_h = text_h.max(th as i32);
-        }
-        let (box_w, box_h) = (
-            text_w + 30 + 24,
-            labels.len() as i32 * (text_h * 5 / 4 + 1) + 24,
-        );
-        let (pw, ph) = chart.plotting_area().dim_in_pixel();
-        let (pw, ph) = (pw as i32, ph as i32);
-        let base = chart.plotting_area().get_base_pixel();
-        let mut samples: Vec<(i32, i32)> = Vec::new();
-        for line in &lines {
-            let px: Vec<(i32, i32)> = line
-                .iter()
-                .map(|p| {
-                    let (x, y) = chart.backend_coord(p);
-                    (x - base.0, y - base.1)
-                })
-                .collect();
-            samples.extend(px.iter().copied());
-            for seg in px.windows(2) {
-                for t in 1..24 {
-                    let f = f64::from(t) / 24.0;
-                    let lerp = |a: i32, b: i32| a + (f * f64::from(b - a)).round() as i32;
-                    samples.push((lerp(seg[0].0, seg[1].0), lerp(seg[0].1, seg[1].1)));
-                }
             }
-        }
-        let inset = 10;
-        let corners = [
-            (pw - box_w - inset, inset),
-            (inset, ph - box_h - inset),
-            (inset, inset),
-            (pw - box_w - inset, ph - box_h - inset),
-        ];
-        let hidden = |&(x, y): &(i32, i32)| {
-            samples
-                .iter()
-                .filter(|&&(sx, sy)| {
-                    sx >= x - 6 && sx <= x + box_w + 6 && sy >= y - 6 && sy <= y + box_h + 6
-                })
-                .count()
-        };
-        let (lx, ly) = corners
-            .iter()
-            .copied()
-            .min_by_key(|c| hidden(c))
-            .unwrap_or(corners[0]);
 
-        if labels.is_empty() {
-            let (cx, cy) = (base.0 + pw / 2, base.1 + ph / 2);
-            put_text(
-                root,
-                "no data",
-                (cx, cy),
-                18.0,
-                DIM_TEXT,
-                (HPos::Center, VPos::Center),
-            )?;
-        } else {
-            chart
-                .configure_series_labels()
-                .position(SeriesLabelPosition::Coordinate(lx, ly))
-                .margin(12)
-                .legend_area_size(30)
-                .label_font(legend_font)
-                .background_style(WHITE.mix(0.9))
-                .border_style(GRID)
-                .draw()?;
+            // The legend under the panel, outside the plotting area.
+            let base = chart.plotting_area().get_base_pixel();
+            let lx = base.0 + 4;
+            let mut ly = y0 + PANEL_H + 4;
+            for &k in members {
+                let s = &self.series[k];
+                let color = strategy_color(&names, k);
+                let cy = ly + ENTRY_H / 2;
+                let seg = [(lx, cy), (lx + 30, cy)];
+                match dash(p) {
+                    None => root.draw(&PathElement::new(seg.to_vec(), color.stroke_width(2)))?,
+                    Some((size, gap)) => {
+                        let mut x = lx;
+                        while x < lx + 30 {
+                            let x1 = (x + size as i32).min(lx + 30);
+                            root.draw(&PathElement::new(
+                                vec![(x, cy), (x1, cy)],
+                                color.stroke_width(2),
+                            ))?;
+                            x = x1 + gap as i32;
+                        }
+                    }
+                }
+                root.draw(
+                    &(EmptyElement::at((lx + 15, cy))
+                        + Polygon::new(marker_shape(p), color.filled())),
+                )?;
+                let text = match (logged[k].is_empty(), s.slope) {
+                    (true, _) if s.points.iter().all(|p| p.1 == 0.0) => {
+                        format!("{}: RMSE 0 (exact), not shown", s.strategy)
+                    }
+                    (true, _) => format!("{}: no point with RMSE > 0, not shown", s.strategy),
+                    (false, Some(m)) if m.is_finite() => format!(
+                        "{}   slope {}",
+                        s.strategy,
+                        format!("{m:+.2}").replace('-', "−")
+                    ),
+                    (false, _) => s.strategy.clone(),
+                };
+                put_text(
+                    root,
+                    &text,
+                    (lx + 40, cy),
+                    15.0,
+                    TEXT,
+                    (HPos::Left, VPos::Center),
+                )?;
+                ly += ENTRY_H;
+            }
         }
         Ok(())
     }
+}
+
+/// The names whose colour is fixed, so that a strategy has the same colour
+/// in every figure.
+const STRATEGY_ORDER: [&str; 11] = [
+    "uniform",
+    "cosine",
+    "brdf",
+    "vndf",
+    "spherical-caps",
+    "bounded-vndf",
+    "light",
+    "mis",
+    "mis-power",
+    "mis-one",
+    "mis-power-one",
+];
+
+/// Twelve colours that stay apart: Okabe–Ito's seven (yellow left out),
+/// then purple, brown, crimson, olive and indigo.
+const STRATEGY_PALETTE: [RGBColor; 12] = [
+    RGBColor(0, 114, 178),
+    RGBColor(213, 94, 0),
+    RGBColor(0, 158, 115),
+    RGBColor(204, 121, 167),
+    RGBColor(230, 159, 0),
+    RGBColor(86, 180, 233),
+    RGBColor(0, 0, 0),
+    RGBColor(117, 60, 160),
+    RGBColor(140, 86, 40),
+    RGBColor(170, 30, 60),
+    RGBColor(110, 130, 0),
+    RGBColor(50, 50, 140),
+];
+
+/// The colour of the strategy `names[k]`: fixed for the known names, else
+/// the next colour after them in order of first appearance.
+fn strategy_color(names: &[&str], k: usize) -> RGBColor {
+    let name = names[k];
+    if let Some(i) = STRATEGY_ORDER.iter().position(|n| *n == name) {
+        return STRATEGY_PALETTE[i];
+    }
+    let mut unknown: Vec<&str> = Vec::new();
+    for n in names {
+        if !STRATEGY_ORDER.contains(n) && !unknown.contains(n) {
+            unknown.push(n);
+        }
+    }
+    let i = unknown.iter().position(|n| *n == name).unwrap_or(0);
+    STRATEGY_PALETTE[(STRATEGY_ORDER.len() + i) % STRATEGY_PALETTE.len()]
 }
 
 // ---------------------------------------------------------------------------
@@ -803,37 +966,54 @@ impl Figure for Convergence<'_> {
 
 struct Polar<'a> {
     title: &'a str,
-    curves: &'a [(String, Vec<(f64, f64)>)],
+    curves: &'a PolarCurves,
     scale: PolarScale,
 }
+
+/// Columns of the legend above a polar plot, and the height of a row.
+const POLAR_LEGEND_COLS: usize = 3;
+const POLAR_LEGEND_ROW_H: i32 = 22;
 
 impl Figure for Polar<'_> {
     fn size(&self) -> (u32, u32) {
         POLAR_SIZE
     }
 
+    #[allow(clippy::too_many_lines)]
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DResult<DB> {
         use std::f64::consts::FRAC_PI_2;
         root.fill(&WHITE)?;
-        let clean = |v: f64| if v.is_finite() && v > 0.0 { v } else { 0.0 };
-        let maxima: Vec<f64> = self
-            .curves
-            .iter()
-            .map(|(_, c)| c.iter().map(|&(_, v)| clean(v)).fold(0.0, f64::max))
-            .collect();
-        let max = maxima.iter().copied().fold(0.0, f64::max);
-        let inv = |m: f64| if m > 0.0 { 1.0 / m } else { 0.0 };
+        let curves = self.curves.all();
+        let max = curves.iter().map(|c| c.max()).fold(0.0, f64::max);
+        let radius = |v: f64| -> f64 {
+            if !(v.is_finite() && v > 0.0 && max > 0.0) {
+                return 0.0;
+            }
+            match self.scale {
+                PolarScale::Linear => v / max,
+                PolarScale::Log => (1.0 + (v / max).log10() / POLAR_DECADES).max(0.0),
+            }
+        };
+        // The value on ring r.
+        let ring_value = |r: f64| match self.scale {
+            PolarScale::Linear => r * max,
+            PolarScale::Log => max * 10f64.powf((r - 1.0) * POLAR_DECADES),
+        };
 
         let title_h = draw_title(root, self.title, 20.0)?;
         let (w, h) = root.dim_in_pixel();
         let caption = match self.scale {
-            PolarScale::Global => format!(
-                "radius = value / maximum over all curves ({}); θi from the normal, negative on the viewer's side",
-                fmt_num(max)
+            PolarScale::Linear => format!(
+                "radius ∝ value in 1/sr, one scale for all curves (outer ring {}); albedo {}",
+                fmt_num(max),
+                fmt_num(self.curves.albedo)
             ),
-            PolarScale::PerCurve => "radius = value / that curve's maximum (in the legend); \
-                 θi from the normal, negative on the viewer's side"
-                .to_string(),
+            PolarScale::Log => format!(
+                "radius = log of the value in 1/sr, one scale for all curves: {} decades, outer ring {}; albedo {}",
+                POLAR_DECADES,
+                fmt_num(max),
+                fmt_num(self.curves.albedo)
+            ),
         };
         let csize = fit_size(root, &caption, 14.0, w.saturating_sub(30))?;
         put_text(
@@ -845,12 +1025,15 @@ impl Figure for Polar<'_> {
             (HPos::Center, VPos::Bottom),
         )?;
 
-        // Equal scale in x and y: fit [−1.25, 1.25] × [−0.12, 1.12].
-        let area = root.margin(title_h, 30, 10, 10);
+        // Equal scale in x and y: fit [−1.14, 1.14] × [−0.12, 1.1] under
+        // the legend, centred.
+        let legend_rows = curves.len().div_ceil(POLAR_LEGEND_COLS) as i32;
+        let legend_h = legend_rows * POLAR_LEGEND_ROW_H + 8;
+        let area = root.margin(title_h + legend_h, 30, 6, 6);
         let (aw, ah) = area.dim_in_pixel();
-        let s = (f64::from(aw) / 2.5).min(f64::from(ah) / 1.24);
+        let s = (f64::from(aw) / 2.28).min(f64::from(ah) / 1.22);
         let half_w = f64::from(aw) / (2.0 * s);
-        let y_lo = -0.12;
+        let y_lo = -0.12 - 0.5 * (f64::from(ah) / s - 1.22);
         let y_hi = y_lo + f64::from(ah) / s;
         let mut chart = ChartBuilder::on(&area).build_cartesian_2d(-half_w..half_w, y_lo..y_hi)?;
 
@@ -866,11 +1049,13 @@ impl Figure for Polar<'_> {
                 GRID
             };
             chart.draw_series(LineSeries::new(ring, color.stroke_width(1)))?;
-            chart.draw_series(std::iter::once(Text::new(
-                fmt_num(r),
-                (-r + 0.012, 0.012),
-                text_style(12.0, DIM_TEXT, HPos::Left, VPos::Bottom),
-            )))?;
+            if max > 0.0 {
+                chart.draw_series(std::iter::once(Text::new(
+                    fmt_num(ring_value(r)),
+                    (-r + 0.012, 0.012),
+                    text_style(11.0, DIM_TEXT, HPos::Left, VPos::Bottom),
+                )))?;
+            }
         }
         for deg in (-75..=75).step_by(15) {
             let t = f64::from(deg).to_radians();
@@ -899,7 +1084,7 @@ impl Figure for Polar<'_> {
         }
         // The surface, and which side is which.
         chart.draw_series(LineSeries::new(
-            [(-1.2, 0.0), (1.2, 0.0)],
+            [(-1.12, 0.0), (1.12, 0.0)],
             BLACK.stroke_width(2),
         ))?;
         chart.draw_series([
@@ -914,35 +1099,78 @@ impl Figure for Polar<'_> {
                 text_style(13.0, DIM_TEXT, HPos::Center, VPos::Top),
             ),
         ])?;
+        // The ray toward the viewer.
+        let theta_o = self.curves.wo.z.clamp(-1.0, 1.0).acos();
+        let view = polar(-theta_o, 1.0);
+        chart.draw_series(DashedLineSeries::new(
+            [(0.0, 0.0), view],
+            6,
+            4,
+            RGBColor(90, 90, 90).stroke_width(1),
+        ))?;
+        let (vx, vy) = polar(-theta_o, 0.62);
+        chart.draw_series(std::iter::once(Text::new(
+            "wo",
+            (vx + 0.02, vy),
+            text_style(13.0, DIM_TEXT, HPos::Left, VPos::Center),
+        )))?;
 
-        for (k, (label, pts)) in self.curves.iter().enumerate() {
-            let color = PALETTE[k % PALETTE.len()];
-            let scale = match self.scale {
-                PolarScale::Global => inv(max),
-                PolarScale::PerCurve => inv(maxima[k]),
-            };
-            let xy: Vec<(f64, f64)> = pts
+        let names: Vec<String> = curves
+            .iter()
+            .map(|c| match c.kind {
+                CurveKind::Integrand => String::new(),
+                CurveKind::Pdf(s) => s.name().to_string(),
+            })
+            .collect();
+        let name_refs: Vec<&str> = names.iter().map(String::as_str).collect();
+        let style = |k: usize| -> (RGBColor, u32) {
+            match curves[k].kind {
+                CurveKind::Integrand => (RGBColor(40, 40, 40), 4),
+                CurveKind::Pdf(_) => (strategy_color(&name_refs, k), 2),
+            }
+        };
+        // The integrand first (underneath), its area lightly filled.
+        for (k, c) in curves.iter().enumerate() {
+            let (color, width) = style(k);
+            let xy: Vec<(f64, f64)> = c
+                .points
                 .iter()
                 .filter(|(t, _)| t.is_finite())
-                .map(|&(t, v)| polar(t.clamp(-FRAC_PI_2, FRAC_PI_2), clean(v) * scale))
+                .map(|&(t, v)| polar(t.clamp(-FRAC_PI_2, FRAC_PI_2), radius(v)))
                 .collect();
-            chart
-                .draw_series(LineSeries::new(xy, color.stroke_width(2)))?
-                .label(format!("{label} (max {})", fmt_num(maxima[k])))
-                .legend(move |(x, y)| {
-                    PathElement::new(vec![(x - 10, y), (x + 10, y)], color.stroke_width(3))
-                });
+            if c.kind == CurveKind::Integrand {
+                chart.draw_series(std::iter::once(Polygon::new(
+                    xy.clone(),
+                    RGBColor(40, 40, 40).mix(0.08).filled(),
+                )))?;
+            }
+            chart.draw_series(LineSeries::new(xy, color.stroke_width(width)))?;
         }
-        if !self.curves.is_empty() {
-            chart
-                .configure_series_labels()
-                .position(SeriesLabelPosition::UpperLeft)
-                .margin(6)
-                .legend_area_size(28)
-                .label_font(font(14.0).color(&TEXT))
-                .background_style(WHITE.mix(0.9))
-                .border_style(GRID)
-                .draw()?;
+
+        // The legend, above the plot in columns.
+        let col_w = (w as i32 - 24) / POLAR_LEGEND_COLS as i32;
+        for (k, c) in curves.iter().enumerate() {
+            let (color, width) = style(k);
+            let lx = 12 + (k % POLAR_LEGEND_COLS) as i32 * col_w;
+            let ly = title_h + 6 + (k / POLAR_LEGEND_COLS) as i32 * POLAR_LEGEND_ROW_H;
+            root.draw(&PathElement::new(
+                vec![(lx, ly), (lx + 26, ly)],
+                color.stroke_width(width),
+            ))?;
+            let label = match c.kind {
+                CurveKind::Integrand => "f·cos θi ÷ albedo".to_string(),
+                CurveKind::Pdf(s) => format!("pdf {s}"),
+            };
+            let text = format!("{label} (max {})", fmt_num(c.max()));
+            let size = fit_size(root, &text, 14.0, (col_w - 40) as u32)?;
+            put_text(
+                root,
+                &text,
+                (lx + 34, ly),
+                size,
+                TEXT,
+                (HPos::Left, VPos::Center),
+            )?;
         }
         Ok(())
     }
@@ -1424,27 +1652,32 @@ mod tests {
         };
         let series = vec![
             Series {
-                label: "uniform".into(),
+                strategy: "uniform".into(),
+                sequence: "independent".into(),
                 points: curve(3.0, -0.5),
                 slope: Some(-0.49),
             },
             Series {
-                label: "brdf".into(),
+                strategy: "brdf".into(),
+                sequence: "independent".into(),
                 points: curve(0.4, -0.5),
                 slope: Some(-0.51),
             },
             Series {
-                label: "vndf".into(),
+                strategy: "vndf".into(),
+                sequence: "independent".into(),
                 points: curve(0.2, -0.5),
                 slope: Some(-0.50),
             },
             Series {
-                label: "heavy tail".into(),
+                strategy: "heavy tail".into(),
+                sequence: "independent".into(),
                 points: curve(1.0, -0.3),
                 slope: Some(-0.31),
             },
             Series {
-                label: "cosine".into(),
+                strategy: "cosine".into(),
+                sequence: "independent".into(),
                 points: vec![(16.0, 0.0), (1024.0, 0.0)],
                 slope: None,
             },
@@ -1461,7 +1694,38 @@ mod tests {
             &(),
         );
         let (o, e) = (h.observed, h.expected);
-        let curves = vec![("a".to_string(), vec![(-1.0, 1.0), (0.0, 2.0), (1.0, 1.0)])];
+        let polar = lobe::experiment::polar::curves(
+            &m,
+            wo,
+            &[BsdfStrategy::Cosine, BsdfStrategy::Uniform],
+            90,
+        )
+        .unwrap();
+        // Many curves: nine strategies × three sequences.
+        let mut many = Vec::new();
+        for (q, sequence) in ["independent", "stratified", "sobol"].iter().enumerate() {
+            for (k, strategy) in [
+                "uniform",
+                "cosine",
+                "brdf",
+                "vndf",
+                "spherical-caps",
+                "bounded-vndf",
+                "light",
+                "mis",
+                "mis-power",
+            ]
+            .iter()
+            .enumerate()
+            {
+                many.push(Series {
+                    strategy: (*strategy).into(),
+                    sequence: (*sequence).into(),
+                    points: curve(0.2 + 0.3 * k as f64, -0.5 - 0.25 * q as f64),
+                    slope: Some(-0.5 - 0.25 * q as f64),
+                });
+            }
+        }
         for ext in ["png", "svg"] {
             let p = |name: &str| dir.join(format!("{name}.{ext}"));
             convergence_plot(
@@ -1471,13 +1735,17 @@ mod tests {
             )
             .unwrap();
             convergence_plot(&p("convergence-empty"), "no data", &[]).unwrap();
-            polar_plot(&p("polar"), "polar", &curves).unwrap();
+            convergence_plot(&p("convergence-many"), "27 curves", &many).unwrap();
+            polar_plot(&p("polar"), "polar", &polar, PolarScale::Linear).unwrap();
+            polar_plot(&p("polar-log"), "polar, log", &polar, PolarScale::Log).unwrap();
             warp_histogram(&p("histogram"), "cosine", &o, &e, 16, 0.5).unwrap();
             weight_heatmap(&p("weights"), "weights", &m, BsdfStrategy::Uniform, wo, 16).unwrap();
             for name in [
                 "convergence",
                 "convergence-empty",
+                "convergence-many",
                 "polar",
+                "polar-log",
                 "histogram",
                 "weights",
             ] {

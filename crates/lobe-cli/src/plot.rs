@@ -1,7 +1,10 @@
 //! `lobe plot`: pictures of a material and a sampling strategy.
 //!
-//! * `polar`: `f_r` (no cosine) in the plane of incidence for the view
-//!   angles 0, 30, 60 and 80°.
+//! * `polar`: in the plane of incidence at the chosen view, the integrand
+//!   `f·cos θi / albedo` (cosine included; the pdf of a zero-variance
+//!   sampler) and the pdf of the chosen strategy (or of every strategy) on
+//!   the same axes, linear or log radius
+//!   ([`lobe::experiment::polar`] computes the curves).
 //! * `histogram`: Nori's warp test, observed against expected sample counts
 //!   over the projected hemisphere, with the p-value of the chi-square test
 //!   of `lobe::stats::chi2`.
@@ -16,7 +19,6 @@ use anyhow::{Context, Result, anyhow, bail};
 use clap::Args;
 use glam::DVec3;
 use lobe::experiment::histogram::projected_histograms;
-use lobe::math::luminance;
 use lobe::stats::chi2::{Chi2Config, chi2_test};
 use lobe::{BsdfStrategy, Material};
 use std::path::{Path, PathBuf};
@@ -26,16 +28,14 @@ use std::time::Duration;
 /// Largest accepted `--res`.
 const MAX_RES: usize = 1024;
 
-/// View angles (degrees) of the polar plot.
-const POLAR_VIEWS: [f64; 4] = [0.0, 30.0, 60.0, 80.0];
-
 /// The arguments of `lobe plot`.
 #[derive(Args, Debug)]
 #[command(
     about = "Draw figures of a material and a sampling strategy (PNG)",
     long_about = "Draw figures of a material and a sampling strategy as PNG files in --out:\n  \
-        polar      f_r (no cosine) in the plane of incidence at view angles 0, 30, 60, 80°\n             \
-        (ignores --theta/--wo and --strategy)                 -> polar.png\n  \
+        polar      in the plane of incidence at --theta/--wo: f·cos θi / albedo (the ideal\n             \
+        pdf) against the pdf of --strategy (without it, of every strategy) on the\n             \
+        same axes; --scale linear or log radius               -> polar.png\n  \
         histogram  the warp test: observed against expected sample counts over the\n             \
         projected hemisphere, with the chi-square p-value     -> histogram-<STRATEGY>.png\n  \
         weights    the sample weight f·cos θi/pdf over the projected hemisphere,\n             \
@@ -53,7 +53,7 @@ pub struct PlotArgs {
     pub material: String,
     #[command(flatten)]
     pub view: ViewArgs,
-    /// Sampling strategy: uniform, cosine, brdf, vndf, spherical-caps, bounded-vndf (not used by polar)
+    /// Sampling strategy: uniform, cosine, brdf, vndf, spherical-caps, bounded-vndf (polar: the pdf drawn against f·cos; all of them when not given)
     #[arg(long, short)]
     pub strategy: Option<String>,
     /// What to draw: polar, histogram, weights or all
@@ -75,6 +75,10 @@ pub struct PlotArgs {
     /// No progress bars
     #[arg(long, short)]
     pub quiet: bool,
+    /// Radius of the polar plot: linear, or log (four decades below the
+    /// largest value), one scale for every curve
+    #[arg(long, default_value = "linear")]
+    pub scale: String,
 }
 
 #[derive(Clone, Copy, PartialEq, Eq)]
@@ -93,6 +97,10 @@ pub fn run(args: &PlotArgs) -> Result<()> {
         "all" => vec![Kind::Polar, Kind::Histogram, Kind::Weights],
         k => bail!("--kind {k}: unknown kind, expected polar, histogram, weights or all"),
     };
+    let scale: figures::PolarScale = args
+        .scale
+        .parse()
+        .map_err(|e| anyhow!("--scale {}: {e}", args.scale))?;
     let material = load_material(&args.material)?;
     let wo = args.view.wo()?;
     let needs_strategy = kinds.iter().any(|&k| k != Kind::Polar);
@@ -104,11 +112,9 @@ pub fn run(args: &PlotArgs) -> Result<()> {
                     BsdfStrategy::names()
                 )
             })?;
-            if needs_strategy {
-                material
-                    .check(s)
-                    .map_err(|e| anyhow!("--strategy {s}: {e}"))?;
-            }
+            material
+                .check(s)
+                .map_err(|e| anyhow!("--strategy {s}: {e}"))?;
             Some(s)
         }
         (None, true) => bail!(
@@ -134,10 +140,22 @@ pub fn run(args: &PlotArgs) -> Result<()> {
         match kind {
             Kind::Polar => {
                 let path = args.out.join("polar.png");
-                let curves = polar_curves(&material);
-                let title =
-                    format!("{label}: f_r (no cosine, luminance) in the plane of incidence");
-                figures::polar_plot_scaled(&path, &title, &curves, figures::PolarScale::PerCurve)?;
+                let strategies = strategy.map_or_else(
+                    || lobe::experiment::polar::default_strategies(&material),
+                    |s| vec![s],
+                );
+                let curves = lobe::experiment::polar::curves(
+                    &material,
+                    wo,
+                    &strategies,
+                    lobe::experiment::polar::DEFAULT_STEPS,
+                )?;
+                let what = match strategy {
+                    Some(s) => format!("the pdf of {s}"),
+                    None => "each strategy's pdf".to_string(),
+                };
+                let title = format!("{label}, {view}: f·cos θi ÷ albedo against {what}");
+                figures::polar_plot(&path, &title, &curves, scale)?;
                 println!("{}", path.display());
             }
             Kind::Histogram => {
@@ -225,27 +243,6 @@ fn view_label(args: &PlotArgs, wo: DVec3) -> String {
     } else {
         format!("θo = {}°", args.view.theta.unwrap_or(30.0))
     }
-}
-
-/// `f_r` luminance in the plane of incidence, θi in (−90°, 90°) with
-/// negative angles on the viewer's side, for each view angle of
-/// [`POLAR_VIEWS`].
-fn polar_curves(m: &Material) -> Vec<(String, Vec<(f64, f64)>)> {
-    POLAR_VIEWS
-        .iter()
-        .map(|&deg| {
-            let wo = lobe::frame::wo_from_theta(deg, 0.0);
-            let pts = (-359..=359)
-                .map(|k| {
-                    let ti = (f64::from(k) * 0.25).to_radians();
-                    // The viewer is on +x, so negative θi means wi.x > 0.
-                    let wi = DVec3::new(-ti.sin(), 0.0, ti.cos());
-                    (ti, luminance(m.eval(wo, wi)))
-                })
-                .collect();
-            (format!("θo = {deg}°"), pts)
-        })
-        .collect()
 }
 
 /// The warp-test figure: histograms, the chi-square test, its summary on

@@ -20,18 +20,17 @@ use crate::converge;
 use crate::figures::{self, PolarScale};
 use anyhow::{Context, Result, anyhow};
 use clap::Args;
-use glam::{DVec2, DVec3};
+use glam::DVec3;
 use lobe::estimator::Strategy;
 use lobe::experiment::converge::{Curve, CurveSettings, curves};
-use lobe::experiment::histogram::projected_histograms;
+use lobe::experiment::histogram::{lost_fraction, projected_histograms};
+use lobe::experiment::polar;
 use lobe::experiment::table::{Row, Table, TableSettings, run_table};
 use lobe::math::luminance;
 use lobe::progress::SystemClock;
 use lobe::sequence::{Sequence, hash64};
 use lobe::stats::chi2::{Chi2Config, chi2_test};
 use lobe::{BsdfStrategy, Light, Material, MaterialDesc, Rgb};
-use rand::{RngExt, SeedableRng};
-use rand_pcg::Pcg64;
 use rayon::prelude::*;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -468,7 +467,11 @@ fn run_job(
                 &(),
             )?;
             let file = format!("{}-convergence.png", model.id);
-            let title = format!("{}: RMSE of {} runs", caption(model), st.runs);
+            let title = format!(
+                "{}, light: white furnace: RMSE of {} runs",
+                caption(model),
+                st.runs
+            );
             figures::convergence_plot(&dir.join(&file), &title, &converge::plot_series(&curves))
                 .with_context(|| format!("cannot write {file}"))?;
             Ok(Done::Convergence(
@@ -485,13 +488,9 @@ fn run_job(
             let m = &materials[i][k];
             let file = format!("{}-polar.png", model.id);
             let title = format!("{}: integrand and sampling densities", caption(model));
-            figures::polar_plot_scaled(
-                &dir.join(&file),
-                &title,
-                &polar_curves(m, wo),
-                PolarScale::PerCurve,
-            )
-            .with_context(|| format!("cannot write {file}"))?;
+            let curves = polar::curves(m, wo, &polar::default_strategies(m), polar::DEFAULT_STEPS)?;
+            figures::polar_plot(&dir.join(&file), &title, &curves, PolarScale::Log)
+                .with_context(|| format!("cannot write {file}"))?;
             Ok(Done::Polar(Figure {
                 file,
                 alt: format!("Polar plot: {title}"),
@@ -573,9 +572,13 @@ fn run_job(
                         .strategies
                         .iter()
                         .map(|row| {
-                            row.name.parse::<BsdfStrategy>().map_or(f64::NAN, |s| {
-                                lost_fraction(m, s, view(*theta), st.lost_samples, seed)
-                            })
+                            row.name
+                                .parse::<BsdfStrategy>()
+                                .ok()
+                                .and_then(|s| {
+                                    lost_fraction(m, s, view(*theta), st.lost_samples, seed).ok()
+                                })
+                                .unwrap_or(f64::NAN)
                         })
                         .collect()
                 })
@@ -604,68 +607,6 @@ fn convergence_series(m: &Material) -> Vec<(Strategy, Sequence)> {
         v.push((BsdfStrategy::BoundedVndf.into(), Sequence::Independent));
     }
     v
-}
-
-/// The strategies of the polar plot.
-fn polar_strategies(m: &Material) -> Vec<BsdfStrategy> {
-    [
-        BsdfStrategy::Uniform,
-        BsdfStrategy::Cosine,
-        BsdfStrategy::Brdf,
-        BsdfStrategy::Vndf,
-        BsdfStrategy::BoundedVndf,
-    ]
-    .into_iter()
-    .filter(|&s| m.check(s).is_ok())
-    .collect()
-}
-
-/// The integrand `f cos θi` divided by its integral (the ideal density) and
-/// the pdf of each strategy, in the plane of incidence: `θi < 0` on the
-/// viewer's side, `wi = (−sin θi, 0, cos θi)`.
-fn polar_curves(m: &Material, wo: DVec3) -> Vec<(String, Vec<(f64, f64)>)> {
-    let steps = 720;
-    let angles: Vec<f64> = (0..=steps)
-        .map(|i| (-90.0 + 180.0 * i as f64 / steps as f64).to_radians())
-        .collect();
-    let dir = |t: f64| DVec3::new(-t.sin(), 0.0, t.cos()).normalize();
-    let albedo = luminance(lobe::estimator::reference(
-        m,
-        &lobe::estimator::ShadingPoint::local(wo),
-        &Light::Constant(Rgb::ONE),
-        1e-6,
-    ));
-    let mut curves = vec![(
-        "f·cos θi ÷ albedo (the ideal pdf)".to_string(),
-        angles
-            .iter()
-            .map(|&t| {
-                let wi = dir(t);
-                (t, luminance(m.eval(wo, wi)) * wi.z.max(0.0) / albedo)
-            })
-            .collect(),
-    )];
-    for s in polar_strategies(m) {
-        curves.push((
-            format!("pdf {}", s.name()),
-            angles.iter().map(|&t| (t, m.pdf(s, wo, dir(t)))).collect(),
-        ));
-    }
-    curves
-}
-
-/// Fraction of samples lost (below the horizon) by `s` at `wo`.
-fn lost_fraction(m: &Material, s: BsdfStrategy, wo: DVec3, samples: usize, seed: u64) -> f64 {
-    let mut rng = Pcg64::seed_from_u64(hash64(seed ^ 0x6c6f_7374));
-    let mut lost = 0usize;
-    for _ in 0..samples {
-        let uc: f64 = rng.random();
-        let u = DVec2::new(rng.random(), rng.random());
-        if m.sample(s, wo, uc, u).is_none() {
-            lost += 1;
-        }
-    }
-    lost as f64 / samples.max(1) as f64
 }
 
 // ---------------------------------------------------------------------------
@@ -1101,7 +1042,8 @@ fn section(h: &mut String, model: &Model, r: &ModelResult, st: &ReportSizes) {
         &r.polar,
         "<b>Shapes in the plane of incidence.</b> The integrand f<sub>r</sub>·cos&thinsp;θ<sub>i</sub> \
          divided by its integral (the ideal density, which would give zero variance) and the density \
-         of each strategy, each scaled to its own peak (the legend gives the peaks, in 1/sr). The \
+         of each strategy, all in 1/sr on one logarithmic radial scale (four decades below the largest \
+         value; the legend gives each curve's peak), so that the curves compare directly. The \
          viewer is on the left, the mirror direction on the right. A good sampler has the shape of \
          the integrand: where its density is much lower than the integrand, the rare samples that \
          land there carry huge weights — the fireflies of a render. Uniform and cosine sampling \

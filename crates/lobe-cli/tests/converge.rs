@@ -223,3 +223,59 @@ fn help_has_an_example() {
     assert!(help.contains("lobe converge --material"), "{help}");
     assert!(help.contains("--max-exp"), "{help}");
 }
+
+/// Many curves: one panel per sequence side by side, the light in the
+/// title, every strategy in the legends.
+#[test]
+fn many_curves_get_a_panel_per_sequence() {
+    let dir = scratch("many");
+    let prefix = dir.join("ggx");
+    let out = lobe(
+        &[
+            "converge",
+            "-m",
+            r#"{"type":"cook-torrance","alpha":0.2}"#,
+            "--theta",
+            "45",
+            "--light",
+            "beam:8",
+            "--runs",
+            "2",
+            "--max-exp",
+            "4",
+            "--out",
+            prefix.to_str().unwrap(),
+            "--quiet",
+        ],
+        None,
+    );
+    assert_ok(&out);
+    let csv = std::fs::read_to_string(dir.join("ggx.csv")).unwrap();
+    let series: std::collections::BTreeSet<(String, String)> = csv
+        .lines()
+        .skip(1)
+        .map(|l| {
+            let f: Vec<&str> = l.split(',').collect();
+            (f[0].to_string(), f[1].to_string())
+        })
+        .collect();
+    assert!(series.len() >= 20, "{} series", series.len());
+    let img = image::open(dir.join("ggx.png")).unwrap();
+    assert!(
+        img.width() >= 1200 && img.width() > img.height(),
+        "three panels side by side: {}×{}",
+        img.width(),
+        img.height()
+    );
+    let svg = std::fs::read_to_string(dir.join("ggx.svg")).unwrap();
+    for text in [
+        "light beam:8",
+        "independent samples",
+        "stratified samples",
+        "sobol samples",
+        "bounded-vndf",
+        "mis-power",
+    ] {
+        assert!(svg.contains(text), "{text:?} is not in the SVG");
+    }
+}

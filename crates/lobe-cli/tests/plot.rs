@@ -197,3 +197,86 @@ fn help_shows_an_example() {
     let help = String::from_utf8_lossy(&out.stdout);
     assert!(help.contains("Examples:") && help.contains("lobe plot --material"));
 }
+
+/// Runs `lobe plot --kind polar` with `extra` into `dir` and returns the
+/// PNG's bytes, after checking it.
+fn polar(dir: &Path, extra: &[&str]) -> Vec<u8> {
+    let mut args = vec![
+        "plot",
+        "--material",
+        r#"{"type":"cook-torrance","alpha":0.2,"kd":0.3}"#,
+        "--kind",
+        "polar",
+        "--out",
+        dir.to_str().unwrap(),
+        "-q",
+    ];
+    args.extend_from_slice(extra);
+    let out = lobe(&args);
+    assert!(
+        out.status.success(),
+        "{extra:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let path = dir.join("polar.png");
+    assert_eq!(stdout_lines(&out), [path.display().to_string()]);
+    check_png(&path, (800, 500));
+    std::fs::read(&path).unwrap()
+}
+
+#[test]
+fn polar_honours_theta_strategy_and_scale() {
+    let dir = fresh_dir("plot-polar");
+    let base = polar(&dir, &["--theta", "30", "--strategy", "vndf"]);
+    let other_view = polar(&dir, &["--theta", "70", "--strategy", "vndf"]);
+    let other_strategy = polar(&dir, &["--theta", "30", "--strategy", "uniform"]);
+    let every_strategy = polar(&dir, &["--theta", "30"]);
+    let log = polar(
+        &dir,
+        &["--theta", "30", "--strategy", "vndf", "--scale", "log"],
+    );
+    let linear = polar(
+        &dir,
+        &["--theta", "30", "--strategy", "vndf", "--scale", "linear"],
+    );
+    assert_eq!(linear, base, "linear is the default scale");
+    for (what, png) in [
+        ("--theta", &other_view),
+        ("--strategy", &other_strategy),
+        ("no --strategy", &every_strategy),
+        ("--scale log", &log),
+    ] {
+        assert_ne!(png, &base, "{what} changes the figure");
+    }
+    // An explicit view in another plane of incidence.
+    polar(&dir, &["--wo", "0.3,0.4,0.866", "--strategy", "brdf"]);
+}
+
+#[test]
+fn polar_refuses_a_bad_scale_or_strategy() {
+    let dir = fresh_dir("plot-polar-bad");
+    let d = dir.to_str().unwrap();
+    for (extra, needle) in [
+        (vec!["--scale", "cubic"], "--scale cubic: unknown scale"),
+        (
+            vec!["--strategy", "vndf", "--material", PHONG],
+            "does not apply",
+        ),
+        (vec!["--strategy", "bogus"], "--strategy"),
+    ] {
+        let mut full: Vec<&str> = vec!["plot", "-q", "--kind", "polar", "--out", d];
+        full.extend(&extra);
+        if !extra.contains(&"--material") {
+            full.extend(["--material", GGX]);
+        }
+        let out = lobe(&full);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{full:?}: {err}");
+        assert_eq!(err.trim_end().lines().count(), 1, "{full:?}: {err}");
+        assert!(
+            err.starts_with("lobe: error:") && err.contains(needle),
+            "{full:?}: {err}"
+        );
+    }
+    assert!(!dir.join("polar.png").exists());
+}

@@ -230,6 +230,30 @@ pub fn weight_pixels(
     })
 }
 
+/// The fraction of `samples` draws of `strategy` at `wo` that fail (a
+/// direction below the horizon, which an estimator counts with weight
+/// zero), from independent uniform numbers seeded by `seed`. Zero when
+/// `samples` is zero. The error says why the strategy does not apply.
+pub fn lost_fraction(
+    m: &Material,
+    strategy: BsdfStrategy,
+    wo: DVec3,
+    samples: usize,
+    seed: u64,
+) -> Result<f64, crate::Error> {
+    let sampler = m.sampler(strategy)?;
+    let mut rng = Pcg64::seed_from_u64(crate::sequence::hash64(seed ^ 0x6c6f_7374));
+    let mut lost = 0usize;
+    for _ in 0..samples {
+        let uc: f64 = rng.random();
+        let u = DVec2::new(rng.random(), rng.random());
+        if sampler.sample(wo, uc, u).is_none() {
+            lost += 1;
+        }
+    }
+    Ok(lost as f64 / samples.max(1) as f64)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -285,6 +309,35 @@ mod tests {
             }
             assert!((2.0 * total - 4.0 * PI).abs() < 1e-6, "res {res}: {total}");
         }
+    }
+
+    #[test]
+    fn lost_samples() {
+        let wo = crate::frame::wo_from_theta(80.0, 0.0);
+        let m = lambert();
+        assert_eq!(
+            lost_fraction(&m, BsdfStrategy::Cosine, wo, 1000, 1),
+            Ok(0.0)
+        );
+        assert_eq!(lost_fraction(&m, BsdfStrategy::Uniform, wo, 0, 1), Ok(0.0));
+        assert!(lost_fraction(&m, BsdfStrategy::Vndf, wo, 10, 1).is_err());
+        // Phong's lobe about the mirror direction of a grazing view: about
+        // half of it is below the horizon.
+        let phong = Material::with_diffuse(
+            Rgb::ZERO,
+            crate::Glossy::Phong(crate::models::Phong::new(Rgb::splat(0.8), 10.0, true).unwrap()),
+        )
+        .unwrap();
+        let a = lost_fraction(&phong, BsdfStrategy::Brdf, wo, 20_000, 3).unwrap();
+        assert!(a > 0.2 && a < 0.6, "{a}");
+        assert_eq!(
+            lost_fraction(&phong, BsdfStrategy::Brdf, wo, 20_000, 3),
+            Ok(a)
+        );
+        assert_ne!(
+            lost_fraction(&phong, BsdfStrategy::Brdf, wo, 20_000, 4),
+            Ok(a)
+        );
     }
 
     #[test]

@@ -6,7 +6,10 @@
 //! * [`converge`]: RMSE against the number of samples, with fitted slopes
 //!   (`lobe converge`).
 //! * [`histogram`]: sample histograms and sample weights over the projected
-//!   hemisphere (`lobe plot`).
+//!   hemisphere, and the fraction of failed samples (`lobe plot`,
+//!   `lobe report`).
+//! * [`polar`]: the integrand and each strategy's pdf in the plane of
+//!   incidence (`lobe plot --kind polar`, `lobe report`).
 //! * [`variance`]: exact variances by quadrature (the baseline of "vs
 //!   uniform") and the largest directional albedo of a material.
 //!
@@ -19,6 +22,7 @@
 
 pub mod converge;
 pub mod histogram;
+pub mod polar;
 pub mod table;
 pub mod variance;
 

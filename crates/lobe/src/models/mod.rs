@@ -386,7 +386,6 @@ glossy_models! {
     cook_torrance::CookTorrance,
 }
 
-
 #[cfg(feature = "desc")]
 /// The material keys, their values and defaults, printed by `lobe eval --help`:
 /// made from each model's parameter table ([`crate::models::MODELS`]).

@@ -1,0 +1,316 @@
+//! Curves in the plane of incidence: the numbers of `lobe plot --kind polar`
+//! and of the report's polar figures.
+//!
+//! The plane of incidence holds the normal (`+z`) and `wo`; a direction in
+//! it is given by its signed angle `θi ∈ [−π/2, π/2]` from the normal,
+//! negative on the viewer's side: `wi = (−sin θi cos φo, −sin θi sin φo,
+//! cos θi)` where `φo` is the azimuth of `wo` (0 when `wo` is the normal).
+//! So with `wo = (sin θo, 0, cos θo)` the viewer is at `θi = −θo` and the
+//! mirror direction at `θi = +θo`.
+//!
+//! Two kinds of curve share one unit, 1/sr, so they can be drawn over the
+//! same axes: the integrand of the furnace estimate divided by its integral,
+//! `f·cos θi / albedo` (the density of a zero-variance sampler), and the pdf
+//! in solid angle of a BSDF strategy. Where a strategy's pdf is much lower
+//! than the integrand, the few samples that land there carry large weights.
+
+use crate::estimator::{ShadingPoint, reference};
+use crate::math::luminance;
+use crate::{BsdfStrategy, Error, Light, Material, Rgb};
+use glam::DVec3;
+
+/// Relative tolerance of the quadrature albedo of [`integrand`].
+pub const ALBEDO_TOLERANCE: f64 = 1e-6;
+
+/// Points of a curve by default: 0.25° apart from −90° to 90°.
+pub const DEFAULT_STEPS: usize = 720;
+
+/// What a [`PolarCurve`] shows.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum CurveKind {
+    /// `f·cos θi / albedo` in luminance: the cosine is included, and the
+    /// curve is the density (1/sr) of a sampler with zero variance.
+    Integrand,
+    /// The pdf in solid angle (1/sr) of a BSDF strategy.
+    Pdf(BsdfStrategy),
+}
+
+/// One curve in the plane of incidence.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PolarCurve {
+    /// What the values are.
+    pub kind: CurveKind,
+    /// `(θi in radians, value in 1/sr)`, θi increasing from −π/2 to π/2.
+    pub points: Vec<(f64, f64)>,
+}
+
+impl PolarCurve {
+    /// A legend text: `f·cos θi ÷ albedo (ideal pdf)` or `pdf vndf`.
+    #[must_use]
+    pub fn label(&self) -> String {
+        match self.kind {
+            CurveKind::Integrand => "f·cos θi ÷ albedo (ideal pdf)".to_string(),
+            CurveKind::Pdf(s) => format!("pdf {s}"),
+        }
+    }
+
+    /// The largest value (0 when there is none, non-finite values left out).
+    #[must_use]
+    pub fn max(&self) -> f64 {
+        self.points
+            .iter()
+            .map(|p| p.1)
+            .filter(|v| v.is_finite())
+            .fold(0.0, f64::max)
+    }
+}
+
+/// The integrand and the pdfs at one view.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PolarCurves {
+    /// The view.
+    pub wo: DVec3,
+    /// The directional albedo `∫ f cos θi dω` (luminance) by quadrature,
+    /// which divides the integrand.
+    pub albedo: f64,
+    /// `f·cos θi / albedo`.
+    pub integrand: PolarCurve,
+    /// One pdf per strategy asked for, in the order asked.
+    pub pdfs: Vec<PolarCurve>,
+}
+
+impl PolarCurves {
+    /// The integrand first, then the pdfs.
+    #[must_use]
+    pub fn all(&self) -> Vec<&PolarCurve> {
+        std::iter::once(&self.integrand).chain(&self.pdfs).collect()
+    }
+}
+
+/// The signed angles of `steps + 1` points from −π/2 to π/2 (radians).
+#[must_use]
+pub fn angles(steps: usize) -> Vec<f64> {
+    let steps = steps.max(1);
+    (0..=steps)
+        .map(|i| (-90.0 + 180.0 * i as f64 / steps as f64).to_radians())
+        .collect()
+}
+
+/// The unit direction at signed angle `theta_i` (radians) in the plane of
+/// incidence of `wo` (see the module documentation).
+#[must_use]
+pub fn plane_direction(wo: DVec3, theta_i: f64) -> DVec3 {
+    let h = DVec3::new(wo.x, wo.y, 0.0);
+    let (cx, cy) = if h.length_squared() > 1e-24 {
+        let h = h.normalize();
+        (h.x, h.y)
+    } else {
+        (1.0, 0.0)
+    };
+    let s = theta_i.sin();
+    DVec3::new(-s * cx, -s * cy, theta_i.cos()).normalize()
+}
+
+/// The directional albedo `∫ f cos θi dω` at `wo` (luminance; the cosine is
+/// included), by adaptive quadrature to [`ALBEDO_TOLERANCE`].
+#[must_use]
+pub fn albedo(m: &Material, wo: DVec3) -> f64 {
+    luminance(reference(
+        m,
+        &ShadingPoint::local(wo),
+        &Light::Constant(Rgb::ONE),
+        ALBEDO_TOLERANCE,
+    ))
+}
+
+/// `f·cos θi / albedo` (luminance, cosine included) at `steps + 1` angles,
+/// given the albedo; zero everywhere when the albedo is not positive.
+#[must_use]
+pub fn integrand(m: &Material, wo: DVec3, albedo: f64, steps: usize) -> PolarCurve {
+    let scale = if albedo > 0.0 && albedo.is_finite() {
+        1.0 / albedo
+    } else {
+        0.0
+    };
+    PolarCurve {
+        kind: CurveKind::Integrand,
+        points: angles(steps)
+            .into_iter()
+            .map(|t| {
+                let wi = plane_direction(wo, t);
+                (t, luminance(m.eval(wo, wi)) * wi.z.max(0.0) * scale)
+            })
+            .collect(),
+    }
+}
+
+/// The pdf in solid angle of `strategy` at `steps + 1` angles. The error
+/// says why the strategy does not apply to `m`.
+pub fn pdf(
+    m: &Material,
+    strategy: BsdfStrategy,
+    wo: DVec3,
+    steps: usize,
+) -> Result<PolarCurve, Error> {
+    let sampler = m.sampler(strategy)?;
+    Ok(PolarCurve {
+        kind: CurveKind::Pdf(strategy),
+        points: angles(steps)
+            .into_iter()
+            .map(|t| (t, sampler.pdf(wo, plane_direction(wo, t))))
+            .collect(),
+    })
+}
+
+/// The integrand and the pdf of each of `strategies` at `wo`, each at
+/// `steps + 1` angles. The error names the first strategy that does not
+/// apply.
+pub fn curves(
+    m: &Material,
+    wo: DVec3,
+    strategies: &[BsdfStrategy],
+    steps: usize,
+) -> Result<PolarCurves, Error> {
+    let a = albedo(m, wo);
+    let pdfs = strategies
+        .iter()
+        .map(|&s| pdf(m, s, wo, steps))
+        .collect::<Result<Vec<_>, _>>()?;
+    Ok(PolarCurves {
+        wo,
+        albedo: a,
+        integrand: integrand(m, wo, a, steps),
+        pdfs,
+    })
+}
+
+/// The strategies of a polar figure when none is chosen: every strategy of
+/// `m` but spherical caps (the same density as visible normals).
+#[must_use]
+pub fn default_strategies(m: &Material) -> Vec<BsdfStrategy> {
+    m.strategies()
+        .into_iter()
+        .filter(|&s| s != BsdfStrategy::SphericalCaps)
+        .collect()
+}
+
+/// `2π ∫ v(θ) sin θ dθ` over `θ ∈ [0, π/2]` from the curve's points on one
+/// side (`side = 1.0` the mirror side, `−1.0` the viewer's side), by the
+/// trapezoidal rule: the integral over the hemisphere of a curve that does
+/// not depend on the azimuth (any curve at `wo = +z` of an isotropic
+/// material, or uniform and cosine sampling).
+#[must_use]
+pub fn hemisphere_integral(curve: &PolarCurve, side: f64) -> f64 {
+    let pts: Vec<(f64, f64)> = curve
+        .points
+        .iter()
+        .filter(|p| p.0 * side >= 0.0)
+        .map(|&(t, v)| (t.abs(), if v.is_finite() { v } else { 0.0 }))
+        .collect();
+    let mut sum = 0.0;
+    for w in pts.windows(2) {
+        let (a, b) = (w[0], w[1]);
+        sum += 0.5 * (a.1 * a.0.sin() + b.1 * b.0.sin()) * (b.0 - a.0).abs();
+    }
+    std::f64::consts::TAU * sum
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::frame::wo_from_theta;
+
+    #[cfg(feature = "desc")]
+    fn ggx(alpha: f64) -> Material {
+        crate::MaterialDesc::from_json(&format!(
+            r#"{{"type":"cook-torrance","distribution":"ggx","alpha":{alpha}}}"#
+        ))
+        .unwrap()
+        .build()
+        .unwrap()
+    }
+
+    #[test]
+    fn lambert_with_cosine_sampling_is_the_ideal_pdf() {
+        let m = Material::lambert(Rgb::splat(0.6)).unwrap();
+        let wo = wo_from_theta(40.0, 0.0);
+        let c = curves(&m, wo, &[BsdfStrategy::Cosine], 360).unwrap();
+        assert!((c.albedo - 0.6).abs() < 1e-6, "albedo {}", c.albedo);
+        assert_eq!(c.pdfs.len(), 1);
+        for (a, b) in c.integrand.points.iter().zip(&c.pdfs[0].points) {
+            assert_eq!(a.0, b.0);
+            assert!((a.1 - b.1).abs() < 1e-6, "θi {}: {} vs {}", a.0, a.1, b.1);
+        }
+        // cos θi / π at the normal.
+        assert!((c.integrand.max() - std::f64::consts::FRAC_1_PI).abs() < 1e-6);
+    }
+
+    #[cfg(feature = "desc")]
+    #[test]
+    fn pdfs_integrate_to_the_kept_fraction_at_the_normal() {
+        let m = ggx(0.3);
+        let s = [
+            BsdfStrategy::Uniform,
+            BsdfStrategy::Cosine,
+            BsdfStrategy::Brdf,
+            BsdfStrategy::Vndf,
+        ];
+        let c = curves(&m, DVec3::Z, &s, 20_000).unwrap();
+        for curve in c.all() {
+            // A pdf integrates to the fraction of samples that stay above
+            // the horizon (brdf sampling loses the reflections of steep
+            // microfacets); the ideal pdf to one.
+            let kept = match curve.kind {
+                CurveKind::Integrand => 1.0,
+                CurveKind::Pdf(st) => {
+                    1.0 - crate::experiment::histogram::lost_fraction(&m, st, DVec3::Z, 400_000, 7)
+                        .unwrap()
+                }
+            };
+            for side in [-1.0, 1.0] {
+                let i = hemisphere_integral(curve, side);
+                assert!((i - kept).abs() < 3e-3, "{}: {i} vs {kept}", curve.label());
+            }
+        }
+        assert!(
+            hemisphere_integral(&c.pdfs[2], 1.0) < 0.95,
+            "brdf loses samples"
+        );
+    }
+
+    #[cfg(feature = "desc")]
+    #[test]
+    fn the_peak_is_on_the_mirror_side_and_strategies_are_checked() {
+        let m = ggx(0.1);
+        let wo = wo_from_theta(50.0, 30.0);
+        let c = curves(&m, wo, &[BsdfStrategy::Vndf], 720).unwrap();
+        let (t, _) = c
+            .pdfs
+            .first()
+            .unwrap()
+            .points
+            .iter()
+            .copied()
+            .fold((0.0, 0.0), |a, p| if p.1 > a.1 { p } else { a });
+        assert!(
+            (t.to_degrees() - 50.0).abs() < 5.0,
+            "peak at {}°",
+            t.to_degrees()
+        );
+        // The plane of incidence holds wo at −θo.
+        let v = plane_direction(wo, -50f64.to_radians());
+        assert!((v - wo).length() < 1e-12, "{v} vs {wo}");
+        let lambert = Material::lambert(Rgb::splat(0.5)).unwrap();
+        assert!(curves(&lambert, wo, &[BsdfStrategy::Vndf], 10).is_err());
+        assert_eq!(
+            default_strategies(&m),
+            [
+                BsdfStrategy::Uniform,
+                BsdfStrategy::Cosine,
+                BsdfStrategy::Brdf,
+                BsdfStrategy::Vndf,
+                BsdfStrategy::BoundedVndf
+            ]
+        );
+    }
+}
