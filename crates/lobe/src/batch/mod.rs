@@ -517,9 +517,6 @@ fn ggx_params(m: &Material, strategy: BsdfStrategy) -> Result<GgxParams, BatchEr
             "strategy `{strategy}` (batched so far: vndf, brdf)"
         ));
     }
-    if m.diffuse.albedo != Rgb::ZERO {
-        return unsupported("a diffuse term kd > 0 (batched so far: a single glossy lobe)".into());
-    }
     let Glossy::CookTorrance(CookTorrance {
         ks,
         microfacet,
@@ -532,6 +529,9 @@ fn ggx_params(m: &Material, strategy: BsdfStrategy) -> Result<GgxParams, BatchEr
             m.model_name()
         ));
     };
+    if m.diffuse.albedo != Rgb::ZERO {
+        return unsupported("a diffuse term kd > 0 (batched so far: a single glossy lobe)".into());
+    }
     if microfacet.ndf() != Ndf::Ggx {
         return unsupported(format!(
             "distribution `{}` (batched so far: ggx)",

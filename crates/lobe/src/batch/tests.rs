@@ -4,14 +4,16 @@
 //! Tolerances, each measured and printed (`--nocapture`):
 //! * validity: the same mask, except where `wi` is within 1e-5 of the
 //!   horizon (for either path);
-//! * `wi`: within 1e-5 absolute of the scalar sample's, or within what a
-//!   change of 4 f32 ulps of `u` makes of the f64 sample (the f32 inputs
-//!   cannot pin `wi` down better where the map `u → wi` is steep: grazing
-//!   `wo` with tiny alpha);
+//! * `wi`: within 1e-5 absolute of the scalar sample's;
 //! * `f`, `pdf`, `weight` of a sample: within 1e-4 relative of the scalar
-//!   `eval_pdf` at the batch's own `wi` (the f32 direction rounds by 6e-8,
-//!   which for alpha = 1e-4 moves `D` by 1e-3: the f64 values of a
-//!   *different* `wi` are no reference), with an absolute floor of 1e-30;
+//!   sample's (absolute floor 1e-30), plus twice what the difference of the
+//!   two `wi` explains: the largest relative change of the f64 value when
+//!   its `wi` moves by that much. An f32 direction is only good to ~1e-7,
+//!   and where the lobe is sharp (alpha = 1e-4: `D` moves by 1e-4 per 1e-8
+//!   of direction) or `wi` grazes the horizon, no f32 sampler can do
+//!   better; the test prints how many samples needed that allowance (about
+//!   one in 10⁴) and the largest error where the direction explains less
+//!   than 1e-5;
 //! * `eval_pdf`: within 1e-4 relative of the scalar `eval_pdf` on the same
 //!   f32 inputs, floor 1e-30, zero where the scalar is zero except within
 //!   1e-5 of the horizon;
@@ -179,13 +181,13 @@ struct Worst {
     mask_exempt: usize,
     mask_bad: Vec<String>,
     wi_abs: f64,
-    wi_beyond_1e5: usize,
     wi_bad: Vec<String>,
     f_rel: f64,
     pdf_rel: f64,
     weight_rel: f64,
     ill_conditioned: usize,
     ill_rel: f64,
+    beyond_rel: usize,
     bad: Vec<String>,
     valid: usize,
     count: usize,
@@ -214,23 +216,6 @@ fn explained_change(m: &Material, s: BsdfStrategy, wo: DVec3, wi: DVec3, delta: 
                 ((v[k] - base[k]) / base[k]).abs()
             };
             worst[k] = worst[k].max(if c.is_finite() { c } else { f64::INFINITY });
-        }
-    }
-    worst
-}
-
-/// The f64 change of the scalar sample's `wi` when `u` moves by 4 f32 ulps.
-fn wi_sensitivity(m: &Material, s: BsdfStrategy, wo: DVec3, u: DVec2, wi: DVec3) -> f64 {
-    let mut worst: f64 = 0.0;
-    for (dx, dy) in [(1.0, 0.0), (-1.0, 0.0), (0.0, 1.0), (0.0, -1.0)] {
-        let du = 4.0 * f64::from(f32::EPSILON) * 0.5;
-        let v = DVec2::new(
-            (u.x + dx * du).clamp(0.0, 1.0 - 1e-9),
-            (u.y + dy * du).clamp(0.0, 1.0 - 1e-9),
-        );
-        match m.sample(s, wo, 0.5, v) {
-            Some(x) => worst = worst.max((x.wi - wi).abs().max_element()),
-            None => return f64::INFINITY,
         }
     }
     worst
@@ -291,14 +276,10 @@ fn compare_samples(
                 let e = (x.wi - wi_b).abs().max_element();
                 w.wi_abs = w.wi_abs.max(e);
                 if e > 1e-5 {
-                    w.wi_beyond_1e5 += 1;
-                    let sens = wi_sensitivity(m, s, wo, u, x.wi);
-                    if e > 1e-5 + sens {
-                        w.wi_bad.push(format!(
-                            "{m:?} {s} wo {wo} u {u}: wi {} vs {wi_b}, |Δ| {e:.2e}, 4-ulp sensitivity {sens:.2e}",
-                            x.wi
-                        ));
-                    }
+                    w.wi_bad.push(format!(
+                        "{m:?} {s} wo {wo} u {u}: wi {} vs {wi_b}, |Δ| {e:.2e}",
+                        x.wi
+                    ));
                 }
                 // f, pdf, weight against the scalar sample's: 1e-4 relative,
                 // plus what the difference of the two wi explains.
@@ -321,7 +302,10 @@ fn compare_samples(
                     .collect();
                 let worst = errs.iter().copied().fold(0.0, f64::max);
                 let explained = explained_change(m, s, wo, x.wi, e);
-                let conditioned = explained.iter().all(|&x| x < 1e-6);
+                let conditioned = explained.iter().all(|&x| x < 1e-5);
+                if worst > REL {
+                    w.beyond_rel += 1;
+                }
                 for (k, &err) in errs.iter().enumerate() {
                     if err > REL + 2.0 * explained[k] {
                         w.bad.push(format!(
@@ -362,20 +346,19 @@ fn batch_sample_matches_scalar() {
             }
             eprintln!(
                 "batch_sample_matches_scalar {level} {s}: {} samples, {} valid; mask differs near the horizon: {}; \
-                 max |Δwi| {:.2e} ({} beyond 1e-5, all within the 4-ulp sensitivity: {}); \
+                 max |Δwi| {:.2e}; \
                  max rel error: f {:.2e}, pdf {:.2e}, weight {:.2e}; \
-                 ill-conditioned (|Δwi| moves a value by over 1e-6): {}, worst {:.2e}, each within 1e-4 + twice what |Δwi| explains",
+                 where |Δwi| moves a value by over 1e-5: {} samples, worst {:.2e}; {} beyond 1e-4, each within 1e-4 + twice what |Δwi| explains",
                 w.count,
                 w.valid,
                 w.mask_exempt,
                 w.wi_abs,
-                w.wi_beyond_1e5,
-                w.wi_bad.is_empty(),
                 w.f_rel,
                 w.pdf_rel,
                 w.weight_rel,
                 w.ill_conditioned,
                 w.ill_rel,
+                w.beyond_rel,
             );
             let show = |v: &[String]| v.iter().take(5).cloned().collect::<Vec<_>>().join("\n");
             assert!(
@@ -401,4 +384,460 @@ fn batch_sample_matches_scalar() {
             );
         }
     }
+}
+
+/// `eval_pdf` on ~10⁶ `(wo, wi)` pairs: random, sampled (near the peak),
+/// `wi = wo` and the mirror direction, grazing included.
+#[test]
+fn batch_eval_pdf_matches_scalar() {
+    let mut rng = Pcg64::seed_from_u64(0xe7a1);
+    let mats = materials(&mut rng);
+    let n = 8_195;
+    for level in levels("batch_eval_pdf_matches_scalar") {
+        for s in [BsdfStrategy::Vndf, BsdfStrategy::Brdf] {
+            let (mut f_rel, mut pdf_rel, mut exempt, mut count) = (0.0f64, 0.0f64, 0usize, 0usize);
+            let mut bad = Vec::new();
+            let mut rng = Pcg64::seed_from_u64(0x5eed);
+            let mut out = EvalPdfBuffers::new(n);
+            for m in &mats {
+                let sp = m.sampler(s).unwrap();
+                let mut wo = [vec![], vec![], vec![]];
+                let mut wi = [vec![], vec![], vec![]];
+                for j in 0..n {
+                    let o = random_wo(&mut rng);
+                    let i = match j % 6 {
+                        0 | 1 => random_wo(&mut rng),
+                        2 | 3 => {
+                            match sp.sample(d3(o), 0.5, DVec2::new(rng.random(), rng.random())) {
+                                Some(x) => [x.wi.x as f32, x.wi.y as f32, x.wi.z as f32],
+                                None => random_wo(&mut rng),
+                            }
+                        }
+                        4 => o,
+                        _ => [-o[0], -o[1], o[2]],
+                    };
+                    for c in 0..3 {
+                        wo[c].push(o[c]);
+                        wi[c].push(i[c]);
+                    }
+                }
+                let b = BatchSampler::with_level(m, s, level).unwrap();
+                b.eval_pdf(dirs(&wo), dirs(&wi), out.output()).unwrap();
+                for j in 0..n {
+                    count += 1;
+                    let o = d3([wo[0][j], wo[1][j], wo[2][j]]);
+                    let i = d3([wi[0][j], wi[1][j], wi[2][j]]);
+                    let (f, pdf) = sp.eval_pdf(o, i);
+                    let fb = [out.f[0][j], out.f[1][j], out.f[2][j]];
+                    let pb = out.pdf[j];
+                    if !(fb.iter().all(|v| v.is_finite()) && pb.is_finite()) {
+                        bad.push(format!("{s} {o} {i}: not finite {fb:?} {pb}"));
+                        continue;
+                    }
+                    if (pdf == 0.0) != (pb == 0.0) {
+                        if o.z.min(i.z) < HORIZON {
+                            exempt += 1;
+                        } else {
+                            bad.push(format!("{s} {o} {i}: pdf {pdf} vs {pb}"));
+                        }
+                        continue;
+                    }
+                    for c in 0..3 {
+                        f_rel = f_rel.max(rel_err(fb[c].into(), f[c]));
+                    }
+                    pdf_rel = pdf_rel.max(rel_err(pb.into(), pdf));
+                }
+            }
+            eprintln!(
+                "batch_eval_pdf_matches_scalar {level} {s}: {count} pairs; max rel error f {f_rel:.2e}, pdf {pdf_rel:.2e}; \
+                 zero on one side only, within 1e-5 of the horizon: {exempt}"
+            );
+            assert!(
+                bad.is_empty(),
+                "{level} {s}: {}",
+                bad[..bad.len().min(5)].join("\n")
+            );
+            assert!(
+                f_rel < REL && pdf_rel < REL,
+                "{level} {s}: f {f_rel}, pdf {pdf_rel}"
+            );
+        }
+    }
+}
+
+fn dirs(v: &[Vec<f32>; 3]) -> Dirs<'_> {
+    Dirs {
+        x: &v[0],
+        y: &v[1],
+        z: &v[2],
+    }
+}
+
+fn bits(b: &SampleBuffers) -> Vec<u32> {
+    let mut v: Vec<u32> = Vec::new();
+    for a in b.wi.iter().chain(&b.f).chain([&b.pdf]).chain(&b.weight) {
+        v.extend(a.iter().map(|x| x.to_bits()));
+    }
+    v.extend(b.valid.iter().map(|&x| u32::from(x)));
+    v
+}
+
+/// The same bits whatever the block size, the thread split and the level.
+#[test]
+fn batch_same_numbers_for_any_block_thread_and_level() {
+    let mut rng = Pcg64::seed_from_u64(0xb10c);
+    let m = ggx(
+        0.05,
+        0.5,
+        Fresnel::Schlick {
+            f0: Rgb::new(0.9, 0.5, 0.2),
+        },
+        Rgb::ONE,
+    );
+    let n = 10_007;
+    let inp = inputs(&mut rng, n);
+    for s in [BsdfStrategy::Vndf, BsdfStrategy::Brdf] {
+        let mut reference: Option<Vec<u32>> = None;
+        for level in levels("batch_same_numbers") {
+            let b = BatchSampler::with_level(&m, s, level).unwrap();
+            let mut whole = SampleBuffers::new(n);
+            b.sample(inp.input(), whole.output()).unwrap();
+            let whole = bits(&whole);
+            // Blocks of odd sizes, one after the other.
+            for block in [1usize, 3, 7, 15, 17, 100, 4097] {
+                let mut parts = SampleBuffers::new(n);
+                let mut start = 0;
+                while start < n {
+                    let end = (start + block).min(n);
+                    let r = start..end;
+                    let mut one = SampleBuffers::new(end - start);
+                    let input = SampleInput {
+                        wo: Dirs {
+                            x: &inp.wo[0][r.clone()],
+                            y: &inp.wo[1][r.clone()],
+                            z: &inp.wo[2][r.clone()],
+                        },
+                        u1: &inp.u1[r.clone()],
+                        u2: &inp.u2[r.clone()],
+                        uc: None,
+                    };
+                    b.sample(input, one.output()).unwrap();
+                    for (d, s) in parts.wi.iter_mut().zip(&one.wi) {
+                        d[r.clone()].copy_from_slice(s);
+                    }
+                    for (d, s) in parts.f.iter_mut().zip(&one.f) {
+                        d[r.clone()].copy_from_slice(s);
+                    }
+                    for (d, s) in parts.weight.iter_mut().zip(&one.weight) {
+                        d[r.clone()].copy_from_slice(s);
+                    }
+                    parts.pdf[r.clone()].copy_from_slice(&one.pdf);
+                    parts.valid[r.clone()].copy_from_slice(&one.valid);
+                    start = end;
+                }
+                assert!(bits(&parts) == whole, "{level} {s}: block {block} differs");
+            }
+            // Two and three threads, each on its own part.
+            for threads in [2usize, 3] {
+                let chunk = n.div_ceil(threads);
+                let results: Vec<SampleBuffers> = std::thread::scope(|scope| {
+                    let handles: Vec<_> = (0..threads)
+                        .map(|t| {
+                            let r = (t * chunk).min(n)..((t + 1) * chunk).min(n);
+                            let inp = &inp;
+                            scope.spawn(move || {
+                                let mut one = SampleBuffers::new(r.len());
+                                let input = SampleInput {
+                                    wo: Dirs {
+                                        x: &inp.wo[0][r.clone()],
+                                        y: &inp.wo[1][r.clone()],
+                                        z: &inp.wo[2][r.clone()],
+                                    },
+                                    u1: &inp.u1[r.clone()],
+                                    u2: &inp.u2[r.clone()],
+                                    uc: None,
+                                };
+                                b.sample(input, one.output()).unwrap();
+                                one
+                            })
+                        })
+                        .collect();
+                    handles.into_iter().map(|h| h.join().unwrap()).collect()
+                });
+                let mut joined = Vec::new();
+                let per_part: Vec<Vec<u32>> = results.iter().map(bits).collect();
+                // Re-interleave each part's arrays into the whole's layout.
+                for k in 0..11 {
+                    for (p, r) in per_part.iter().zip(&results) {
+                        let len = r.pdf.len();
+                        joined.extend_from_slice(&p[k * len..(k + 1) * len]);
+                    }
+                }
+                assert!(joined == whole, "{level} {s}: {threads} threads differ");
+            }
+            match &reference {
+                None => reference = Some(whole),
+                Some(r) => assert!(*r == whole, "{level} {s}: differs from the first level"),
+            }
+        }
+    }
+}
+
+#[test]
+fn batch_errors_name_the_slice_and_the_unsupported() {
+    let m = ggx(0.2, 0.2, Fresnel::None, Rgb::ONE);
+    let b = BatchSampler::with_level(&m, BsdfStrategy::Vndf, SimdLevel::Scalar).unwrap();
+    let v = vec![0.5f32; 8];
+    let short = vec![0.5f32; 7];
+    let mut out = SampleBuffers::new(8);
+    let input = SampleInput {
+        wo: Dirs {
+            x: &v,
+            y: &v,
+            z: &v,
+        },
+        u1: &v,
+        u2: &short,
+        uc: None,
+    };
+    let e = b.sample(input, out.output()).unwrap_err();
+    assert_eq!(
+        e,
+        BatchError::Length {
+            slice: "u2",
+            expected: 8,
+            found: 7
+        }
+    );
+    assert!(
+        e.to_string().contains("`u2` has 7 values, expected 8"),
+        "{e}"
+    );
+    let input = SampleInput {
+        u2: &v,
+        uc: Some(&short),
+        ..input
+    };
+    assert!(matches!(
+        b.sample(input, out.output()),
+        Err(BatchError::Length { slice: "uc", .. })
+    ));
+    let mut small = SampleBuffers::new(7);
+    let input = SampleInput { uc: None, ..input };
+    assert!(matches!(
+        b.sample(input, small.output()),
+        Err(BatchError::Length { slice: "wi.x", .. })
+    ));
+    let mut e_out = EvalPdfBuffers::new(8);
+    let d = Dirs {
+        x: &v,
+        y: &v,
+        z: &v,
+    };
+    let d7 = Dirs { z: &short, ..d };
+    assert!(matches!(
+        b.eval_pdf(d, d7, e_out.output()),
+        Err(BatchError::Length { slice: "wi.z", .. })
+    ));
+    assert!(b.eval_pdf(d, d, e_out.output()).is_ok());
+    let empty: &[f32] = &[];
+    let mut none = SampleBuffers::new(0);
+    let e = Dirs {
+        x: empty,
+        y: empty,
+        z: empty,
+    };
+    assert!(
+        b.sample(
+            SampleInput {
+                wo: e,
+                u1: empty,
+                u2: empty,
+                uc: None
+            },
+            none.output()
+        )
+        .is_ok()
+    );
+
+    // What the first step does not batch: a clear error, the scalar path has it.
+    let unsupported =
+        |m: &Material, s: BsdfStrategy| match BatchSampler::with_level(m, s, SimdLevel::Scalar) {
+            Err(BatchError::Unsupported { reason }) => reason,
+            other => panic!("{other:?}"),
+        };
+    assert!(unsupported(&m, BsdfStrategy::SphericalCaps).contains("spherical-caps"));
+    assert!(unsupported(&m, BsdfStrategy::Cosine).contains("cosine"));
+    let beckmann = {
+        let mf = Microfacet::new(Ndf::Beckmann, 0.2, 0.2).unwrap();
+        let l = CookTorrance::new(Rgb::ONE, mf, Shadowing::SmithCorrelated, Fresnel::None).unwrap();
+        Material::with_diffuse(Rgb::ZERO, Glossy::CookTorrance(l)).unwrap()
+    };
+    assert!(unsupported(&beckmann, BsdfStrategy::Vndf).contains("beckmann"));
+    let separable = {
+        let mf = Microfacet::new(Ndf::Ggx, 0.2, 0.2).unwrap();
+        let l = CookTorrance::new(Rgb::ONE, mf, Shadowing::SmithSeparable, Fresnel::None).unwrap();
+        Material::with_diffuse(Rgb::ZERO, Glossy::CookTorrance(l)).unwrap()
+    };
+    assert!(unsupported(&separable, BsdfStrategy::Vndf).contains("smith-separable"));
+    let two_lobes = Material {
+        diffuse: crate::models::Lambert::new(Rgb::splat(0.3)).unwrap(),
+        ..m
+    };
+    assert!(unsupported(&two_lobes, BsdfStrategy::Vndf).contains("kd"));
+    let conductor = ggx(
+        0.2,
+        0.2,
+        Fresnel::Conductor {
+            eta: Rgb::ONE,
+            k: Rgb::ONE,
+        },
+        Rgb::ONE,
+    );
+    assert!(unsupported(&conductor, BsdfStrategy::Vndf).contains("Fresnel"));
+    assert!(
+        unsupported(&Material::lambert(Rgb::ONE).unwrap(), BsdfStrategy::Brdf).contains("lambert")
+    );
+
+    // Levels by name.
+    assert_eq!("avx2".parse::<SimdLevel>().unwrap(), SimdLevel::Avx2);
+    assert!(matches!(
+        "sse9".parse::<SimdLevel>(),
+        Err(BatchError::Level { .. })
+    ));
+    for l in SimdLevel::ALL {
+        assert_eq!(l.check().is_ok(), l.is_available());
+        if !l.is_available() {
+            let e = BatchSampler::with_level(&m, BsdfStrategy::Vndf, l).unwrap_err();
+            assert!(e.to_string().contains("lacks"), "{e}");
+        }
+    }
+    assert!(SimdLevel::Scalar.is_available() && SimdLevel::best().is_available());
+}
+
+/// Chi-square of the batch samplers against the scalar pdf
+/// (`lobe::stats::chi2`), at every level. The uniforms are the harness's
+/// own stream, drawn ahead and sampled as one block; the expected counts
+/// (the cubature of the pdf) are computed once per case and shared by the
+/// levels.
+#[cfg(feature = "stats")]
+#[test]
+fn batch_chi2() {
+    use crate::stats::chi2::{Chi2Config, chi2_test, chi2_test_cells, sidak};
+    use crate::stats::quadrature::Estimate;
+    use std::cell::Cell;
+    let cfg = Chi2Config {
+        samples: 500_000,
+        ..Chi2Config::default()
+    };
+    let cases = [
+        ggx(0.02, 0.02, Fresnel::None, Rgb::ONE),
+        ggx(
+            0.3,
+            0.3,
+            Fresnel::Schlick {
+                f0: Rgb::splat(0.3),
+            },
+            Rgb::ONE,
+        ),
+        ggx(1.0, 1.0, Fresnel::None, Rgb::ONE),
+        ggx(0.05, 0.5, Fresnel::None, Rgb::ONE),
+    ];
+    let views = [0.0, 60.0, 89.0];
+    let lv = levels("batch_chi2");
+    let alpha = sidak(0.01, cases.len() * views.len() * 2 * lv.len());
+    // The harness's stream: uc, u.x, u.y per sample.
+    let mut rng = Pcg64::seed_from_u64(cfg.seed);
+    let (mut u1, mut u2) = (Vec::new(), Vec::new());
+    for _ in 0..cfg.samples {
+        let _uc: f64 = rng.random();
+        let x: f64 = rng.random();
+        let y: f64 = rng.random();
+        // Round down into [0, 1) in f32.
+        let f = |v: f64| {
+            let r = v as f32;
+            if f64::from(r) > v { r.next_down() } else { r }
+        };
+        u1.push(f(x));
+        u2.push(f(y));
+    }
+    let mut failures = Vec::new();
+    for (ci, m) in cases.iter().enumerate() {
+        for &theta in &views {
+            let wo = crate::frame::wo_from_theta(theta, 0.3f64.to_degrees());
+            let wo32 = [wo.x as f32, wo.y as f32, wo.z as f32];
+            let n = cfg.samples;
+            let wox = vec![wo32[0]; n];
+            let woy = vec![wo32[1]; n];
+            let woz = vec![wo32[2]; n];
+            let wo64 = d3(wo32);
+            for s in [BsdfStrategy::Vndf, BsdfStrategy::Brdf] {
+                let mut cells: Option<Vec<f64>> = None;
+                for &level in &lv {
+                    let b = BatchSampler::with_level(m, s, level).unwrap();
+                    let mut out = SampleBuffers::new(n);
+                    let input = SampleInput {
+                        wo: Dirs {
+                            x: &wox,
+                            y: &woy,
+                            z: &woz,
+                        },
+                        u1: &u1,
+                        u2: &u2,
+                        uc: None,
+                    };
+                    b.sample(input, out.output()).unwrap();
+                    let next = Cell::new(0usize);
+                    let sample = |_uc: f64, u: DVec2| {
+                        let i = next.get();
+                        next.set(i + 1);
+                        debug_assert!((f64::from(u1[i]) - u.x).abs() < 1e-7);
+                        (out.valid[i] == 1).then(|| {
+                            DVec3::new(
+                                out.wi[0][i].into(),
+                                out.wi[1][i].into(),
+                                out.wi[2][i].into(),
+                            )
+                        })
+                    };
+                    let r = match &cells {
+                        None => {
+                            let sp = m.sampler(s).unwrap();
+                            let r = chi2_test(&cfg, sample, |wi| sp.pdf(wo64, wi));
+                            cells = Some(r.expected.iter().map(|e| e / n as f64).collect());
+                            r
+                        }
+                        Some(p) => {
+                            let k = Cell::new(0usize);
+                            chi2_test_cells(&cfg, sample, |_, _, _, _| {
+                                let v = p[k.get()];
+                                k.set(k.get() + 1);
+                                Estimate {
+                                    value: v,
+                                    error: 0.0,
+                                    evals: 0,
+                                    converged: true,
+                                }
+                            })
+                        }
+                    };
+                    eprintln!(
+                        "batch_chi2 {level} {s} θ={theta} case {ci}: p = {:.3e}",
+                        r.p_value
+                    );
+                    if !r.passes(alpha) {
+                        failures.push(format!(
+                            "{level} {s} θ={theta} {:?}: χ²={:.1} dof={} p={:.3e} {}",
+                            m.glossy,
+                            r.statistic,
+                            r.dof,
+                            r.p_value,
+                            r.message.clone().unwrap_or_default()
+                        ));
+                    }
+                }
+            }
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
