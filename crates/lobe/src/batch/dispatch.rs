@@ -86,6 +86,36 @@ fn store_sampled<L: Lanes>(
     l.store_mask(s.valid, &mut valid[k..]);
 }
 
+/// One vector of samples from the first `L::N` values of each input.
+#[inline(always)]
+fn run_sample<L: Lanes, const VNDF: bool>(l: L, p: &GgxParams, x: [&[f32]; 5]) -> Sampled<L> {
+    kernel::sample::<L, VNDF>(
+        l,
+        p,
+        [l.load(x[0]), l.load(x[1]), l.load(x[2])],
+        l.load(x[3]),
+        l.load(x[4]),
+    )
+}
+
+/// One vector of `eval_pdf`, stored at `k`.
+#[inline(always)]
+fn run_eval_pdf<L: Lanes, const VNDF: bool>(
+    l: L,
+    p: &GgxParams,
+    x: [&[f32]; 6],
+    out: &mut [&mut [f32]; 4],
+    k: usize,
+) {
+    let wo = [l.load(x[0]), l.load(x[1]), l.load(x[2])];
+    let wi = [l.load(x[3]), l.load(x[4]), l.load(x[5])];
+    let (f, pdf) = kernel::eval_pdf::<L, VNDF>(l, p, wo, wi);
+    l.store(f[0], &mut out[0][k..]);
+    l.store(f[1], &mut out[1][k..]);
+    l.store(f[2], &mut out[2][k..]);
+    l.store(pdf, &mut out[3][k..]);
+}
+
 #[inline(always)]
 fn sample_block<L: Lanes, const VNDF: bool>(
     l: L,
@@ -94,18 +124,19 @@ fn sample_block<L: Lanes, const VNDF: bool>(
     (out, valid): SampleOut<'_, '_>,
 ) {
     let n = inp[0].len();
-    let run = |x: [&[f32]; 5]| {
-        kernel::sample::<L, VNDF>(
-            l,
-            p,
-            [l.load(x[0]), l.load(x[1]), l.load(x[2])],
-            l.load(x[3]),
-            l.load(x[4]),
-        )
-    };
     let mut k = 0;
     while k + L::N <= n {
-        let s = run(inp.map(|s| &s[k..]));
+        let s = run_sample::<L, VNDF>(
+            l,
+            p,
+            [
+                &inp[0][k..],
+                &inp[1][k..],
+                &inp[2][k..],
+                &inp[3][k..],
+                &inp[4][k..],
+            ],
+        );
         store_sampled(l, &s, out, valid, k);
         k += L::N;
     }
@@ -122,7 +153,7 @@ fn sample_block<L: Lanes, const VNDF: bool>(
         for (b, s) in ib.iter_mut().zip(inp) {
             b[..rem].copy_from_slice(&s[k..]);
         }
-        let s = run([&ib[0], &ib[1], &ib[2], &ib[3], &ib[4]]);
+        let s = run_sample::<L, VNDF>(l, p, [&ib[0], &ib[1], &ib[2], &ib[3], &ib[4]]);
         let mut ob = [[0.0f32; MAX_LANES]; 10];
         let mut vb = [0u8; MAX_LANES];
         {
@@ -144,16 +175,17 @@ fn eval_pdf_block<L: Lanes, const VNDF: bool>(
     out: EvalOut<'_, '_>,
 ) {
     let n = inp[0].len();
-    let run = |x: [&[f32]; 6], out: &mut [&mut [f32]; 4], k: usize| {
-        let v = x.map(|s| l.load(s));
-        let (f, pdf) = kernel::eval_pdf::<L, VNDF>(l, p, [v[0], v[1], v[2]], [v[3], v[4], v[5]]);
-        for (o, v) in out.iter_mut().zip([f[0], f[1], f[2], pdf]) {
-            l.store(v, &mut o[k..]);
-        }
-    };
     let mut k = 0;
     while k + L::N <= n {
-        run(inp.map(|s| &s[k..]), out, k);
+        let x = [
+            &inp[0][k..],
+            &inp[1][k..],
+            &inp[2][k..],
+            &inp[3][k..],
+            &inp[4][k..],
+            &inp[5][k..],
+        ];
+        run_eval_pdf::<L, VNDF>(l, p, x, out, k);
         k += L::N;
     }
     if k < n {
@@ -167,7 +199,15 @@ fn eval_pdf_block<L: Lanes, const VNDF: bool>(
         let mut ob = [[0.0f32; MAX_LANES]; 4];
         {
             let mut refs = ob.each_mut().map(|a| &mut a[..]);
-            run(ib.each_ref().map(|b| &b[..]), &mut refs, 0);
+            let x = [
+                &ib[0][..],
+                &ib[1][..],
+                &ib[2][..],
+                &ib[3][..],
+                &ib[4][..],
+                &ib[5][..],
+            ];
+            run_eval_pdf::<L, VNDF>(l, p, x, &mut refs, 0);
         }
         for (o, b) in out.iter_mut().zip(&ob) {
             o[k..].copy_from_slice(&b[..rem]);

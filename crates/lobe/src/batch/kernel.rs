@@ -16,6 +16,10 @@
 //! * brdf: `pdf = D hz / (4 wo·h)`,
 //!   `weight = ks F 2 wi.z (wo·h) / (hz (wi.z Lo + wo.z Li))`.
 //!
+//! No closures and no `array::map` here: everything must inline into the
+//! `#[target_feature]` entry points for the intrinsics to inline (a closure
+//! is a function of its own, compiled without the level's features).
+//!
 //! `sample` evaluates `f`, `pdf` and `weight` with the microfacet normal it
 //! drew as the half vector (`|h| = 1`, `wo·h = wo·m`), as the scalar path
 //! does; `eval_pdf` with `h = wo + wi`.
@@ -43,6 +47,16 @@ type V3<L> = [<L as Lanes>::F; 3];
 #[inline(always)]
 fn dot<L: Lanes>(l: L, a: V3<L>, b: V3<L>) -> L::F {
     l.mul_add(a[0], b[0], l.mul_add(a[1], b[1], a[2] * b[2]))
+}
+
+/// `m ? v : zero` for each of three.
+#[inline(always)]
+fn select3<L: Lanes>(l: L, m: L::M, v: V3<L>, zero: L::F) -> V3<L> {
+    [
+        l.select(m, v[0], zero),
+        l.select(m, v[1], zero),
+        l.select(m, v[2], zero),
+    ]
 }
 
 /// `‖(αx w.x, αy w.y, w.z)‖`.
@@ -109,7 +123,11 @@ fn eval_at<L: Lanes, const VNDF: bool>(
     let m = one - cos_oh;
     let m2 = m * m;
     let m5 = m2 * m2 * m;
-    let ksf = [0, 1, 2].map(|c| l.mul_add(l.splat(p.ks_1mf0[c]), m5, l.splat(p.ks_f0[c])));
+    let ksf = [
+        l.mul_add(l.splat(p.ks_1mf0[0]), m5, l.splat(p.ks_f0[0])),
+        l.mul_add(l.splat(p.ks_1mf0[1]), m5, l.splat(p.ks_f0[1])),
+        l.mul_add(l.splat(p.ks_1mf0[2]), m5, l.splat(p.ks_f0[2])),
+    ];
     let (pdf, wscale) = if VNDF {
         let pdf = l.splat(0.5) * d / (wo[2] + lo);
         (pdf, wi[2] * (wo[2] + lo) * rden)
@@ -119,9 +137,9 @@ fn eval_at<L: Lanes, const VNDF: bool>(
     };
     Eval {
         ok,
-        f: ksf.map(|k| k * dg),
+        f: [ksf[0] * dg, ksf[1] * dg, ksf[2] * dg],
         pdf,
-        weight: ksf.map(|k| k * wscale),
+        weight: [ksf[0] * wscale, ksf[1] * wscale, ksf[2] * wscale],
     }
 }
 
@@ -172,8 +190,12 @@ pub(crate) fn sample<L: Lanes, const VNDF: bool>(
         let one_m_u = one - u1;
         let a = l.sqrt(l.mul_add(u1, sin * sin, one_m_u));
         let rs = r * sin;
-        let a_minus = l.select(l.gt(rs, zero), one_m_u / (a + rs), a - rs);
-        let a_plus = l.select(l.lt(rs, zero), one_m_u / (a - rs), a + rs);
+        // One of a ± rs is a + |rs|; the other is (1 − u1) over it.
+        let big = a + l.abs(rs);
+        let small = one_m_u / big;
+        let rs_pos = l.gt(rs, zero);
+        let a_minus = l.select(rs_pos, small, big);
+        let a_plus = l.select(rs_pos, big, small);
         // 1 − h = len2 / (2 (1 + wh.z)).
         let omh = l.splat(0.5) * len2 / (one + wh[2]);
         let hv = one - omh;
@@ -223,13 +245,12 @@ pub(crate) fn sample<L: Lanes, const VNDF: bool>(
         & l.is_finite(e.weight[2])
         & l.is_finite(e.pdf);
     let valid = l.gt(om, zero) & e.ok & l.gt(e.pdf, zero) & finite;
-    let keep = |v: L::F| l.select(valid, v, zero);
     Sampled {
         valid,
-        wi: wi.map(keep),
-        f: e.f.map(keep),
-        pdf: keep(e.pdf),
-        weight: e.weight.map(keep),
+        wi: select3(l, valid, wi, zero),
+        f: select3(l, valid, e.f, zero),
+        pdf: l.select(valid, e.pdf, zero),
+        weight: select3(l, valid, e.weight, zero),
     }
 }
 
@@ -246,8 +267,5 @@ pub(crate) fn eval_pdf<L: Lanes, const VNDF: bool>(
     let e = eval::<L, VNDF>(l, p, wo, wi);
     let f_ok = e.ok & l.is_finite(e.f[0]) & l.is_finite(e.f[1]) & l.is_finite(e.f[2]);
     let p_ok = e.ok & l.is_finite(e.pdf);
-    (
-        e.f.map(|v| l.select(f_ok, v, zero)),
-        l.select(p_ok, e.pdf, zero),
-    )
+    (select3(l, f_ok, e.f, zero), l.select(p_ok, e.pdf, zero))
 }
