@@ -116,18 +116,31 @@ enum Mode {
     Scalar,
 }
 
-/// One thread's work on `range` in `mode`; returns a sum of the results so
-/// that nothing is optimized away.
-fn work(
+/// What one timing runs: the mode, the material and strategy, the inputs.
+#[derive(Clone, Copy)]
+struct Job<'a> {
     mode: Mode,
-    m: &Material,
+    m: &'a Material,
     strategy: BsdfStrategy,
-    b: &BatchSampler,
-    inputs: &Inputs,
+    b: &'a BatchSampler,
+    inputs: &'a Inputs,
+}
+
+/// One thread's work on `range`; returns a sum of the results so that
+/// nothing is optimized away.
+fn work(
+    job: Job<'_>,
     range: std::ops::Range<usize>,
     out: &mut SampleBuffers,
     ev: &mut EvalPdfBuffers,
 ) -> f64 {
+    let Job {
+        mode,
+        m,
+        strategy,
+        b,
+        inputs,
+    } = job;
     let mut total = 0.0f64;
     if mode == Mode::Scalar {
         for i in range {
@@ -203,15 +216,8 @@ fn sum_f32(v: &[f32]) -> f32 {
 
 /// The median wall time of `reps` timed runs (after one warm-up run) of
 /// `threads` workers, each on its part of the inputs.
-fn time(
-    mode: Mode,
-    m: &Material,
-    strategy: BsdfStrategy,
-    b: &BatchSampler,
-    inputs: &Inputs,
-    threads: usize,
-    reps: usize,
-) -> Duration {
+fn time(job: Job<'_>, threads: usize, reps: usize) -> Duration {
+    let inputs = job.inputs;
     let n = inputs.len();
     let chunk = n.div_ceil(threads);
     let start = Barrier::new(threads + 1);
@@ -226,16 +232,7 @@ fn time(
                 let mut ev = EvalPdfBuffers::new(BLOCK);
                 for _ in 0..=reps {
                     start.wait();
-                    black_box(work(
-                        mode,
-                        m,
-                        strategy,
-                        b,
-                        inputs,
-                        range.clone(),
-                        &mut out,
-                        &mut ev,
-                    ));
+                    black_box(work(job, range.clone(), &mut out, &mut ev));
                     end.wait();
                 }
             });
@@ -291,17 +288,16 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     let msps = |d: Duration| args.samples as f64 / d.as_secs_f64() / 1e6;
     let mut results = Vec::new();
     for (&s, b) in strategies.iter().zip(&samplers) {
-        let full = time(
-            Mode::SampleEvalPdf,
-            &m,
-            s,
+        let job = |mode| Job {
+            mode,
+            m: &m,
+            strategy: s,
             b,
-            &inputs,
-            args.threads,
-            args.reps,
-        );
-        let sample = time(Mode::Sample, &m, s, b, &inputs, args.threads, args.reps);
-        let scalar = time(Mode::Scalar, &m, s, b, &inputs, args.threads, args.reps);
+            inputs: &inputs,
+        };
+        let full = time(job(Mode::SampleEvalPdf), args.threads, args.reps);
+        let sample = time(job(Mode::Sample), args.threads, args.reps);
+        let scalar = time(job(Mode::Scalar), args.threads, args.reps);
         results.push((s, msps(full), msps(sample), msps(scalar)));
     }
     let level = level.map_or("none", |l| l.name());

@@ -3,7 +3,7 @@
 //!
 //! Tolerances, each measured and printed (`--nocapture`):
 //! * validity: the same mask, except where `wi` is within 1e-5 of the
-//!   horizon (for either path);
+//!   horizon (for either path; measured: no exception needed);
 //! * `wi`: within 1e-5 absolute of the scalar sample's;
 //! * `f`, `pdf`, `weight` of a sample: within 1e-4 relative of the scalar
 //!   sample's (absolute floor 1e-30), plus twice what the difference of the
