@@ -4,6 +4,7 @@
 //! `lobe: error: <message>` on stderr and exit code 1 (clap's own usage
 //! errors exit 2).
 
+mod bench;
 mod common;
 mod compare;
 mod converge;
@@ -43,6 +44,7 @@ enum Command {
     Report(report::ReportArgs),
     Render(render::RenderArgs),
     Compare(compare::CompareArgs),
+    Bench(bench::BenchArgs),
 }
 
 fn main() -> ExitCode {
@@ -56,6 +58,7 @@ fn main() -> ExitCode {
         Command::Report(args) => report::run(&args),
         Command::Render(args) => render::run(&args),
         Command::Compare(args) => compare::run(&args),
+        Command::Bench(args) => bench::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -66,6 +66,7 @@
 //! # Ok::<(), lobe::Error>(())
 //! ```
 
+pub mod batch;
 #[cfg(feature = "desc")]
 pub mod desc;
 pub mod envmap;

@@ -1,0 +1,341 @@
+//! `lobe bench`: throughput of the batch kernels (`lobe::batch`), with the
+//! scalar f64 path as a peer measured in the same run.
+
+use anyhow::{Context, Result, bail};
+use clap::Args;
+use glam::{DVec2, DVec3};
+use lobe::batch::{BatchSampler, Dirs, EvalPdfBuffers, SampleBuffers, SampleInput};
+use lobe::{BsdfStrategy, Material};
+use rand::{RngExt, SeedableRng};
+use std::hint::black_box;
+use std::sync::Barrier;
+use std::time::{Duration, Instant};
+
+const DEFAULT_MATERIAL: &str = r#"{"type":"cook-torrance","distribution":"ggx","alpha":0.2}"#;
+
+/// Samples per call of the batch API: the outputs stay in the L1/L2 caches.
+const BLOCK: usize = 4096;
+
+#[derive(Args, Debug)]
+#[command(
+    about = "Throughput of the batch (SIMD) kernels, with the scalar f64 path as a peer",
+    long_about = "Throughput of the batch kernels of lobe::batch in million samples per second: \
+                  `msps` is sample + eval_pdf at the sampled direction (what a path tracer with MIS \
+                  does per BSDF sample), `sample_msps` is sample alone, and `scalar_msps` is the \
+                  scalar f64 path (Material::sample, then eval and pdf) on the same inputs, in the \
+                  same run. The inputs (wo uniform over the hemisphere, u1, u2 uniform; fixed seed) \
+                  are precomputed; each thread takes a contiguous part and runs it in blocks of 4096 \
+                  samples into its own output buffers, summing the results. Each figure is the \
+                  median of --reps warm repetitions (one more, untimed, runs first).\n\n\
+                  The dispatch level is the best the CPU has unless LOBE_SIMD=scalar|avx2|avx512 \
+                  forces one. Speed claims come from here or from `cargo bench`, never from timed \
+                  tests; on a shared machine compare the ratios within one run.",
+    after_help = "Examples:\n  \
+                  lobe bench\n  \
+                  lobe bench --threads 2 --json\n  \
+                  LOBE_SIMD=avx2 lobe bench --material '{\"type\":\"cook-torrance\",\"alpha_u\":0.1,\"alpha_v\":0.4}' --strategy vndf"
+)]
+pub struct BenchArgs {
+    /// Material: JSON text, @file.json or @file.toml; default GGX alpha = 0.2.
+    /// The batch path has Cook-Torrance GGX, smith-correlated, Fresnel none or
+    /// schlick, kd = 0
+    #[arg(long)]
+    pub material: Option<String>,
+    /// Comma-separated strategies (batched: vndf, brdf)
+    #[arg(long, default_value = "vndf,brdf")]
+    pub strategy: String,
+    /// Worker threads, each on its own part of the inputs
+    #[arg(long, default_value_t = 1)]
+    pub threads: usize,
+    /// Precomputed inputs (at least 2^22 for a figure worth quoting)
+    #[arg(long, short = 'n', default_value_t = 1 << 22)]
+    pub samples: usize,
+    /// Timed repetitions; the median is reported
+    #[arg(long, default_value_t = 7)]
+    pub reps: usize,
+    /// Print JSON instead of a table
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Precomputed inputs in structure-of-arrays layout.
+struct Inputs {
+    wo: [Vec<f32>; 3],
+    u1: Vec<f32>,
+    u2: Vec<f32>,
+}
+
+impl Inputs {
+    fn new(n: usize) -> Self {
+        let mut rng = rand_pcg::Pcg64::seed_from_u64(0x6c6f_6265_6265_6e63);
+        let mut v = Inputs {
+            wo: [vec![], vec![], vec![]],
+            u1: Vec::with_capacity(n),
+            u2: Vec::with_capacity(n),
+        };
+        for _ in 0..n {
+            let cos_t: f64 = 1.0 - rng.random::<f64>();
+            let sin_t = (1.0 - cos_t * cos_t).max(0.0).sqrt();
+            let phi = std::f64::consts::TAU * rng.random::<f64>();
+            let w = [sin_t * phi.cos(), sin_t * phi.sin(), cos_t];
+            for (c, x) in v.wo.iter_mut().zip(w) {
+                c.push(x as f32);
+            }
+            // 24 random bits: uniform f32 in [0, 1).
+            v.u1.push((rng.random::<u32>() >> 8) as f32 / (1u32 << 24) as f32);
+            v.u2.push((rng.random::<u32>() >> 8) as f32 / (1u32 << 24) as f32);
+        }
+        v
+    }
+
+    fn input(&self, r: std::ops::Range<usize>) -> SampleInput<'_> {
+        SampleInput {
+            wo: Dirs {
+                x: &self.wo[0][r.clone()],
+                y: &self.wo[1][r.clone()],
+                z: &self.wo[2][r.clone()],
+            },
+            u1: &self.u1[r.clone()],
+            u2: &self.u2[r],
+            uc: None,
+        }
+    }
+
+    fn len(&self) -> usize {
+        self.u1.len()
+    }
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+enum Mode {
+    /// Batch sample, then batch eval_pdf at the sampled directions.
+    SampleEvalPdf,
+    /// Batch sample alone.
+    Sample,
+    /// The scalar f64 path: sample, then eval and pdf.
+    Scalar,
+}
+
+/// What one timing runs: the mode, the material and strategy, the inputs.
+#[derive(Clone, Copy)]
+struct Job<'a> {
+    mode: Mode,
+    m: &'a Material,
+    strategy: BsdfStrategy,
+    b: &'a BatchSampler,
+    inputs: &'a Inputs,
+}
+
+/// One thread's work on `range`; returns a sum of the results so that
+/// nothing is optimized away.
+fn work(
+    job: Job<'_>,
+    range: std::ops::Range<usize>,
+    out: &mut SampleBuffers,
+    ev: &mut EvalPdfBuffers,
+) -> f64 {
+    let Job {
+        mode,
+        m,
+        strategy,
+        b,
+        inputs,
+    } = job;
+    let mut total = 0.0f64;
+    if mode == Mode::Scalar {
+        for i in range {
+            let wo = DVec3::new(
+                inputs.wo[0][i].into(),
+                inputs.wo[1][i].into(),
+                inputs.wo[2][i].into(),
+            );
+            let u = DVec2::new(inputs.u1[i].into(), inputs.u2[i].into());
+            if let Some(s) = m.sample(strategy, wo, 0.5, u) {
+                let wi = black_box(s.wi);
+                total += s.weight.x + m.eval(wo, wi).x + m.pdf(strategy, wo, wi);
+            }
+        }
+        return total;
+    }
+    let mut start = range.start;
+    while start < range.end {
+        let end = (start + BLOCK).min(range.end);
+        let len = end - start;
+        let mut o = out.output();
+        // Trim the block buffers to this block's length.
+        o.wi.x = &mut o.wi.x[..len];
+        o.wi.y = &mut o.wi.y[..len];
+        o.wi.z = &mut o.wi.z[..len];
+        o.f.r = &mut o.f.r[..len];
+        o.f.g = &mut o.f.g[..len];
+        o.f.b = &mut o.f.b[..len];
+        o.pdf = &mut o.pdf[..len];
+        o.weight.r = &mut o.weight.r[..len];
+        o.weight.g = &mut o.weight.g[..len];
+        o.weight.b = &mut o.weight.b[..len];
+        o.valid = &mut o.valid[..len];
+        let input = inputs.input(start..end);
+        b.sample(input, o).expect("lengths match");
+        let mut sum = 0.0f32;
+        if mode == Mode::SampleEvalPdf {
+            let mut e = ev.output();
+            e.f.r = &mut e.f.r[..len];
+            e.f.g = &mut e.f.g[..len];
+            e.f.b = &mut e.f.b[..len];
+            e.pdf = &mut e.pdf[..len];
+            let wi = black_box(out.wi());
+            let wi = Dirs {
+                x: &wi.x[..len],
+                y: &wi.y[..len],
+                z: &wi.z[..len],
+            };
+            b.eval_pdf(input.wo, wi, e).expect("lengths match");
+            sum +=
+                sum_f32(&out.weight[0][..len]) + sum_f32(&ev.f[0][..len]) + sum_f32(&ev.pdf[..len]);
+        } else {
+            sum += sum_f32(&out.weight[0][..len]);
+        }
+        total += f64::from(sum);
+        start = end;
+    }
+    total
+}
+
+/// A sum with 16 independent accumulators (vectorizable), so that the
+/// checksum costs little next to the kernels.
+fn sum_f32(v: &[f32]) -> f32 {
+    let mut acc = [0.0f32; 16];
+    let mut chunks = v.chunks_exact(16);
+    for c in &mut chunks {
+        for (a, x) in acc.iter_mut().zip(c) {
+            *a += x;
+        }
+    }
+    acc.iter().sum::<f32>() + chunks.remainder().iter().sum::<f32>()
+}
+
+/// The median wall time of `reps` timed runs (after one warm-up run) of
+/// `threads` workers, each on its part of the inputs.
+fn time(job: Job<'_>, threads: usize, reps: usize) -> Duration {
+    let inputs = job.inputs;
+    let n = inputs.len();
+    let chunk = n.div_ceil(threads);
+    let start = Barrier::new(threads + 1);
+    let end = Barrier::new(threads + 1);
+    let mut times = Vec::with_capacity(reps);
+    std::thread::scope(|scope| {
+        for t in 0..threads {
+            let range = (t * chunk).min(n)..((t + 1) * chunk).min(n);
+            let (start, end) = (&start, &end);
+            scope.spawn(move || {
+                let mut out = SampleBuffers::new(BLOCK);
+                let mut ev = EvalPdfBuffers::new(BLOCK);
+                for _ in 0..=reps {
+                    start.wait();
+                    black_box(work(job, range.clone(), &mut out, &mut ev));
+                    end.wait();
+                }
+            });
+        }
+        for rep in 0..=reps {
+            let t0 = Instant::now();
+            start.wait();
+            end.wait();
+            if rep > 0 {
+                times.push(t0.elapsed());
+            }
+        }
+    });
+    times.sort();
+    times[times.len() / 2]
+}
+
+/// The CPU model from /proc/cpuinfo.
+fn cpu_model() -> String {
+    std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .find(|l| l.starts_with("model name"))
+                .and_then(|l| l.split_once(':'))
+                .map(|(_, v)| v.trim().to_string())
+        })
+        .unwrap_or_else(|| "unknown".into())
+}
+
+pub fn run(args: &BenchArgs) -> Result<()> {
+    if args.threads == 0 {
+        bail!("--threads must be at least 1");
+    }
+    if args.samples == 0 || args.reps == 0 {
+        bail!("--samples and --reps must be at least 1");
+    }
+    let material = args.material.as_deref().unwrap_or(DEFAULT_MATERIAL);
+    let m = Material::load(material).context("--material")?;
+    let strategies: Vec<BsdfStrategy> = args
+        .strategy
+        .split(',')
+        .map(|s| s.trim().parse::<BsdfStrategy>())
+        .collect::<Result<_, _>>()
+        .context("--strategy")?;
+    let samplers: Vec<BatchSampler> = strategies
+        .iter()
+        .map(|&s| BatchSampler::new(&m, s))
+        .collect::<Result<_, _>>()
+        .with_context(|| format!("--material {material}"))?;
+    let level = samplers.first().map(BatchSampler::level);
+    let inputs = Inputs::new(args.samples);
+    let msps = |d: Duration| args.samples as f64 / d.as_secs_f64() / 1e6;
+    let mut results = Vec::new();
+    for (&s, b) in strategies.iter().zip(&samplers) {
+        let job = |mode| Job {
+            mode,
+            m: &m,
+            strategy: s,
+            b,
+            inputs: &inputs,
+        };
+        let full = time(job(Mode::SampleEvalPdf), args.threads, args.reps);
+        let sample = time(job(Mode::Sample), args.threads, args.reps);
+        let scalar = time(job(Mode::Scalar), args.threads, args.reps);
+        results.push((s, msps(full), msps(sample), msps(scalar)));
+    }
+    let level = level.map_or("none", |l| l.name());
+    let cpu = cpu_model();
+    if args.json {
+        let v = serde_json::json!({
+            "simd": level,
+            "cpu": cpu,
+            "threads": args.threads,
+            "samples": args.samples,
+            "reps": args.reps,
+            "block": BLOCK,
+            "material": material,
+            "results": results.iter().map(|&(s, x, y, z)| serde_json::json!({
+                "strategy": s.name(),
+                "msps": x,
+                "sample_msps": y,
+                "scalar_msps": z,
+            })).collect::<Vec<_>>(),
+        });
+        println!("{}", serde_json::to_string_pretty(&v)?);
+    } else {
+        println!("material {material}");
+        println!(
+            "cpu {cpu}; simd {level}; {} threads; {} samples, median of {} reps; M samples/s",
+            args.threads, args.samples, args.reps
+        );
+        println!(
+            "{:<10} {:>18} {:>12} {:>18} {:>8}",
+            "strategy", "sample+eval+pdf", "sample", "scalar f64 s+e+p", "speedup"
+        );
+        for (s, x, y, z) in results {
+            println!(
+                "{:<10} {x:>18.1} {y:>12.1} {z:>18.1} {:>7.1}x",
+                s.name(),
+                x / z
+            );
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,349 @@
+//! The block loops, instantiated once per level: the portable one, and
+//! `#[target_feature]` entry points for AVX2 + FMA and AVX-512, entered
+//! only with the level's token (proof that the CPU has the features).
+//!
+//! A block is cut into vectors of `L::N` lanes; the last, partial vector is
+//! copied into padded stack buffers, run through the same kernel and copied
+//! back. Lanes never interact, so the numbers of a sample do not depend on
+//! the block size, on where the block was cut, or on the thread.
+
+use super::SimdLevel;
+use super::kernel::{self, GgxParams, Sampled};
+#[cfg(target_arch = "x86_64")]
+use super::lanes::{Avx2, Avx512};
+use super::lanes::{Lanes, Scalar};
+
+/// The widest level's lane count: the size of the tail buffers.
+const MAX_LANES: usize = 16;
+
+/// A level with its token.
+#[derive(Debug, Clone, Copy)]
+pub(crate) enum Backend {
+    Scalar(Scalar),
+    #[cfg(target_arch = "x86_64")]
+    Avx2(Avx2),
+    #[cfg(target_arch = "x86_64")]
+    Avx512(Avx512),
+}
+
+impl Backend {
+    /// The level's token, `None` when the CPU lacks it.
+    pub(crate) fn new(level: SimdLevel) -> Option<Backend> {
+        match level {
+            SimdLevel::Scalar => Some(Backend::Scalar(Scalar)),
+            #[cfg(target_arch = "x86_64")]
+            SimdLevel::Avx2 => Avx2::new().map(Backend::Avx2),
+            #[cfg(target_arch = "x86_64")]
+            SimdLevel::Avx512 => Avx512::new().map(Backend::Avx512),
+            #[cfg(not(target_arch = "x86_64"))]
+            _ => None,
+        }
+    }
+
+    pub(crate) fn level(self) -> SimdLevel {
+        match self {
+            Backend::Scalar(_) => SimdLevel::Scalar,
+            #[cfg(target_arch = "x86_64")]
+            Backend::Avx2(_) => SimdLevel::Avx2,
+            #[cfg(target_arch = "x86_64")]
+            Backend::Avx512(_) => SimdLevel::Avx512,
+        }
+    }
+}
+
+/// Inputs of `sample`: `wo.x, wo.y, wo.z, u1, u2`, all of one length.
+pub(crate) type SampleIn<'a> = [&'a [f32]; 5];
+/// Outputs of `sample`: `wi.xyz, f.rgb, pdf, weight.rgb`, and the mask.
+pub(crate) type SampleOut<'a, 'b> = (&'b mut [&'a mut [f32]; 10], &'b mut [u8]);
+/// Inputs of `eval_pdf`: `wo.xyz, wi.xyz`.
+pub(crate) type EvalIn<'a> = [&'a [f32]; 6];
+/// Outputs of `eval_pdf`: `f.rgb, pdf`.
+pub(crate) type EvalOut<'a, 'b> = &'b mut [&'a mut [f32]; 4];
+
+#[inline(always)]
+fn store_sampled<L: Lanes>(
+    l: L,
+    s: &Sampled<L>,
+    out: &mut [&mut [f32]; 10],
+    valid: &mut [u8],
+    k: usize,
+) {
+    let values = [
+        s.wi[0],
+        s.wi[1],
+        s.wi[2],
+        s.f[0],
+        s.f[1],
+        s.f[2],
+        s.pdf,
+        s.weight[0],
+        s.weight[1],
+        s.weight[2],
+    ];
+    for (o, v) in out.iter_mut().zip(values) {
+        l.store(v, &mut o[k..]);
+    }
+    l.store_mask(s.valid, &mut valid[k..]);
+}
+
+/// One vector of samples from the first `L::N` values of each input.
+#[inline(always)]
+fn run_sample<L: Lanes, const VNDF: bool>(l: L, p: &GgxParams, x: [&[f32]; 5]) -> Sampled<L> {
+    kernel::sample::<L, VNDF>(
+        l,
+        p,
+        [l.load(x[0]), l.load(x[1]), l.load(x[2])],
+        l.load(x[3]),
+        l.load(x[4]),
+    )
+}
+
+/// One vector of `eval_pdf`, stored at `k`.
+#[inline(always)]
+fn run_eval_pdf<L: Lanes, const VNDF: bool>(
+    l: L,
+    p: &GgxParams,
+    x: [&[f32]; 6],
+    out: &mut [&mut [f32]; 4],
+    k: usize,
+) {
+    let wo = [l.load(x[0]), l.load(x[1]), l.load(x[2])];
+    let wi = [l.load(x[3]), l.load(x[4]), l.load(x[5])];
+    let (f, pdf) = kernel::eval_pdf::<L, VNDF>(l, p, wo, wi);
+    l.store(f[0], &mut out[0][k..]);
+    l.store(f[1], &mut out[1][k..]);
+    l.store(f[2], &mut out[2][k..]);
+    l.store(pdf, &mut out[3][k..]);
+}
+
+#[inline(always)]
+fn sample_block<L: Lanes, const VNDF: bool>(
+    l: L,
+    p: &GgxParams,
+    inp: SampleIn<'_>,
+    (out, valid): SampleOut<'_, '_>,
+) {
+    let n = inp[0].len();
+    let mut k = 0;
+    while k + L::N <= n {
+        let s = run_sample::<L, VNDF>(
+            l,
+            p,
+            [
+                &inp[0][k..],
+                &inp[1][k..],
+                &inp[2][k..],
+                &inp[3][k..],
+                &inp[4][k..],
+            ],
+        );
+        store_sampled(l, &s, out, valid, k);
+        k += L::N;
+    }
+    if k < n {
+        let rem = n - k;
+        // Padding: wo = +z, u = 1/2 (a valid, harmless sample).
+        let mut ib = [
+            [0.0f32; MAX_LANES],
+            [0.0; MAX_LANES],
+            [1.0; MAX_LANES],
+            [0.5; MAX_LANES],
+            [0.5; MAX_LANES],
+        ];
+        for (b, s) in ib.iter_mut().zip(inp) {
+            b[..rem].copy_from_slice(&s[k..]);
+        }
+        let s = run_sample::<L, VNDF>(l, p, [&ib[0], &ib[1], &ib[2], &ib[3], &ib[4]]);
+        let mut ob = [[0.0f32; MAX_LANES]; 10];
+        let mut vb = [0u8; MAX_LANES];
+        {
+            let mut refs = ob.each_mut().map(|a| &mut a[..]);
+            store_sampled(l, &s, &mut refs, &mut vb, 0);
+        }
+        for (o, b) in out.iter_mut().zip(&ob) {
+            o[k..].copy_from_slice(&b[..rem]);
+        }
+        valid[k..].copy_from_slice(&vb[..rem]);
+    }
+}
+
+#[inline(always)]
+fn eval_pdf_block<L: Lanes, const VNDF: bool>(
+    l: L,
+    p: &GgxParams,
+    inp: EvalIn<'_>,
+    out: EvalOut<'_, '_>,
+) {
+    let n = inp[0].len();
+    let mut k = 0;
+    while k + L::N <= n {
+        let x = [
+            &inp[0][k..],
+            &inp[1][k..],
+            &inp[2][k..],
+            &inp[3][k..],
+            &inp[4][k..],
+            &inp[5][k..],
+        ];
+        run_eval_pdf::<L, VNDF>(l, p, x, out, k);
+        k += L::N;
+    }
+    if k < n {
+        let rem = n - k;
+        let mut ib = [[0.0f32; MAX_LANES]; 6];
+        ib[2] = [1.0; MAX_LANES];
+        ib[5] = [1.0; MAX_LANES];
+        for (b, s) in ib.iter_mut().zip(inp) {
+            b[..rem].copy_from_slice(&s[k..]);
+        }
+        let mut ob = [[0.0f32; MAX_LANES]; 4];
+        {
+            let mut refs = ob.each_mut().map(|a| &mut a[..]);
+            let x = [
+                &ib[0][..],
+                &ib[1][..],
+                &ib[2][..],
+                &ib[3][..],
+                &ib[4][..],
+                &ib[5][..],
+            ];
+            run_eval_pdf::<L, VNDF>(l, p, x, &mut refs, 0);
+        }
+        for (o, b) in out.iter_mut().zip(&ob) {
+            o[k..].copy_from_slice(&b[..rem]);
+        }
+    }
+}
+
+/// Both strategies of one level: `vndf` picks the instance once per block.
+#[inline(always)]
+fn sample_level<L: Lanes>(
+    l: L,
+    vndf: bool,
+    p: &GgxParams,
+    inp: SampleIn<'_>,
+    out: SampleOut<'_, '_>,
+) {
+    if vndf {
+        sample_block::<L, true>(l, p, inp, out);
+    } else {
+        sample_block::<L, false>(l, p, inp, out);
+    }
+}
+
+#[inline(always)]
+fn eval_pdf_level<L: Lanes>(
+    l: L,
+    vndf: bool,
+    p: &GgxParams,
+    inp: EvalIn<'_>,
+    out: EvalOut<'_, '_>,
+) {
+    if vndf {
+        eval_pdf_block::<L, true>(l, p, inp, out);
+    } else {
+        eval_pdf_block::<L, false>(l, p, inp, out);
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+fn sample_avx2(l: Avx2, vndf: bool, p: &GgxParams, inp: SampleIn<'_>, out: SampleOut<'_, '_>) {
+    sample_level(l, vndf, p, inp, out);
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f,avx512dq,avx512bw,avx512vl,avx2,fma")]
+fn sample_avx512(l: Avx512, vndf: bool, p: &GgxParams, inp: SampleIn<'_>, out: SampleOut<'_, '_>) {
+    sample_level(l, vndf, p, inp, out);
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+fn eval_pdf_avx2(l: Avx2, vndf: bool, p: &GgxParams, inp: EvalIn<'_>, out: EvalOut<'_, '_>) {
+    eval_pdf_level(l, vndf, p, inp, out);
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f,avx512dq,avx512bw,avx512vl,avx2,fma")]
+fn eval_pdf_avx512(l: Avx512, vndf: bool, p: &GgxParams, inp: EvalIn<'_>, out: EvalOut<'_, '_>) {
+    eval_pdf_level(l, vndf, p, inp, out);
+}
+
+/// Run `sample` over a block (lengths already checked equal).
+pub(crate) fn sample(
+    b: Backend,
+    vndf: bool,
+    p: &GgxParams,
+    inp: SampleIn<'_>,
+    out: SampleOut<'_, '_>,
+) {
+    match b {
+        Backend::Scalar(l) => sample_level(l, vndf, p, inp, out),
+        // SAFETY: an `Avx2` token exists only if the CPU has AVX2 and FMA.
+        #[cfg(target_arch = "x86_64")]
+        Backend::Avx2(l) => unsafe { sample_avx2(l, vndf, p, inp, out) },
+        // SAFETY: an `Avx512` token exists only if the CPU has AVX-512F/DQ/BW/VL and FMA
+        // (AVX2 is implied by AVX-512F).
+        #[cfg(target_arch = "x86_64")]
+        Backend::Avx512(l) => unsafe { sample_avx512(l, vndf, p, inp, out) },
+    }
+}
+
+/// Run `eval_pdf` over a block (lengths already checked equal).
+pub(crate) fn eval_pdf(
+    b: Backend,
+    vndf: bool,
+    p: &GgxParams,
+    inp: EvalIn<'_>,
+    out: EvalOut<'_, '_>,
+) {
+    match b {
+        Backend::Scalar(l) => eval_pdf_level(l, vndf, p, inp, out),
+        // SAFETY: an `Avx2` token exists only if the CPU has AVX2 and FMA.
+        #[cfg(target_arch = "x86_64")]
+        Backend::Avx2(l) => unsafe { eval_pdf_avx2(l, vndf, p, inp, out) },
+        // SAFETY: an `Avx512` token exists only if the CPU has AVX-512F/DQ/BW/VL and FMA.
+        #[cfg(target_arch = "x86_64")]
+        Backend::Avx512(l) => unsafe { eval_pdf_avx512(l, vndf, p, inp, out) },
+    }
+}
+
+/// `sincos_turns` over slices at `level` (for the accuracy test).
+#[cfg(test)]
+pub(crate) fn sincos_slice(level: SimdLevel, t: &[f32], s: &mut [f32], c: &mut [f32]) {
+    #[inline(always)]
+    fn run<L: Lanes>(l: L, t: &[f32], s: &mut [f32], c: &mut [f32]) {
+        let mut k = 0;
+        while k + L::N <= t.len() {
+            let (sv, cv) = super::math::sincos_turns(l, l.load(&t[k..]));
+            l.store(sv, &mut s[k..]);
+            l.store(cv, &mut c[k..]);
+            k += L::N;
+        }
+        for k in k..t.len() {
+            let (sv, cv) = super::math::sincos_turns(Scalar, t[k]);
+            s[k] = sv;
+            c[k] = cv;
+        }
+    }
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma")]
+    fn avx2(l: Avx2, t: &[f32], s: &mut [f32], c: &mut [f32]) {
+        run(l, t, s, c);
+    }
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx512f,avx512dq,avx512bw,avx512vl,avx2,fma")]
+    fn avx512(l: Avx512, t: &[f32], s: &mut [f32], c: &mut [f32]) {
+        run(l, t, s, c);
+    }
+    match Backend::new(level).expect("level available") {
+        Backend::Scalar(l) => run(l, t, s, c),
+        // SAFETY: the token proves AVX2 and FMA.
+        #[cfg(target_arch = "x86_64")]
+        Backend::Avx2(l) => unsafe { avx2(l, t, s, c) },
+        // SAFETY: the token proves AVX-512F/DQ/BW/VL and FMA.
+        #[cfg(target_arch = "x86_64")]
+        Backend::Avx512(l) => unsafe { avx512(l, t, s, c) },
+    }
+}

@@ -1,0 +1,460 @@
+//! The lane layer: one small trait, [`Lanes`], over which the batch kernels
+//! are written once, and its three instances: [`Scalar`] (one `f32` lane,
+//! portable), [`Avx2`] (8 lanes, AVX2 + FMA) and [`Avx512`] (16 lanes,
+//! AVX-512F/DQ/BW/VL).
+//!
+//! A level is a zero-sized *token*: `Avx2` and `Avx512` can only be made by
+//! [`Avx2::new`] / [`Avx512::new`], which check the CPU at run time, and
+//! their vector and mask types can only be made through a token (their
+//! fields are private). So wherever a vector value exists, the CPU has the
+//! instructions its operators use: that is the argument of every `SAFETY:`
+//! comment below. The kernels are `#[inline(always)]` generics, instantiated
+//! inside `#[target_feature]` entry points ([`super::dispatch`]) so that the
+//! intrinsics are inlined into code compiled for that level.
+//!
+//! Every operation is exactly rounded IEEE arithmetic (add, mul, fused
+//! multiply-add, div, sqrt, round, compare, select), the same at every
+//! level: the three levels give bit-identical results.
+
+use std::ops::{Add, BitAnd, BitOr, Div, Mul, Neg, Not, Sub};
+
+/// A SIMD width and its operations on `f32` lanes.
+pub(crate) trait Lanes: Copy {
+    /// Number of lanes.
+    const N: usize;
+    /// A vector of `N` `f32`.
+    type F: Copy
+        + Add<Output = Self::F>
+        + Sub<Output = Self::F>
+        + Mul<Output = Self::F>
+        + Div<Output = Self::F>
+        + Neg<Output = Self::F>;
+    /// A mask of `N` lanes.
+    type M: Copy + BitAnd<Output = Self::M> + BitOr<Output = Self::M> + Not<Output = Self::M>;
+
+    fn splat(self, x: f32) -> Self::F;
+    /// The first `N` values of `s` (panics if shorter; the kernels never
+    /// pass a shorter slice).
+    fn load(self, s: &[f32]) -> Self::F;
+    /// Into the first `N` values of `s`.
+    fn store(self, v: Self::F, s: &mut [f32]);
+    /// `1` where the mask is set, `0` elsewhere, into the first `N` bytes.
+    fn store_mask(self, m: Self::M, s: &mut [u8]);
+    /// `a · b + c`, rounded once.
+    fn mul_add(self, a: Self::F, b: Self::F, c: Self::F) -> Self::F;
+    fn sqrt(self, a: Self::F) -> Self::F;
+    fn min(self, a: Self::F, b: Self::F) -> Self::F;
+    fn max(self, a: Self::F, b: Self::F) -> Self::F;
+    /// Round to the nearest integer, ties to even.
+    fn round(self, a: Self::F) -> Self::F;
+    fn floor(self, a: Self::F) -> Self::F;
+    /// `a < b` (false when either is NaN).
+    fn lt(self, a: Self::F, b: Self::F) -> Self::M;
+    /// `a > b` (false when either is NaN).
+    fn gt(self, a: Self::F, b: Self::F) -> Self::M;
+    /// `a == b` (false when either is NaN).
+    fn eq(self, a: Self::F, b: Self::F) -> Self::M;
+    /// `m ? a : b` lane by lane.
+    fn select(self, m: Self::M, a: Self::F, b: Self::F) -> Self::F;
+    fn abs(self, a: Self::F) -> Self::F;
+
+    /// Finite (neither infinite nor NaN).
+    #[inline(always)]
+    fn is_finite(self, a: Self::F) -> Self::M {
+        self.lt(self.abs(a), self.splat(f32::INFINITY))
+    }
+}
+
+// ---------------------------------------------------------------- scalar
+
+/// One `f32` lane in portable Rust: the fallback on any CPU.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Scalar;
+
+impl Lanes for Scalar {
+    const N: usize = 1;
+    type F = f32;
+    type M = bool;
+
+    #[inline(always)]
+    fn splat(self, x: f32) -> f32 {
+        x
+    }
+    #[inline(always)]
+    fn load(self, s: &[f32]) -> f32 {
+        s[0]
+    }
+    #[inline(always)]
+    fn store(self, v: f32, s: &mut [f32]) {
+        s[0] = v;
+    }
+    #[inline(always)]
+    fn store_mask(self, m: bool, s: &mut [u8]) {
+        s[0] = u8::from(m);
+    }
+    #[inline(always)]
+    fn mul_add(self, a: f32, b: f32, c: f32) -> f32 {
+        // Fused, as at the SIMD levels (bit-identical results).
+        a.mul_add(b, c)
+    }
+    #[inline(always)]
+    fn sqrt(self, a: f32) -> f32 {
+        a.sqrt()
+    }
+    #[inline(always)]
+    fn min(self, a: f32, b: f32) -> f32 {
+        // minps semantics: the second operand when either is NaN.
+        if a < b { a } else { b }
+    }
+    #[inline(always)]
+    fn max(self, a: f32, b: f32) -> f32 {
+        if a > b { a } else { b }
+    }
+    #[inline(always)]
+    fn round(self, a: f32) -> f32 {
+        a.round_ties_even()
+    }
+    #[inline(always)]
+    fn floor(self, a: f32) -> f32 {
+        a.floor()
+    }
+    #[inline(always)]
+    fn lt(self, a: f32, b: f32) -> bool {
+        a < b
+    }
+    #[inline(always)]
+    fn gt(self, a: f32, b: f32) -> bool {
+        a > b
+    }
+    #[inline(always)]
+    fn eq(self, a: f32, b: f32) -> bool {
+        a == b
+    }
+    #[inline(always)]
+    fn select(self, m: bool, a: f32, b: f32) -> f32 {
+        if m { a } else { b }
+    }
+    #[inline(always)]
+    fn abs(self, a: f32) -> f32 {
+        a.abs()
+    }
+}
+
+// ---------------------------------------------------------------- x86
+
+#[cfg(target_arch = "x86_64")]
+pub(crate) use x86::{Avx2, Avx512};
+
+#[cfg(target_arch = "x86_64")]
+mod x86 {
+    use super::Lanes;
+    use std::arch::x86_64::*;
+    use std::ops::{Add, BitAnd, BitOr, Div, Mul, Neg, Not, Sub};
+
+    /// Binary operators of a vector type by one intrinsic each.
+    macro_rules! binary_ops {
+        ($ty:ident, $($trait:ident $method:ident $intrinsic:ident),*) => {$(
+            impl $trait for $ty {
+                type Output = $ty;
+                #[inline(always)]
+                fn $method(self, o: $ty) -> $ty {
+                    // SAFETY: a value of this type exists only when its
+                    // level's token was made, i.e. the CPU has the feature.
+                    $ty(unsafe { $intrinsic(self.0, o.0) })
+                }
+            }
+        )*};
+    }
+
+    // ------------------------------------------------------------ AVX2
+
+    /// AVX2 + FMA, 8 lanes. Made only by [`Avx2::new`].
+    #[derive(Debug, Clone, Copy)]
+    pub(crate) struct Avx2(());
+
+    impl Avx2 {
+        /// The token, if this CPU has AVX2 and FMA.
+        #[must_use]
+        pub(crate) fn new() -> Option<Self> {
+            (is_x86_feature_detected!("avx2") && is_x86_feature_detected!("fma"))
+                .then_some(Avx2(()))
+        }
+    }
+
+    #[derive(Clone, Copy)]
+    pub(crate) struct F8(__m256);
+    /// All bits set in a lane that is true.
+    #[derive(Clone, Copy)]
+    pub(crate) struct M8(__m256);
+
+    binary_ops!(F8, Add add _mm256_add_ps, Sub sub _mm256_sub_ps, Mul mul _mm256_mul_ps, Div div _mm256_div_ps);
+    binary_ops!(M8, BitAnd bitand _mm256_and_ps, BitOr bitor _mm256_or_ps);
+
+    impl Neg for F8 {
+        type Output = F8;
+        #[inline(always)]
+        fn neg(self) -> F8 {
+            // SAFETY: F8 exists only with AVX2 (see `Avx2::new`).
+            F8(unsafe { _mm256_xor_ps(self.0, _mm256_set1_ps(-0.0)) })
+        }
+    }
+
+    impl Not for M8 {
+        type Output = M8;
+        #[inline(always)]
+        fn not(self) -> M8 {
+            // SAFETY: M8 exists only with AVX2 (see `Avx2::new`).
+            M8(unsafe { _mm256_xor_ps(self.0, _mm256_castsi256_ps(_mm256_set1_epi32(-1))) })
+        }
+    }
+
+    impl Lanes for Avx2 {
+        const N: usize = 8;
+        type F = F8;
+        type M = M8;
+
+        #[inline(always)]
+        fn splat(self, x: f32) -> F8 {
+            // SAFETY: the token proves AVX2.
+            F8(unsafe { _mm256_set1_ps(x) })
+        }
+        #[inline(always)]
+        fn load(self, s: &[f32]) -> F8 {
+            let s = &s[..8];
+            // SAFETY: the token proves AVX2; `s` holds 8 readable f32.
+            F8(unsafe { _mm256_loadu_ps(s.as_ptr()) })
+        }
+        #[inline(always)]
+        fn store(self, v: F8, s: &mut [f32]) {
+            let s = &mut s[..8];
+            // SAFETY: the token proves AVX2; `s` holds 8 writable f32.
+            unsafe { _mm256_storeu_ps(s.as_mut_ptr(), v.0) }
+        }
+        #[inline(always)]
+        fn store_mask(self, m: M8, s: &mut [u8]) {
+            // SAFETY: the token proves AVX2.
+            let bits = unsafe { _mm256_movemask_ps(m.0) };
+            for (i, b) in s[..8].iter_mut().enumerate() {
+                *b = ((bits >> i) & 1) as u8;
+            }
+        }
+        #[inline(always)]
+        fn mul_add(self, a: F8, b: F8, c: F8) -> F8 {
+            // SAFETY: the token proves FMA.
+            F8(unsafe { _mm256_fmadd_ps(a.0, b.0, c.0) })
+        }
+        #[inline(always)]
+        fn sqrt(self, a: F8) -> F8 {
+            // SAFETY: the token proves AVX2.
+            F8(unsafe { _mm256_sqrt_ps(a.0) })
+        }
+        #[inline(always)]
+        fn min(self, a: F8, b: F8) -> F8 {
+            // SAFETY: the token proves AVX2.
+            F8(unsafe { _mm256_min_ps(a.0, b.0) })
+        }
+        #[inline(always)]
+        fn max(self, a: F8, b: F8) -> F8 {
+            // SAFETY: the token proves AVX2.
+            F8(unsafe { _mm256_max_ps(a.0, b.0) })
+        }
+        #[inline(always)]
+        fn round(self, a: F8) -> F8 {
+            // SAFETY: the token proves AVX2.
+            F8(
+                unsafe {
+                    _mm256_round_ps::<{ _MM_FROUND_TO_NEAREST_INT | _MM_FROUND_NO_EXC }>(a.0)
+                },
+            )
+        }
+        #[inline(always)]
+        fn floor(self, a: F8) -> F8 {
+            // SAFETY: the token proves AVX2.
+            F8(unsafe { _mm256_round_ps::<{ _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC }>(a.0) })
+        }
+        #[inline(always)]
+        fn lt(self, a: F8, b: F8) -> M8 {
+            // SAFETY: the token proves AVX2.
+            M8(unsafe { _mm256_cmp_ps::<_CMP_LT_OQ>(a.0, b.0) })
+        }
+        #[inline(always)]
+        fn gt(self, a: F8, b: F8) -> M8 {
+            // SAFETY: the token proves AVX2.
+            M8(unsafe { _mm256_cmp_ps::<_CMP_GT_OQ>(a.0, b.0) })
+        }
+        #[inline(always)]
+        fn eq(self, a: F8, b: F8) -> M8 {
+            // SAFETY: the token proves AVX2.
+            M8(unsafe { _mm256_cmp_ps::<_CMP_EQ_OQ>(a.0, b.0) })
+        }
+        #[inline(always)]
+        fn select(self, m: M8, a: F8, b: F8) -> F8 {
+            // SAFETY: the token proves AVX2. blendv takes the second
+            // operand where the mask's sign bit is set.
+            F8(unsafe { _mm256_blendv_ps(b.0, a.0, m.0) })
+        }
+        #[inline(always)]
+        fn abs(self, a: F8) -> F8 {
+            // SAFETY: the token proves AVX2.
+            F8(unsafe { _mm256_andnot_ps(_mm256_set1_ps(-0.0), a.0) })
+        }
+    }
+
+    // ------------------------------------------------------------ AVX-512
+
+    /// AVX-512F/DQ/BW/VL, 16 lanes. Made only by [`Avx512::new`].
+    #[derive(Debug, Clone, Copy)]
+    pub(crate) struct Avx512(());
+
+    impl Avx512 {
+        /// The token, if this CPU has AVX-512F, DQ, BW and VL (and FMA).
+        #[must_use]
+        pub(crate) fn new() -> Option<Self> {
+            (is_x86_feature_detected!("avx512f")
+                && is_x86_feature_detected!("avx512dq")
+                && is_x86_feature_detected!("avx512bw")
+                && is_x86_feature_detected!("avx512vl")
+                && is_x86_feature_detected!("fma"))
+            .then_some(Avx512(()))
+        }
+    }
+
+    #[derive(Clone, Copy)]
+    pub(crate) struct F16(__m512);
+    /// One bit per lane.
+    #[derive(Clone, Copy)]
+    pub(crate) struct M16(__mmask16);
+
+    binary_ops!(F16, Add add _mm512_add_ps, Sub sub _mm512_sub_ps, Mul mul _mm512_mul_ps, Div div _mm512_div_ps);
+
+    impl Neg for F16 {
+        type Output = F16;
+        #[inline(always)]
+        fn neg(self) -> F16 {
+            // SAFETY: F16 exists only with AVX-512 (see `Avx512::new`).
+            F16(unsafe {
+                _mm512_castsi512_ps(_mm512_xor_si512(
+                    _mm512_castps_si512(self.0),
+                    _mm512_set1_epi32(i32::MIN),
+                ))
+            })
+        }
+    }
+
+    // Masks are plain bit sets: no intrinsic needed.
+    impl BitAnd for M16 {
+        type Output = M16;
+        #[inline(always)]
+        fn bitand(self, o: M16) -> M16 {
+            M16(self.0 & o.0)
+        }
+    }
+    impl BitOr for M16 {
+        type Output = M16;
+        #[inline(always)]
+        fn bitor(self, o: M16) -> M16 {
+            M16(self.0 | o.0)
+        }
+    }
+    impl Not for M16 {
+        type Output = M16;
+        #[inline(always)]
+        fn not(self) -> M16 {
+            M16(!self.0)
+        }
+    }
+
+    impl Lanes for Avx512 {
+        const N: usize = 16;
+        type F = F16;
+        type M = M16;
+
+        #[inline(always)]
+        fn splat(self, x: f32) -> F16 {
+            // SAFETY: the token proves AVX-512F.
+            F16(unsafe { _mm512_set1_ps(x) })
+        }
+        #[inline(always)]
+        fn load(self, s: &[f32]) -> F16 {
+            let s = &s[..16];
+            // SAFETY: the token proves AVX-512F; `s` holds 16 readable f32.
+            F16(unsafe { _mm512_loadu_ps(s.as_ptr()) })
+        }
+        #[inline(always)]
+        fn store(self, v: F16, s: &mut [f32]) {
+            let s = &mut s[..16];
+            // SAFETY: the token proves AVX-512F; `s` holds 16 writable f32.
+            unsafe { _mm512_storeu_ps(s.as_mut_ptr(), v.0) }
+        }
+        #[inline(always)]
+        fn store_mask(self, m: M16, s: &mut [u8]) {
+            let s = &mut s[..16];
+            // SAFETY: the token proves AVX-512BW and VL; `s` holds 16
+            // writable bytes.
+            unsafe {
+                let v = _mm_maskz_mov_epi8(m.0, _mm_set1_epi8(1));
+                _mm_storeu_si128(s.as_mut_ptr().cast(), v);
+            }
+        }
+        #[inline(always)]
+        fn mul_add(self, a: F16, b: F16, c: F16) -> F16 {
+            // SAFETY: the token proves AVX-512F.
+            F16(unsafe { _mm512_fmadd_ps(a.0, b.0, c.0) })
+        }
+        #[inline(always)]
+        fn sqrt(self, a: F16) -> F16 {
+            // SAFETY: the token proves AVX-512F.
+            F16(unsafe { _mm512_sqrt_ps(a.0) })
+        }
+        #[inline(always)]
+        fn min(self, a: F16, b: F16) -> F16 {
+            // SAFETY: the token proves AVX-512F.
+            F16(unsafe { _mm512_min_ps(a.0, b.0) })
+        }
+        #[inline(always)]
+        fn max(self, a: F16, b: F16) -> F16 {
+            // SAFETY: the token proves AVX-512F.
+            F16(unsafe { _mm512_max_ps(a.0, b.0) })
+        }
+        #[inline(always)]
+        fn round(self, a: F16) -> F16 {
+            // SAFETY: the token proves AVX-512F.
+            F16(unsafe {
+                _mm512_roundscale_ps::<{ _MM_FROUND_TO_NEAREST_INT | _MM_FROUND_NO_EXC }>(a.0)
+            })
+        }
+        #[inline(always)]
+        fn floor(self, a: F16) -> F16 {
+            // SAFETY: the token proves AVX-512F.
+            F16(unsafe {
+                _mm512_roundscale_ps::<{ _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC }>(a.0)
+            })
+        }
+        #[inline(always)]
+        fn lt(self, a: F16, b: F16) -> M16 {
+            // SAFETY: the token proves AVX-512F.
+            M16(unsafe { _mm512_cmp_ps_mask::<_CMP_LT_OQ>(a.0, b.0) })
+        }
+        #[inline(always)]
+        fn gt(self, a: F16, b: F16) -> M16 {
+            // SAFETY: the token proves AVX-512F.
+            M16(unsafe { _mm512_cmp_ps_mask::<_CMP_GT_OQ>(a.0, b.0) })
+        }
+        #[inline(always)]
+        fn eq(self, a: F16, b: F16) -> M16 {
+            // SAFETY: the token proves AVX-512F.
+            M16(unsafe { _mm512_cmp_ps_mask::<_CMP_EQ_OQ>(a.0, b.0) })
+        }
+        #[inline(always)]
+        fn select(self, m: M16, a: F16, b: F16) -> F16 {
+            // SAFETY: the token proves AVX-512F. blend takes the second
+            // operand where the mask bit is set.
+            F16(unsafe { _mm512_mask_blend_ps(m.0, b.0, a.0) })
+        }
+        #[inline(always)]
+        fn abs(self, a: F16) -> F16 {
+            // SAFETY: the token proves AVX-512F.
+            F16(unsafe { _mm512_abs_ps(a.0) })
+        }
+    }
+}
