@@ -911,20 +911,10 @@ impl Figure for Convergence<'_> {
 }
 
 /// The names whose colour is fixed, so that a strategy has the same colour
-/// in every figure.
-const STRATEGY_ORDER: [&str; 11] = [
-    "uniform",
-    "cosine",
-    "brdf",
-    "vndf",
-    "spherical-caps",
-    "bounded-vndf",
-    "light",
-    "mis",
-    "mis-power",
-    "mis-one",
-    "mis-power-one",
-];
+/// in every figure: every strategy lobe knows, in [`lobe::Strategy::all`] order.
+fn strategy_order() -> Vec<String> {
+    lobe::Strategy::all().iter().map(|s| s.name()).collect()
+}
 
 /// Twelve colours that stay apart: Okabe–Ito's seven (yellow left out),
 /// then purple, brown, crimson, olive and indigo.
@@ -947,17 +937,18 @@ const STRATEGY_PALETTE: [RGBColor; 12] = [
 /// the next colour after them in order of first appearance.
 fn strategy_color(names: &[&str], k: usize) -> RGBColor {
     let name = names[k];
-    if let Some(i) = STRATEGY_ORDER.iter().position(|n| *n == name) {
+    let order = strategy_order();
+    if let Some(i) = order.iter().position(|n| n == name) {
         return STRATEGY_PALETTE[i];
     }
     let mut unknown: Vec<&str> = Vec::new();
     for n in names {
-        if !STRATEGY_ORDER.contains(n) && !unknown.contains(n) {
+        if !order.iter().any(|o| o == n) && !unknown.contains(n) {
             unknown.push(n);
         }
     }
     let i = unknown.iter().position(|n| *n == name).unwrap_or(0);
-    STRATEGY_PALETTE[(STRATEGY_ORDER.len() + i) % STRATEGY_PALETTE.len()]
+    STRATEGY_PALETTE[(order.len() + i) % STRATEGY_PALETTE.len()]
 }
 
 // ---------------------------------------------------------------------------
