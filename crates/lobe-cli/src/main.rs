@@ -11,6 +11,7 @@ mod converge;
 mod demo;
 mod estimate;
 mod eval;
+mod eval_batch;
 mod figures;
 mod plot;
 mod render;
