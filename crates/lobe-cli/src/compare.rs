@@ -59,6 +59,10 @@ pub struct CompareArgs {
     /// Seed of the random streams (default: the scene's render.seed)
     #[arg(long)]
     pub seed: Option<u64>,
+    /// Sample pattern of every render: sobol, stratified or independent
+    /// (default: the scene's render.sequence, itself sobol by default)
+    #[arg(long)]
+    pub sequence: Option<String>,
     /// Worker threads (default: one per core)
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=4096))]
     pub threads: Option<u32>,
@@ -772,6 +776,7 @@ pub struct Summary {
     pub width: usize,
     pub height: usize,
     pub seed: u64,
+    pub sequence: &'static str,
     pub max_depth: u32,
     pub reference: ReferenceJson,
     pub equal_samples: Vec<ShotJson>,
@@ -807,6 +812,7 @@ pub fn summary(scene: &str, s: &CompareSettings, cmp: &Comparison, figure: Figur
         width: r.image.width,
         height: r.image.height,
         seed: s.seed,
+        sequence: s.sequence.name(),
         max_depth: s.max_depth,
         reference: ReferenceJson {
             strategy: r.method.name().to_string(),
@@ -885,6 +891,10 @@ pub fn run(args: &CompareArgs) -> Result<()> {
             .reference_spp
             .unwrap_or_else(|| default_reference_spp(spp)),
         seed: args.seed.unwrap_or(scene.options.seed),
+        sequence: match &args.sequence {
+            Some(s) => crate::estimate::parse_sequence(s)?,
+            None => scene.options.sequence,
+        },
         max_depth: scene.options.max_depth,
         threads: args.threads.map(|t| t as usize),
         equal_time: true,

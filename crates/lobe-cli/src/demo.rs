@@ -316,6 +316,7 @@ fn showcase(plan: &DemoSizes, dir: &Path, quiet: bool) -> Result<()> {
         spp: plan.spp,
         reference_spp: plan.reference_spp,
         seed: 1,
+        sequence: Sequence::Sobol,
         max_depth: MAX_DEPTH,
         threads: None,
         equal_time: false,

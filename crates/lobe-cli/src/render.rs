@@ -4,6 +4,7 @@ use crate::common::progress;
 use anyhow::{Result, anyhow, bail};
 use clap::Args;
 use lobe::estimator::Strategy;
+use lobe_render::integrator::render_progressive;
 use lobe_render::{fallbacks, load_scene, render};
 use std::path::PathBuf;
 use std::time::Instant;
@@ -22,8 +23,10 @@ use std::time::Instant;
                   brdf for that object, with a note. max_depth > 1 in the scene adds path tracing.\n\n\
                   Writes NAME.exr (linear RGB, 32-bit float) and NAME.png (scaled by 2^--exposure, \
                   a filmic curve (ACES fit) on luminance that keeps each pixel's hue, sRGB-encoded, \
-                  8 bits). Every pixel has its own random stream, so the image is the same for any \
-                  --threads.",
+                  8 bits). Every pixel has its own randomization of the sample pattern (--sequence: \
+                  Owen-scrambled Sobol by default, in its own dimensions for the pixel position, each \
+                  technique's samples and each bounce), so the image is the same for any --threads. \
+                  --time renders whole passes until the time is up.",
     after_help = "Example:\n  lobe render examples/scene.toml --spp 16 --strategy mis-power --out preview",
     after_long_help = SCENE_HELP
 )]
@@ -39,6 +42,16 @@ pub struct RenderArgs {
     /// Seed of the random streams (overrides the scene's render.seed)
     #[arg(long)]
     pub seed: Option<u64>,
+    /// Sample pattern in every dimension of a pixel's samples: sobol
+    /// (Owen-scrambled, the default), stratified or independent (overrides
+    /// the scene's render.sequence)
+    #[arg(long)]
+    pub sequence: Option<String>,
+    /// Render whole passes of --spp samples per pixel until SECONDS have
+    /// passed (at least one pass), and print the spp reached; the image
+    /// depends only on the number of passes
+    #[arg(long, value_name = "SECONDS")]
+    pub time: Option<f64>,
     /// Worker threads (default: one per core)
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=4096))]
     pub threads: Option<u32>,
@@ -85,6 +98,7 @@ Scene file (TOML; unknown keys are errors; paths are relative to the scene file)
   spp = 64
   strategy = \"mis\"
   seed = 1
+  sequence = \"sobol\"   # sobol (default), stratified or independent
   max_depth = 1        # 1 = direct lighting; more adds bounces
 
 Materials take the keys of `lobe eval --help`.
@@ -92,7 +106,8 @@ Materials take the keys of `lobe eval --help`.
 Examples:
   lobe render examples/scene.toml
   lobe render examples/scene.toml --spp 16 --strategy light --out light-16
-  lobe render examples/scene.toml --threads 1 --seed 7 --quiet";
+  lobe render examples/scene.toml --threads 1 --seed 7 --quiet
+  lobe render examples/scene.toml --spp 4 --time 10 --sequence sobol";
 
 /// The help of `--strategy`: every accepted name.
 fn strategy_help() -> String {
@@ -129,6 +144,14 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     if let Some(s) = args.seed {
         opts.seed = s;
     }
+    if let Some(s) = &args.sequence {
+        opts.sequence = crate::estimate::parse_sequence(s)?;
+    }
+    let budget = match args.time {
+        None => None,
+        Some(t) if t.is_finite() && t > 0.0 && t <= 1e7 => Some(std::time::Duration::from_secs_f64(t)),
+        Some(t) => bail!("--time {t}: must be a number of seconds in (0, 1e7]"),
+    };
     opts.threads = args.threads.map(|t| t as usize);
     scene.options = opts;
     for w in &scene.warnings {
@@ -152,16 +175,31 @@ pub fn run(args: &RenderArgs) -> Result<()> {
                 opts.spp
             )
         })?;
+    if opts.sequence == lobe::sequence::Sequence::Sobol
+        && opts.spp > lobe_render::integrator::SOBOL_MAX_SAMPLES
+    {
+        bail!(
+            "--spp {}: the sobol sequence has 2^32 points per pixel; use fewer spp or --sequence stratified",
+            opts.spp
+        );
+    }
     let pb = progress(total, "rendering", args.quiet);
+    let template = if budget.is_some() {
+        // Passes until the time is up: no known length.
+        "{msg:>12} {spinner} {human_pos} samples, {per_sec}, {elapsed}"
+    } else {
+        "{msg:>12} [{wide_bar}] {human_pos}/{human_len} samples, {per_sec}, {elapsed}<{eta}"
+    };
     pb.set_style(
-        indicatif::ProgressStyle::with_template(
-            "{msg:>12} [{wide_bar}] {human_pos}/{human_len} samples, {per_sec}, {elapsed}<{eta}",
-        )
-        .expect("progress template is valid")
-        .progress_chars("=> "),
+        indicatif::ProgressStyle::with_template(template)
+            .expect("progress template is valid")
+            .progress_chars("=> "),
     );
     let t0 = Instant::now();
-    let image = render(&scene, &opts, |n| pb.inc(n));
+    let image = match budget {
+        None => render(&scene, &opts, |n| pb.inc(n)),
+        Some(b) => render_progressive(&scene, &opts, b, u64::MAX, |n| pb.inc(n)),
+    };
     let secs = t0.elapsed().as_secs_f64();
     pb.finish_and_clear();
     if image.stats.nonfinite > 0 {
@@ -180,11 +218,17 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         },
     )?;
     let samples = image.stats.camera_rays as f64;
+    let passes = image.stats.passes.max(1);
+    let spp = if budget.is_some() {
+        format!("{} spp ({passes} passes of {})", passes * opts.spp, opts.spp)
+    } else {
+        format!("{} spp", opts.spp)
+    };
     println!(
-        "wrote {} and {} ({w}x{h}, {} spp, {}, max_depth {}): {:.2} s, {:.2} M samples/s, {:.2} M rays/s",
+        "wrote {} and {} ({w}x{h}, {spp}, {}, {}, max_depth {}): {:.2} s, {:.2} M samples/s, {:.2} M rays/s",
         exr.display(),
         png.display(),
-        opts.spp,
+        opts.sequence,
         opts.strategy,
         opts.max_depth,
         secs,

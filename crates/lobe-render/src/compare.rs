@@ -45,6 +45,8 @@ pub struct CompareSettings {
     pub spp: u32,
     pub reference_spp: u32,
     pub seed: u64,
+    /// The sample pattern of every render, the reference's included.
+    pub sequence: lobe::sequence::Sequence,
     pub max_depth: u32,
     /// Threads of a local pool; `None` runs on rayon's current pool.
     pub threads: Option<usize>,
@@ -167,6 +169,7 @@ pub fn run_comparison(
             spp: spp.into(),
             strategy: method,
             seed,
+            sequence: s.sequence,
             max_depth: s.max_depth,
             threads: s.threads,
         };

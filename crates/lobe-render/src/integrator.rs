@@ -43,11 +43,26 @@
 //! else `brdf`). Russian roulette starts after the third bounce. With
 //! `max_depth = 1` this is the single-bounce estimator above.
 //!
-//! # Determinism
+//! # Samples and determinism
 //!
-//! Pixel `(x, y)` draws every random number from its own PCG stream, seeded
-//! from `(seed, y · width + x)`, so the image is the same bit for bit for
-//! any thread count and any order of the rows.
+//! Every number a sample uses comes from [`lobe::sequence::pair_point`] in
+//! its own dimension pair ([`dims`]): the position in the pixel, then per
+//! bounce the BSDF sample's direction and lobe choice, the light sample
+//! (multi-sample MIS gives each technique its own dimensions), the
+//! continuation's direction and lobe choice, and Russian roulette. The
+//! pattern ([`RenderOptions::sequence`]) is `sobol` (Owen-scrambled,
+//! padded per pair) by default, or `stratified`, or `independent`. Pixel
+//! `(x, y)` has its own randomization, seeded from `(seed, y · width + x)`,
+//! so the image is the same bit for bit for any thread count and any order
+//! of the rows.
+//!
+//! # Passes
+//!
+//! [`render_pass`] renders pass `p` of `spp` samples per pixel: Sobol and
+//! independent samples `p·spp … (p+1)·spp − 1` of the pixel's sequence, a
+//! fresh stratification for `stratified`. [`render_progressive`] averages
+//! whole passes until a time budget is spent; its image depends only on the
+//! number of passes.
 
 use crate::geometry::{Hit, spawn_ray};
 pub use crate::options::RenderOptions;
@@ -56,11 +71,67 @@ use glam::{DVec2, DVec3};
 use lobe::estimator::{DrawnBsdf, MisForm, ShadingEstimator, ShadingPoint, Strategy, Visibility};
 use lobe::light::Light;
 use lobe::math::Rgb;
-use lobe::sequence::hash64;
+use lobe::sequence::{Sequence, hash64, pair_point};
 use lobe::{BsdfSampler, BsdfStrategy, Frame, Material};
-use rand::RngExt;
-use rand_pcg::Pcg64;
 use rayon::prelude::*;
+use std::time::{Duration, Instant};
+
+/// The dimension pairs of one sample ([`lobe::sequence::pair_point`]).
+pub mod dims {
+    /// The position in the pixel.
+    pub const CAMERA: u32 = 0;
+    /// Pairs per bounce.
+    pub const PER_BOUNCE: u32 = 6;
+    /// The BSDF sample's direction `u` at bounce `b` (from 0).
+    #[must_use]
+    pub const fn bsdf_u(b: u32) -> u32 {
+        1 + PER_BOUNCE * b
+    }
+    /// The BSDF sample's lobe choice `uc` (first coordinate).
+    #[must_use]
+    pub const fn bsdf_uc(b: u32) -> u32 {
+        2 + PER_BOUNCE * b
+    }
+    /// The light sample.
+    #[must_use]
+    pub const fn light(b: u32) -> u32 {
+        3 + PER_BOUNCE * b
+    }
+    /// The continuation's direction, when the estimate drew no BSDF sample.
+    #[must_use]
+    pub const fn next_u(b: u32) -> u32 {
+        4 + PER_BOUNCE * b
+    }
+    /// The continuation's lobe choice (first coordinate).
+    #[must_use]
+    pub const fn next_uc(b: u32) -> u32 {
+        5 + PER_BOUNCE * b
+    }
+    /// Russian roulette (first coordinate).
+    #[must_use]
+    pub const fn roulette(b: u32) -> u32 {
+        6 + PER_BOUNCE * b
+    }
+}
+
+/// One sample of one pixel: where its numbers come from.
+#[derive(Debug, Clone, Copy)]
+struct PixelSample {
+    sequence: Sequence,
+    seed: u64,
+    n: u64,
+    index: u64,
+}
+
+impl PixelSample {
+    fn pair(&self, dim: u32) -> DVec2 {
+        DVec2::from_array(pair_point(self.sequence, self.seed, self.n, self.index, dim))
+    }
+
+    fn one(&self, dim: u32) -> f64 {
+        self.pair(dim).x
+    }
+}
 
 /// Counters of one render.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -72,6 +143,8 @@ pub struct RenderStats {
     /// Path samples whose value was not finite, counted as zero (should
     /// stay 0; a non-zero count is a bug worth reporting).
     pub nonfinite: u64,
+    /// Whole passes of `spp` samples per pixel (1 for [`render`]).
+    pub passes: u64,
 }
 
 /// A linear RGB image, row 0 at the top.
@@ -170,22 +243,94 @@ pub fn fallbacks(scene: &Scene, strategy: Strategy) -> Vec<Fallback> {
         .collect()
 }
 
-/// Render `scene` with `opts`. Rows are rendered in parallel (on a local
+/// The largest spp × passes a Sobol render takes (its sample index is 32
+/// bits).
+pub const SOBOL_MAX_SAMPLES: u64 = 1 << 32;
+
+/// Render `scene` with `opts` (pass 0 of [`render_pass`]). Rows are rendered in parallel (on a local
 /// pool of `opts.threads` threads, else on rayon's current pool), each
 /// written in place; `progress` is called with the number of samples
 /// (camera rays) finished, every few thousand samples of a pixel and at its
 /// end (they add up to `width × height × spp`).
 #[must_use]
 pub fn render(scene: &Scene, opts: &RenderOptions, progress: impl Fn(u64) + Sync) -> Image {
+    render_pass(scene, opts, 0, progress)
+}
+
+/// Pass `pass` of a progressive render: `opts.spp` more samples per pixel
+/// (see the module doc); the mean of passes `0..P` is the image of `P`
+/// passes. Sobol takes `(pass + 1) · spp ≤ 2³²` ([`SOBOL_MAX_SAMPLES`]).
+#[must_use]
+pub fn render_pass(
+    scene: &Scene,
+    opts: &RenderOptions,
+    pass: u64,
+    progress: impl Fn(u64) + Sync,
+) -> Image {
+    on_pool(opts, || render_on_pool(scene, opts, pass, &progress))
+}
+
+fn on_pool<T: Send>(opts: &RenderOptions, f: impl FnOnce() -> T + Send) -> T {
     if let Some(n) = opts.threads
         && let Ok(pool) = rayon::ThreadPoolBuilder::new().num_threads(n).build()
     {
-        return pool.install(|| render_on_pool(scene, opts, &progress));
+        return pool.install(f);
     }
-    render_on_pool(scene, opts, &progress)
+    f()
 }
 
-fn render_on_pool(scene: &Scene, opts: &RenderOptions, progress: &(dyn Fn(u64) + Sync)) -> Image {
+/// Render whole passes of `opts.spp` samples per pixel until `budget` has
+/// passed (at least one pass; never more than `max_passes`), and return
+/// their mean, with the pass count in `stats.passes`. The image depends only
+/// on the pass count: the same count gives the same bits whatever the
+/// thread count or the machine's speed.
+#[must_use]
+pub fn render_progressive(
+    scene: &Scene,
+    opts: &RenderOptions,
+    budget: Duration,
+    max_passes: u64,
+    progress: impl Fn(u64) + Sync,
+) -> Image {
+    let t0 = Instant::now();
+    let max_passes = match opts.sequence {
+        Sequence::Sobol => max_passes.min(SOBOL_MAX_SAMPLES / opts.spp.max(1)),
+        _ => max_passes,
+    }
+    .max(1);
+    on_pool(opts, || {
+        let mut sum = render_on_pool(scene, opts, 0, &progress);
+        let mut passes = 1;
+        // Go on while another pass, at the mean pass time so far, fits.
+        while passes < max_passes {
+            let per_pass = t0.elapsed() / passes as u32;
+            if t0.elapsed() + per_pass > budget {
+                break;
+            }
+            let img = render_on_pool(scene, opts, passes, &progress);
+            for (a, b) in sum.pixels.iter_mut().zip(&img.pixels) {
+                *a += *b;
+            }
+            sum.stats.camera_rays += img.stats.camera_rays;
+            sum.stats.rays += img.stats.rays;
+            sum.stats.nonfinite += img.stats.nonfinite;
+            passes += 1;
+        }
+        let k = 1.0 / passes as f64;
+        for p in &mut sum.pixels {
+            *p *= k;
+        }
+        sum.stats.passes = passes;
+        sum
+    })
+}
+
+fn render_on_pool(
+    scene: &Scene,
+    opts: &RenderOptions,
+    pass: u64,
+    progress: &(dyn Fn(u64) + Sync),
+) -> Image {
     let (w, h) = (scene.camera.width as usize, scene.camera.height as usize);
     let shading: Vec<ObjectShading> = scene
         .objects
@@ -201,6 +346,8 @@ fn render_on_pool(scene: &Scene, opts: &RenderOptions, progress: &(dyn Fn(u64) +
         spp: opts.spp.max(1),
         max_depth: opts.max_depth.max(1),
         seed: opts.seed,
+        sequence: opts.sequence,
+        pass,
         width: w,
     };
     let mut img = Image::new(w, h);
@@ -222,23 +369,16 @@ fn render_on_pool(scene: &Scene, opts: &RenderOptions, progress: &(dyn Fn(u64) +
             camera_rays: a.camera_rays + b.camera_rays,
             rays: a.rays + b.rays,
             nonfinite: a.nonfinite + b.nonfinite,
+            passes: 1,
         });
     img
 }
 
-/// The random stream of pixel `index` for `seed`: a PCG64 whose state and
-/// stream are both hashed from the pair (so that neighbouring pixels'
-/// streams are unrelated).
+/// The randomization of pixel `index` for `seed` (hashed, so that
+/// neighbouring pixels' patterns are unrelated).
 #[must_use]
-pub fn pixel_rng(seed: u64, index: u64) -> Pcg64 {
-    let a = hash64(seed ^ 0x6c6f_6265_7265_6e64);
-    let b = hash64(index ^ a.rotate_left(23));
-    let c = hash64(b ^ 0x9e37_79b9_7f4a_7c15);
-    let d = hash64(a ^ c);
-    Pcg64::new(
-        (u128::from(a) << 64) | u128::from(b),
-        (u128::from(c) << 64) | u128::from(d ^ index),
-    )
+pub fn pixel_seed(seed: u64, index: u64) -> u64 {
+    hash64(hash64(seed ^ 0x6c6f_6265_7265_6e64) ^ hash64(index))
 }
 
 /// Progress is reported every this many samples of a pixel (and at its end).
@@ -252,6 +392,8 @@ struct Context<'a> {
     spp: u64,
     max_depth: u32,
     seed: u64,
+    sequence: Sequence,
+    pass: u64,
     width: usize,
 }
 
@@ -283,14 +425,30 @@ impl Visibility for SceneVisibility<'_> {
 
 impl Context<'_> {
     fn pixel(&self, x: usize, y: usize, stats: &mut RenderStats) -> Rgb {
-        let mut rng = pixel_rng(self.seed, (y * self.width + x) as u64);
+        let pixel_seed = pixel_seed(self.seed, (y * self.width + x) as u64);
         let mut sum = Rgb::ZERO;
         let mut pending = 0u64;
-        for _ in 0..self.spp {
-            let (jx, jy): (f64, f64) = (rng.random(), rng.random());
-            let ray = self.scene.camera.ray(x as f64 + jx, y as f64 + jy);
+        for i in 0..self.spp {
+            let ps = match self.sequence {
+                // A fresh stratification per pass.
+                Sequence::Stratified => PixelSample {
+                    sequence: self.sequence,
+                    seed: hash64(pixel_seed ^ hash64(self.pass)),
+                    n: self.spp,
+                    index: i,
+                },
+                // The pixel's one sequence goes on.
+                Sequence::Sobol | Sequence::Independent => PixelSample {
+                    sequence: self.sequence,
+                    seed: pixel_seed,
+                    n: self.spp,
+                    index: self.pass * self.spp + i,
+                },
+            };
+            let j = ps.pair(dims::CAMERA);
+            let ray = self.scene.camera.ray(x as f64 + j.x, y as f64 + j.y);
             stats.camera_rays += 1;
-            let v = self.radiance(ray, &mut rng, stats);
+            let v = self.radiance(ray, &ps, stats);
             if v.is_finite() {
                 sum += v;
             } else {
@@ -309,7 +467,7 @@ impl Context<'_> {
     }
 
     /// Radiance arriving along a camera ray.
-    fn radiance(&self, ray: crate::geometry::Ray, rng: &mut Pcg64, stats: &mut RenderStats) -> Rgb {
+    fn radiance(&self, ray: crate::geometry::Ray, ps: &PixelSample, stats: &mut RenderStats) -> Rgb {
         stats.rays += 1;
         let Some((mut hit, mut obj)) = self.scene.intersect(&ray, f64::INFINITY) else {
             return self.light.radiance(ray.dir);
@@ -350,15 +508,22 @@ impl Context<'_> {
             // sample's (lobe choice, direction).
             let k = strategy.points_per_sample();
             debug_assert!(k <= points.len());
+            let b = depth - 1;
+            let bsdf_point = || {
+                let u = ps.pair(dims::bsdf_u(b));
+                [ps.one(dims::bsdf_uc(b)), u.x, u.y]
+            };
+            let light_point = || {
+                let u = ps.pair(dims::light(b));
+                [0.0, u.x, u.y]
+            };
             match strategy {
-                Strategy::Light => {
-                    points[0] = [0.0, rng.random(), rng.random()];
-                }
+                Strategy::Light => points[0] = light_point(),
                 Strategy::Mis(m) if m.form == MisForm::MultiSample => {
-                    points[1] = [0.0, rng.random(), rng.random()];
-                    points[0] = [rng.random(), rng.random(), rng.random()];
+                    points[1] = light_point();
+                    points[0] = bsdf_point();
                 }
-                _ => points[0] = [rng.random(), rng.random(), rng.random()],
+                _ => points[0] = bsdf_point(),
             }
             let mut vis = SceneVisibility {
                 scene: self.scene,
@@ -376,8 +541,8 @@ impl Context<'_> {
             // Continue with the estimate's BSDF sample, or draw one (light
             // sampling alone, or one-sample MIS that chose the light).
             let drawn = e.bsdf.or_else(|| {
-                let uc: f64 = rng.random();
-                let u = DVec2::new(rng.random(), rng.random());
+                let uc = ps.one(dims::next_uc(b));
+                let u = ps.pair(dims::next_u(b));
                 let s = shading.continuation.sample(wo, uc, u)?;
                 let dir = frame.to_world(s.wi);
                 let escaped = vis.escapes(dir);
@@ -399,7 +564,7 @@ impl Context<'_> {
             if depth > 3 {
                 // Russian roulette after the third bounce.
                 let q = beta.max_element().min(0.95);
-                if q <= 0.0 || rng.random::<f64>() >= q {
+                if q <= 0.0 || ps.one(dims::roulette(b)) >= q {
                     break;
                 }
                 beta /= q;

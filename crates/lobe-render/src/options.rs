@@ -1,8 +1,10 @@
-//! What to render with: samples per pixel, the technique, the seed, the path
+//! What to render with: samples per pixel, the technique, the seed, the
+//! sample sequence, the path
 //! depth and the thread count. A scene file's `[render]` table sets them
 //! ([`crate::scene`]); the renderer ([`crate::render()`]) reads them.
 
 use lobe::estimator::{Heuristic, Strategy};
+use lobe::sequence::Sequence;
 
 /// Render settings.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -14,6 +16,9 @@ pub struct RenderOptions {
     /// on the material's best BSDF strategy.
     pub strategy: Strategy,
     pub seed: u64,
+    /// How each pixel's samples are placed in every dimension the
+    /// integrator draws ([`lobe::sequence::pair_point`]); Sobol by default.
+    pub sequence: Sequence,
     /// 1 = direct lighting; more adds bounces. At least 1.
     pub max_depth: u32,
     /// Threads of a local pool; `None` runs on rayon's current pool.
@@ -26,6 +31,7 @@ impl Default for RenderOptions {
             spp: 64,
             strategy: Strategy::mis(Heuristic::Balance),
             seed: 1,
+            sequence: Sequence::Sobol,
             max_depth: 1,
             threads: None,
         }

@@ -27,6 +27,7 @@
 //! spp = 64
 //! strategy = "mis"    # a BSDF strategy, light, mis or mis-power
 //! seed = 1
+//! sequence = "sobol"  # sobol, stratified or independent
 //! max_depth = 1       # 1 = direct lighting
 //! ```
 
@@ -328,6 +329,8 @@ pub struct RenderDesc {
     pub strategy: String,
     #[serde(default = "default_seed")]
     pub seed: u64,
+    #[serde(default = "default_sequence")]
+    pub sequence: String,
     #[serde(default = "default_depth")]
     pub max_depth: u32,
 }
@@ -341,6 +344,9 @@ fn default_strategy() -> String {
 fn default_seed() -> u64 {
     1
 }
+fn default_sequence() -> String {
+    "sobol".into()
+}
 fn default_depth() -> u32 {
     1
 }
@@ -351,6 +357,7 @@ impl Default for RenderDesc {
             spp: default_spp(),
             strategy: default_strategy(),
             seed: default_seed(),
+            sequence: default_sequence(),
             max_depth: default_depth(),
         }
     }
@@ -619,11 +626,17 @@ fn build(desc: &SceneDesc, base: &Path) -> FieldResult<Scene> {
         .parse()
         .map_err(|e: lobe::Error| (render_field("strategy"), e.to_string()))?;
 
+    let sequence: lobe::sequence::Sequence = r
+        .sequence
+        .parse()
+        .map_err(|e: lobe::Error| (render_field("sequence"), e.to_string()))?;
+
     let mut scene = Scene::new(camera, map);
     scene.options = RenderOptions {
         spp: r.spp,
         strategy,
         seed: r.seed,
+        sequence,
         max_depth: r.max_depth,
         threads: None,
     };

@@ -144,6 +144,7 @@ fn a_comparison_under_a_fake_clock() {
         spp: 2,
         reference_spp: 16,
         seed: 9,
+        sequence: lobe::sequence::Sequence::Sobol,
         max_depth: 1,
         threads: Some(1),
         equal_time: true,

@@ -19,6 +19,7 @@ fn opts(method: Strategy, spp: u64) -> RenderOptions {
         spp,
         strategy: method,
         seed: 3,
+        sequence: lobe::sequence::Sequence::Sobol,
         max_depth: 1,
         threads: None,
     }
@@ -237,6 +238,99 @@ fn techniques_agree_pixel_by_pixel() {
         };
         let (m, se) = mean_se(&diff, &px, lobe::math::luminance);
         assert!(m.abs() < 4.5 * se, "{method}: mean difference {m} ± {se}");
+    }
+}
+
+/// The scene of `techniques_agree_pixel_by_pixel`: a GGX sphere with a
+/// diffuse term on a Lambertian plane under a smooth sky; and its covered
+/// pixels.
+fn sphere_on_plane() -> (Scene, Vec<(usize, usize)>) {
+    let ggx = MaterialDesc::from_json(
+        r#"{"type":"cook-torrance","distribution":"ggx","alpha":0.25,"kd":0.3}"#,
+    )
+    .unwrap()
+    .build()
+    .unwrap();
+    let camera = Camera::new(
+        DVec3::new(0.0, 1.0, 3.0),
+        DVec3::new(0.0, 0.6, 0.0),
+        DVec3::Y,
+        40.0,
+        24,
+        20,
+    )
+    .unwrap();
+    let scene = Scene::new(camera, smooth_env())
+        .with(Object::sphere(DVec3::new(0.0, 0.6, 0.0), 0.6, ggx).unwrap())
+        .with(Object::plane(DVec3::ZERO, DVec3::Y, lambert(0.5)).unwrap());
+    let mut px = covered(&scene, 0);
+    px.extend(covered(&scene, 1));
+    (scene, px)
+}
+
+/// Issue 10: every sequence is unbiased, and at equal spp the stratified
+/// and Sobol patterns have less error than independent samples (measured:
+/// 0.67× and 0.60× the RMSE of independent at 64 spp, seed 5; the
+/// visibility edges and the sphere's outline limit the gain).
+#[test]
+fn every_sequence_is_unbiased_and_qmc_has_less_error() {
+    use lobe::sequence::Sequence;
+    let (scene, px) = sphere_on_plane();
+    let mut r = opts(Strategy::mis(Heuristic::Balance), 2048);
+    r.seed = 99;
+    let reference = render(&scene, &r, |_| {});
+    let err = |img: &Image| -> (f64, f64, f64) {
+        let d: Vec<f64> = px
+            .iter()
+            .map(|&(x, y)| lobe::math::luminance(img.get(x, y) - reference.get(x, y)))
+            .collect();
+        let n = d.len() as f64;
+        let m = d.iter().sum::<f64>() / n;
+        let var = d.iter().map(|x| (x - m) * (x - m)).sum::<f64>() / (n - 1.0);
+        let rmse = (d.iter().map(|x| x * x).sum::<f64>() / n).sqrt();
+        (m, (var / n).sqrt(), rmse)
+    };
+    let mut rmse = Vec::new();
+    for seq in Sequence::ALL {
+        let mut o = opts(Strategy::mis(Heuristic::Balance), 64);
+        o.seed = 5;
+        o.sequence = seq;
+        let (m, se, e) = err(&render(&scene, &o, |_| {}));
+        eprintln!("{seq}: mean difference {m:.2e} ± {se:.2e}, rmse {e:.4}");
+        assert!(m.abs() < 4.5 * se, "{seq}: mean difference {m} ± {se}");
+        rmse.push(e);
+    }
+    let [indep, strat, sobol] = rmse[..] else {
+        unreachable!()
+    };
+    assert!(strat < 0.85 * indep, "stratified {strat} vs independent {indep}");
+    assert!(sobol < 0.8 * indep, "sobol {sobol} vs independent {indep}");
+}
+
+/// `render_progressive` returns the mean of whole passes, the same bits as
+/// averaging `render_pass` 0, 1, 2 by hand, whatever the time it was given.
+#[test]
+fn progressive_passes_are_reproducible() {
+    use lobe::sequence::Sequence;
+    use lobe_render::integrator::{render_pass, render_progressive};
+    let (scene, _) = sphere_on_plane();
+    for seq in Sequence::ALL {
+        let mut o = opts(Strategy::mis(Heuristic::Balance), 2);
+        o.sequence = seq;
+        o.max_depth = 3;
+        let hour = std::time::Duration::from_secs(3600);
+        let p = render_progressive(&scene, &o, hour, 3, |_| {});
+        assert_eq!(p.stats.passes, 3);
+        let passes: Vec<Image> = (0..3).map(|k| render_pass(&scene, &o, k, |_| {})).collect();
+        assert_ne!(passes[0].pixels, passes[1].pixels, "{seq}: passes differ");
+        for (i, px) in p.pixels.iter().enumerate() {
+            let mean = (passes[0].pixels[i] + passes[1].pixels[i] + passes[2].pixels[i]) * (1.0 / 3.0);
+            assert_eq!(*px, mean, "{seq}: pixel {i}");
+        }
+        // A tiny budget still gives one whole pass.
+        let one = render_progressive(&scene, &o, std::time::Duration::ZERO, 100, |_| {});
+        assert_eq!(one.stats.passes, 1);
+        assert_eq!(one.pixels, passes[0].pixels);
     }
 }
 

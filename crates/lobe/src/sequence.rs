@@ -281,9 +281,114 @@ pub fn permute(i: u64, n: u64, seed: u32) -> u64 {
     }
 }
 
+/// Point `index` of an `n`-point pattern in dimension pair `dim`, for an
+/// integrator that draws many dimensions per sample (a renderer's pixel:
+/// the lens position, then per bounce the BSDF's direction and lobe choice,
+/// the light sample, the path's continuation, Russian roulette).
+///
+/// Each pair is its own randomization of a 2D pattern, decorrelated from
+/// every other pair by its own shuffle of the sample index (the "padding"
+/// of Burley 2020, §4), so that every pair is as well distributed as a 2D
+/// pattern alone, for every `n`:
+/// * [`Sequence::Independent`]: hashed uniform numbers (a function of
+///   `(seed, dim, index)`, so any sample can be drawn in any order);
+/// * [`Sequence::Stratified`]: one jittered point per cell of an `nx × ny`
+///   grid ([`grid_shape`]) in a per-pair random order, or a Latin hypercube
+///   where `n` has no such grid;
+/// * [`Sequence::Sobol`]: Sobol dimensions 1 and 2 (a (0, 2)-sequence),
+///   the index shuffled and each coordinate Owen-scrambled per pair
+///   (Burley's hash-based nested uniform scramble). Indices beyond `n` go
+///   on with the same sequence (progressive rendering); `index` must be
+///   below 2³².
+///
+/// `seed` selects the randomization (one per pixel); `n` matters only to
+/// `Stratified`. The numbers are in [0, 1).
+#[must_use]
+pub fn pair_point(seq: Sequence, seed: u64, n: u64, index: u64, dim: u32) -> [f64; 2] {
+    let s = hash64(seed ^ hash64(0x7061_6972_0000_0000 ^ u64::from(dim)));
+    let unit = |bits: u64| (bits >> 11) as f64 * (1.0 / (1u64 << 53) as f64);
+    match seq {
+        Sequence::Independent => {
+            let a = hash64(s ^ hash64(index));
+            [unit(a), unit(hash64(a ^ 0x5eed))]
+        }
+        Sequence::Stratified => {
+            let n = n.max(1);
+            debug_assert!(index < n);
+            let j = hash64(s ^ hash64(index ^ 0x6a69_7474_6572));
+            let (jx, jy) = (unit(j), unit(hash64(j)));
+            let (nx, ny) = grid_shape(n as usize);
+            let (x, y) = if nx > 0 {
+                let cell = permute(index, n, s as u32);
+                let (cx, cy) = (cell % nx as u64, cell / nx as u64);
+                ((cx as f64 + jx) / nx as f64, (cy as f64 + jy) / ny as f64)
+            } else {
+                let px = permute(index, n, s as u32);
+                let py = permute(index, n, (s >> 32) as u32);
+                ((px as f64 + jx) / n as f64, (py as f64 + jy) / n as f64)
+            };
+            [x.min(ONE_MINUS_EPS), y.min(ONE_MINUS_EPS)]
+        }
+        Sequence::Sobol => {
+            debug_assert!(index <= u64::from(u32::MAX));
+            let i = nested_uniform_scramble(index as u32, s as u32);
+            let x = nested_uniform_scramble(sobol(i, 0), (s >> 32) as u32);
+            let y = nested_uniform_scramble(sobol(i, 1), hash64(s) as u32);
+            let k = 1.0 / 4_294_967_296.0;
+            [f64::from(x) * k, f64::from(y) * k]
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The pairs of [`pair_point`]: every coordinate in [0, 1); Sobol's
+    /// first 2^k points of a pair put one point in each of the 2^k
+    /// elementary intervals of every shape (a (0, k, 2)-net), and two pairs
+    /// are decorrelated (their joint 2D projection is not a net).
+    #[test]
+    fn pair_points_are_nets_per_pair_and_decorrelated_across_pairs() {
+        let n = 256u64;
+        for seq in Sequence::ALL {
+            for i in 0..n {
+                for d in 0..4 {
+                    let p = pair_point(seq, 7, n, i, d);
+                    assert!(p.iter().all(|x| (0.0..1.0).contains(x)), "{seq} {p:?}");
+                }
+            }
+        }
+        let pts: Vec<[f64; 2]> = (0..n).map(|i| pair_point(Sequence::Sobol, 3, n, i, 5)).collect();
+        for kx in 0..=8u32 {
+            let (bx, by) = (1u64 << kx, 1u64 << (8 - kx));
+            let mut cells = vec![0u32; 256];
+            for p in &pts {
+                let cx = (p[0] * bx as f64) as u64;
+                let cy = (p[1] * by as f64) as u64;
+                cells[(cy * bx + cx) as usize] += 1;
+            }
+            assert!(cells.iter().all(|&c| c == 1), "shape {bx}x{by}");
+        }
+        // Stratified: one point per cell of the 16 × 16 grid.
+        let mut cells = vec![0u32; 256];
+        for i in 0..n {
+            let p = pair_point(Sequence::Stratified, 3, n, i, 2);
+            cells[(p[1] * 16.0) as usize * 16 + (p[0] * 16.0) as usize] += 1;
+        }
+        assert!(cells.iter().all(|&c| c == 1));
+        // Across pairs: x of pair 0 against x of pair 1 is not a net in 16 × 16.
+        let mut cells = vec![0u32; 256];
+        for i in 0..n {
+            let a = pair_point(Sequence::Sobol, 3, n, i, 0)[0];
+            let b = pair_point(Sequence::Sobol, 3, n, i, 1)[0];
+            cells[(b * 16.0) as usize * 16 + (a * 16.0) as usize] += 1;
+        }
+        assert!(cells.iter().any(|&c| c != 1), "pairs 0 and 1 are correlated");
+        // Progressive: the sequence goes on past n.
+        let later = pair_point(Sequence::Sobol, 3, n, 300, 5);
+        assert!(later.iter().all(|x| (0.0..1.0).contains(x)));
+    }
 
     #[test]
     fn sobol_first_points_are_the_known_ones() {
