@@ -17,7 +17,7 @@ use crate::compare::{
 use anyhow::{Context, Result};
 use clap::Args;
 use glam::DVec3;
-use lobe::estimator::{Heuristic, Strategy};
+use lobe::estimator::Strategy;
 use lobe::experiment::table::{TableSettings, run_table};
 use lobe::math::luminance;
 use lobe::progress::SystemClock;
@@ -311,7 +311,7 @@ fn showcase(plan: &DemoSizes, dir: &Path, quiet: bool) -> Result<()> {
         methods: vec![
             Strategy::Bsdf(BsdfStrategy::Brdf),
             Strategy::Light,
-            Strategy::mis(Heuristic::Balance),
+            Strategy::MIS,
         ],
         spp: plan.spp,
         reference_spp: plan.reference_spp,

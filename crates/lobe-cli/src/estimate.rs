@@ -77,15 +77,16 @@ pub struct EstimateArgs {
 #[must_use]
 pub fn strategy_help() -> String {
     format!(
-        "`all` or a comma-separated list of: {} (all: every BSDF strategy that applies, light, mis, mis-power)",
+        "`all` or a comma-separated list of: {} (all: every BSDF strategy that applies, light, mis, mis-balance, mis-power). mis (the default MIS) gives each sample's draws to BSDF sampling, to the balance heuristic or to light sampling, whichever a pilot of its own samples says has the least variance; mis-balance and mis-power are multi-sample MIS with those heuristics; mis-one and mis-power-one one-sample MIS",
         Strategy::names()
     )
 }
 
 /// Parse `all` or a list of technique names: the BSDF strategies
 /// (uniform, cosine, brdf, vndf, spherical-caps, bounded-vndf), `light`,
-/// and MIS: `mis` (balance) and `mis-power`, multi-sample, or `mis-one` and
-/// `mis-power-one`, one-sample. Each is checked against the material.
+/// and MIS: `mis` (adaptive), `mis-balance` and `mis-power`, multi-sample,
+/// or `mis-one` and `mis-power-one`, one-sample. Each is checked against the
+/// material.
 pub fn parse_strategies(
     spec: &str,
     m: &Material,
@@ -106,6 +107,7 @@ pub fn parse_strategies(
         let mut v: Vec<Strategy> = m.strategies().into_iter().map(Strategy::from).collect();
         v.extend([
             Strategy::Light,
+            mis(Heuristic::Balance, MisForm::Adaptive),
             mis(Heuristic::Balance, MisForm::MultiSample),
             mis(Heuristic::Power, MisForm::MultiSample),
         ]);
@@ -115,15 +117,17 @@ pub fn parse_strategies(
     for name in spec.split(',').map(str::trim) {
         let t = match name {
             "light" => Strategy::Light,
-            "mis" => mis(Heuristic::Balance, MisForm::MultiSample),
+            "mis" => mis(Heuristic::Balance, MisForm::Adaptive),
+            "mis-balance" => mis(Heuristic::Balance, MisForm::MultiSample),
             "mis-power" => mis(Heuristic::Power, MisForm::MultiSample),
             "mis-one" => mis(Heuristic::Balance, MisForm::OneSample),
             "mis-power-one" => mis(Heuristic::Power, MisForm::OneSample),
             _ => {
                 let s: BsdfStrategy = name.parse().map_err(|_| {
                     anyhow::anyhow!(
-                        "--strategy: unknown strategy `{name}`, expected all or a list of: {}, light, mis, mis-power, mis-one, mis-power-one",
-                        BsdfStrategy::names()
+                        "--strategy: unknown strategy `{name}`, expected all or a list of: {}, {}",
+                        BsdfStrategy::names(),
+                        lobe::estimator::NON_BSDF_NAMES.join(", ")
                     )
                 })?;
                 m.check(s).map_err(|e| anyhow::anyhow!("--strategy: {e}"))?;

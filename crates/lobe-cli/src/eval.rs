@@ -496,7 +496,11 @@ pub(crate) enum Request {
 
 impl Query {
     /// Check the keys present, the vectors and the strategy.
-    pub(crate) fn check(self, material: &Material, strategies: &[BsdfStrategy]) -> Result<Request, String> {
+    pub(crate) fn check(
+        self,
+        material: &Material,
+        strategies: &[BsdfStrategy],
+    ) -> Result<Request, String> {
         const KINDS: &str = "an eval line has wo and wi; a sample line has wo, u, strategy, and uc where the material has two lobes";
         let wo = self
             .wo

@@ -129,8 +129,14 @@ pub fn process_batch<R: BufRead, W: Write>(
                         push3(&mut evals.b, wi);
                         if places.len() == BLOCK {
                             run_block(
-                                material, &strategies, &keys, &mut samplers, &mut evals,
-                                &mut samples, &mut places, out,
+                                material,
+                                &strategies,
+                                &keys,
+                                &mut samplers,
+                                &mut evals,
+                                &mut samples,
+                                &mut places,
+                                out,
                             )?;
                         }
                         continue;
@@ -155,8 +161,14 @@ pub fn process_batch<R: BufRead, W: Write>(
                         c.uc.push(unit_f32(uc));
                         if places.len() == BLOCK {
                             run_block(
-                                material, &strategies, &keys, &mut samplers, &mut evals,
-                                &mut samples, &mut places, out,
+                                material,
+                                &strategies,
+                                &keys,
+                                &mut samplers,
+                                &mut evals,
+                                &mut samples,
+                                &mut places,
+                                out,
                             )?;
                         }
                         continue;
@@ -170,7 +182,13 @@ pub fn process_batch<R: BufRead, W: Write>(
         };
         // End of input or a bad line: answer the lines before it first.
         run_block(
-            material, &strategies, &keys, &mut samplers, &mut evals, &mut samples, &mut places,
+            material,
+            &strategies,
+            &keys,
+            &mut samplers,
+            &mut evals,
+            &mut samples,
+            &mut places,
             out,
         )?;
         return match stop {
@@ -320,7 +338,9 @@ fn run_block<W: Write>(
                 if !(wi.iter().chain(&w).all(|x| x.is_finite()) && p.is_finite()) {
                     return Err(Failure::Line(
                         c.line[i],
-                        format!("the sample is not finite in f32 (wi {wi:?}, pdf {p}, weight {w:?})"),
+                        format!(
+                            "the sample is not finite in f32 (wi {wi:?}, pdf {p}, weight {w:?})"
+                        ),
                     ));
                 }
                 out.write_all(b"{\"wi\":")?;

@@ -149,7 +149,9 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     }
     let budget = match args.time {
         None => None,
-        Some(t) if t.is_finite() && t > 0.0 && t <= 1e7 => Some(std::time::Duration::from_secs_f64(t)),
+        Some(t) if t.is_finite() && t > 0.0 && t <= 1e7 => {
+            Some(std::time::Duration::from_secs_f64(t))
+        }
         Some(t) => bail!("--time {t}: must be a number of seconds in (0, 1e7]"),
     };
     opts.threads = args.threads.map(|t| t as usize);
@@ -220,7 +222,11 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let samples = image.stats.camera_rays as f64;
     let passes = image.stats.passes.max(1);
     let spp = if budget.is_some() {
-        format!("{} spp ({passes} passes of {})", passes * opts.spp, opts.spp)
+        format!(
+            "{} spp ({passes} passes of {})",
+            passes * opts.spp,
+            opts.spp
+        )
     } else {
         format!("{} spp", opts.spp)
     };

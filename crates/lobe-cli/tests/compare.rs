@@ -91,8 +91,9 @@ fn writes_the_grid_and_the_numbers() {
         (j["width"].as_u64(), j["height"].as_u64()),
         (Some(48), Some(32))
     );
-    // The default strategies: brdf, vndf (the sphere has it), light, mis.
-    let want = ["brdf", "vndf", "light", "mis"];
+    // The default strategies: brdf, vndf (the sphere has it), light, and the
+    // three MIS side by side.
+    let want = ["brdf", "vndf", "light", "mis-balance", "mis-power", "mis"];
     let mut rmse = std::collections::HashMap::new();
     for section in ["equal_samples", "equal_time"] {
         let rows = j[section]

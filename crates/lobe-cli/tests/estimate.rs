@@ -74,6 +74,7 @@ fn json_has_every_field_and_estimates_agree_with_the_reference() {
             "bounded-vndf",
             "light",
             "mis",
+            "mis-balance",
             "mis-power"
         ]
     );

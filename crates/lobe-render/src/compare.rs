@@ -101,7 +101,12 @@ pub fn default_methods(scene: &Scene) -> Vec<Strategy> {
     {
         v.push(Strategy::Bsdf(BsdfStrategy::Vndf));
     }
-    v.extend([Strategy::Light, Strategy::mis(Heuristic::Balance)]);
+    v.extend([
+        Strategy::Light,
+        Strategy::mis(Heuristic::Balance),
+        Strategy::mis(Heuristic::Power),
+        Strategy::MIS,
+    ]);
     v
 }
 
@@ -181,9 +186,7 @@ pub fn run_comparison(
         .map(|&m| shot(m, spp, s.seed, ""))
         .collect();
     let equal_time = s.equal_time.then(|| {
-        let mis = equal_samples
-            .iter()
-            .find(|x| x.method == Strategy::mis(Heuristic::Balance));
+        let mis = equal_samples.iter().find(|x| x.method == Strategy::MIS);
         let (budget_s, budget_from) = match mis {
             Some(x) => (x.time_s, format!("the time of mis at {spp} spp")),
             None => {

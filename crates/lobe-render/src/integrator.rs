@@ -11,20 +11,30 @@
 //! * **BSDF sampling** with a strategy `s`: draw `wi ~ p_s`, trace a ray;
 //!   if it escapes, `f L cos / p_s`, else 0 (the environment is the only
 //!   light). A failed sample (below the horizon) counts as 0.
-//! * **Light sampling** ([`EnvMap::sample`]): draw a world direction with
+//! * **Light sampling** ([`lobe::envmap::EnvMap::sample`]): draw a world direction with
 //!   density ∝ the map's luminance, take it to the local frame; below the
 //!   horizon it is a failed sample; otherwise a shadow ray, and
 //!   `f L cos / p_light` when it escapes.
 //! * **MIS** (Veach's multi-sample form with one sample per strategy):
 //!   both of the above, each weighted by the balance heuristic
-//!   `p_t / (p_b + p_l)` (`mis`) or the power heuristic
+//!   `p_t / (p_b + p_l)` (`mis-balance`) or the power heuristic
 //!   `p_t² / (p_b² + p_l²)` (`mis-power`), where the BSDF strategy is
 //!   `vndf` when the material has it, else `brdf`, and the light strategy
 //!   draws from the MIS-compensated distribution
-//!   ([`EnvMap::sample_compensated`], density ∝ `max(0, lum − mean)`), as
-//!   `lobe`'s estimator does ([`lobe::Light::sample_mis`]).
+//!   ([`lobe::envmap::EnvMap::sample_compensated`], density ∝ `max(0, lum − mean)`), as
+//!   `lobe`'s estimator does ([`lobe::Light::sample`] with [`lobe::light::LightDistribution::Compensated`]).
 //!
-//! This is [`lobe::estimator::technique_value`] with a shadow ray added.
+//! * **Adaptive MIS** (`mis`, the default): the same two draws per sample,
+//!   given at the first bounce to BSDF sampling, the balance heuristic or
+//!   light sampling as a pilot says is best for the pixel
+//!   ([`lobe::estimator::Pilot`]): before pass 0, [`pilot_spp`] extra
+//!   samples per pixel of their own randomization (not in the image) record
+//!   the balance heuristic's draws; each pixel takes the allocation of
+//!   least estimated variance over the pilots of the 7 × 7 pixels around it
+//!   ([`PILOT_RADIUS`]). Every pass uses the same allocations. Deeper
+//!   bounces use the balance heuristic.
+//!
+//! This is [`lobe::estimator::ShadingEstimator::estimate`] with shadow rays.
 //!
 //! **Strategy fallback:** a BSDF strategy that does not apply to an
 //! object's material (`vndf` on a Phong sphere, `spherical-caps` on a
@@ -68,7 +78,10 @@ use crate::geometry::{Hit, spawn_ray};
 pub use crate::options::RenderOptions;
 use crate::scene::Scene;
 use glam::{DVec2, DVec3};
-use lobe::estimator::{DrawnBsdf, MisForm, ShadingEstimator, ShadingPoint, Strategy, Visibility};
+use lobe::estimator::{
+    Allocation, DrawnBsdf, Mis, MisForm, Pilot, ShadingEstimator, ShadingPoint, Strategy,
+    Visibility,
+};
 use lobe::light::Light;
 use lobe::math::Rgb;
 use lobe::sequence::{Sequence, hash64, pair_point};
@@ -87,7 +100,8 @@ pub mod dims {
     pub const fn bsdf_u(b: u32) -> u32 {
         1 + PER_BOUNCE * b
     }
-    /// The BSDF sample's lobe choice `uc` (first coordinate).
+    /// The BSDF sample's lobe choice `uc` (first coordinate; the second is
+    /// the light point's, used when adaptive MIS gives it to BSDF sampling).
     #[must_use]
     pub const fn bsdf_uc(b: u32) -> u32 {
         2 + PER_BOUNCE * b
@@ -114,6 +128,18 @@ pub mod dims {
     }
 }
 
+/// The first bounce of a pixel's samples under adaptive MIS.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum FirstBounce {
+    /// As the estimator is (every technique but adaptive MIS; adaptive MIS
+    /// at the balance heuristic).
+    Plain,
+    /// Adaptive MIS's pilot: the balance heuristic, recorded.
+    Pilot,
+    /// Adaptive MIS with the pixel's allocation.
+    Allocated(Allocation),
+}
+
 /// One sample of one pixel: where its numbers come from.
 #[derive(Debug, Clone, Copy)]
 struct PixelSample {
@@ -125,7 +151,13 @@ struct PixelSample {
 
 impl PixelSample {
     fn pair(&self, dim: u32) -> DVec2 {
-        DVec2::from_array(pair_point(self.sequence, self.seed, self.n, self.index, dim))
+        DVec2::from_array(pair_point(
+            self.sequence,
+            self.seed,
+            self.n,
+            self.index,
+            dim,
+        ))
     }
 
     fn one(&self, dim: u32) -> f64 {
@@ -267,8 +299,33 @@ pub fn render_pass(
     pass: u64,
     progress: impl Fn(u64) + Sync,
 ) -> Image {
-    on_pool(opts, || render_on_pool(scene, opts, pass, &progress))
+    on_pool(opts, || {
+        if pass > 0 && is_adaptive(opts.strategy) {
+            // The allocations of later passes come from pass 0's pilot.
+            let pilots = pilot_phase(scene, opts).0;
+            render_on_pool(scene, opts, pass, &progress, Some(&pilots)).0
+        } else {
+            render_on_pool(scene, opts, pass, &progress, None).0
+        }
+    })
 }
+
+/// Whether `s` is adaptive MIS, whose first bounce a per-pixel pilot tunes.
+fn is_adaptive(s: Strategy) -> bool {
+    matches!(s, Strategy::Mis(m) if m.form == MisForm::Adaptive)
+}
+
+/// Pilot samples per pixel of adaptive MIS for passes of `spp`: extra
+/// samples of their own randomization, drawn once before pass 0 and not
+/// part of the image.
+#[must_use]
+pub fn pilot_spp(spp: u64) -> u64 {
+    (spp / 8).max(1)
+}
+
+/// Half the side of the window of pixels whose pilots decide a pixel's
+/// allocation (7 × 7 pixels).
+pub const PILOT_RADIUS: usize = 3;
 
 fn on_pool<T: Send>(opts: &RenderOptions, f: impl FnOnce() -> T + Send) -> T {
     if let Some(n) = opts.threads
@@ -299,7 +356,7 @@ pub fn render_progressive(
     }
     .max(1);
     on_pool(opts, || {
-        let mut sum = render_on_pool(scene, opts, 0, &progress);
+        let (mut sum, pilots) = render_on_pool(scene, opts, 0, &progress, None);
         let mut passes = 1;
         // Go on while another pass, at the mean pass time so far, fits.
         while passes < max_passes {
@@ -307,7 +364,7 @@ pub fn render_progressive(
             if t0.elapsed() + per_pass > budget {
                 break;
             }
-            let img = render_on_pool(scene, opts, passes, &progress);
+            let img = render_on_pool(scene, opts, passes, &progress, Some(&pilots)).0;
             for (a, b) in sum.pixels.iter_mut().zip(&img.pixels) {
                 *a += *b;
             }
@@ -325,53 +382,167 @@ pub fn render_progressive(
     })
 }
 
-fn render_on_pool(
-    scene: &Scene,
+/// The first bounce's shading per pixel of adaptive MIS.
+fn context<'a>(
+    scene: &'a Scene,
     opts: &RenderOptions,
     pass: u64,
-    progress: &(dyn Fn(u64) + Sync),
-) -> Image {
-    let (w, h) = (scene.camera.width as usize, scene.camera.height as usize);
-    let shading: Vec<ObjectShading> = scene
-        .objects
-        .iter()
-        .map(|o| object_shading(opts.strategy, &o.material))
-        .collect();
-    let light = Light::Env(scene.environment.clone());
-    let ctx = Context {
+    light: &'a Light,
+    shading: &'a [ObjectShading<'a>],
+    progress: &'a (dyn Fn(u64) + Sync),
+) -> Context<'a> {
+    Context {
         progress,
         scene,
-        light: &light,
-        shading: &shading,
+        light,
+        shading,
         spp: opts.spp.max(1),
         max_depth: opts.max_depth.max(1),
         seed: opts.seed,
         sequence: opts.sequence,
         pass,
-        width: w,
+        width: scene.camera.width as usize,
+    }
+}
+
+fn shadings<'s>(scene: &'s Scene, opts: &RenderOptions) -> Vec<ObjectShading<'s>> {
+    scene
+        .objects
+        .iter()
+        .map(|o| object_shading(opts.strategy, &o.material))
+        .collect()
+}
+
+fn add_stats(a: RenderStats, b: RenderStats) -> RenderStats {
+    RenderStats {
+        camera_rays: a.camera_rays + b.camera_rays,
+        rays: a.rays + b.rays,
+        nonfinite: a.nonfinite + b.nonfinite,
+        passes: 1,
+    }
+}
+
+/// The pilot of adaptive MIS: per pixel, [`pilot_spp`] samples of their own
+/// randomization (a seed apart from the image's), the balance heuristic at
+/// the first bounce, recorded; their values are not used.
+fn pilot_phase(scene: &Scene, opts: &RenderOptions) -> (Vec<Pilot>, RenderStats) {
+    let (w, h) = (scene.camera.width as usize, scene.camera.height as usize);
+    let shading = shadings(scene, opts);
+    let light = Light::Env(scene.environment.clone());
+    let pilot_opts = RenderOptions {
+        seed: hash64(opts.seed ^ 0x7069_6c6f_7470_6978),
+        spp: pilot_spp(opts.spp.max(1)),
+        ..*opts
     };
+    let ctx = context(scene, &pilot_opts, 0, &light, &shading, &|_| {});
+    let k = ctx.spp;
+    let rows: Vec<(Vec<(Rgb, Pilot)>, RenderStats)> = (0..h)
+        .into_par_iter()
+        .map(|y| {
+            let mut stats = RenderStats::default();
+            let row = (0..w)
+                .map(|x| ctx.pixel(x, y, 0..k, FirstBounce::Pilot, &mut stats))
+                .collect();
+            (row, stats)
+        })
+        .collect();
+    let mut pilots = Vec::with_capacity(w * h);
+    let mut stats = RenderStats::default();
+    for (row, s) in rows {
+        pilots.extend(row.into_iter().map(|(_, p)| p));
+        stats = add_stats(stats, s);
+    }
+    (pilots, stats)
+}
+
+/// The allocation of pixel `(x, y)`: from the pilots of the pixels within
+/// [`PILOT_RADIUS`], merged.
+fn pooled_allocation(
+    pilots: &[Pilot],
+    w: usize,
+    h: usize,
+    x: usize,
+    y: usize,
+    mis: Mis,
+) -> Allocation {
+    let mut p = Pilot::default();
+    for yy in y.saturating_sub(PILOT_RADIUS)..(y + PILOT_RADIUS + 1).min(h) {
+        for xx in x.saturating_sub(PILOT_RADIUS)..(x + PILOT_RADIUS + 1).min(w) {
+            p.merge(&pilots[yy * w + xx]);
+        }
+    }
+    p.choose(mis.n_bsdf, mis.n_light)
+}
+
+/// One pass; for adaptive MIS also the per-pixel pilots (pass 0 draws them
+/// in its first [`pilot_spp`] samples; later passes take `prior`).
+fn render_on_pool(
+    scene: &Scene,
+    opts: &RenderOptions,
+    pass: u64,
+    progress: &(dyn Fn(u64) + Sync),
+    prior: Option<&[Pilot]>,
+) -> (Image, Vec<Pilot>) {
+    let (w, h) = (scene.camera.width as usize, scene.camera.height as usize);
+    let shading = shadings(scene, opts);
+    let light = Light::Env(scene.environment.clone());
+    let ctx = context(scene, opts, pass, &light, &shading, progress);
     let mut img = Image::new(w, h);
     if w == 0 || h == 0 {
-        return img;
+        return (img, Vec::new());
     }
-    img.stats = img
-        .pixels
+    let spp = ctx.spp;
+    let k = 1.0 / spp as f64;
+    let mis = match opts.strategy {
+        Strategy::Mis(mis) if mis.form == MisForm::Adaptive => mis,
+        _ => {
+            img.stats = render_rows(&ctx, &mut img.pixels, |_, _| (0..spp, FirstBounce::Plain));
+            for px in &mut img.pixels {
+                *px *= k;
+            }
+            return (img, Vec::new());
+        }
+    };
+    let (pilots, pilot_stats) = match prior {
+        Some(p) => (p.to_vec(), RenderStats::default()),
+        None => pilot_phase(scene, opts),
+    };
+    let stats = render_rows(&ctx, &mut img.pixels, |x, y| {
+        let a = pooled_allocation(&pilots, w, h, x, y, mis);
+        (0..spp, FirstBounce::Allocated(a))
+    });
+    for px in &mut img.pixels {
+        *px *= k;
+    }
+    // The pilot's rays are work done, but not camera rays of the image.
+    img.stats = RenderStats {
+        rays: stats.rays + pilot_stats.rays,
+        nonfinite: stats.nonfinite + pilot_stats.nonfinite,
+        ..stats
+    };
+    (img, pilots)
+}
+
+/// Every pixel's samples `range` with first-bounce mode `mode`, as chosen
+/// per pixel, rows in parallel; stores each pixel's sum (not divided).
+fn render_rows(
+    ctx: &Context<'_>,
+    pixels: &mut [Rgb],
+    plan: impl Fn(usize, usize) -> (std::ops::Range<u64>, FirstBounce) + Sync,
+) -> RenderStats {
+    let w = ctx.width;
+    pixels
         .par_chunks_mut(w)
         .enumerate()
         .map(|(y, row)| {
             let mut stats = RenderStats::default();
             for (x, px) in row.iter_mut().enumerate() {
-                *px = ctx.pixel(x, y, &mut stats);
+                let (range, mode) = plan(x, y);
+                *px = ctx.pixel(x, y, range, mode, &mut stats).0;
             }
             stats
         })
-        .reduce(RenderStats::default, |a, b| RenderStats {
-            camera_rays: a.camera_rays + b.camera_rays,
-            rays: a.rays + b.rays,
-            nonfinite: a.nonfinite + b.nonfinite,
-            passes: 1,
-        });
-    img
+        .reduce(RenderStats::default, add_stats)
 }
 
 /// The randomization of pixel `index` for `seed` (hashed, so that
@@ -424,11 +595,22 @@ impl Visibility for SceneVisibility<'_> {
 }
 
 impl Context<'_> {
-    fn pixel(&self, x: usize, y: usize, stats: &mut RenderStats) -> Rgb {
+    /// Samples `range` of pixel `(x, y)`: their sum, and in
+    /// [`FirstBounce::Pilot`] mode the pilot statistics of their first
+    /// bounces.
+    fn pixel(
+        &self,
+        x: usize,
+        y: usize,
+        range: std::ops::Range<u64>,
+        mode: FirstBounce,
+        stats: &mut RenderStats,
+    ) -> (Rgb, Pilot) {
         let pixel_seed = pixel_seed(self.seed, (y * self.width + x) as u64);
         let mut sum = Rgb::ZERO;
+        let mut pilot = Pilot::default();
         let mut pending = 0u64;
-        for i in 0..self.spp {
+        for i in range {
             let ps = match self.sequence {
                 // A fresh stratification per pass.
                 Sequence::Stratified => PixelSample {
@@ -448,7 +630,7 @@ impl Context<'_> {
             let j = ps.pair(dims::CAMERA);
             let ray = self.scene.camera.ray(x as f64 + j.x, y as f64 + j.y);
             stats.camera_rays += 1;
-            let v = self.radiance(ray, &ps, stats);
+            let v = self.radiance(ray, &ps, mode, &mut pilot, stats);
             if v.is_finite() {
                 sum += v;
             } else {
@@ -463,11 +645,18 @@ impl Context<'_> {
         if pending > 0 {
             (self.progress)(pending);
         }
-        sum / self.spp as f64
+        (sum, pilot)
     }
 
     /// Radiance arriving along a camera ray.
-    fn radiance(&self, ray: crate::geometry::Ray, ps: &PixelSample, stats: &mut RenderStats) -> Rgb {
+    fn radiance(
+        &self,
+        ray: crate::geometry::Ray,
+        ps: &PixelSample,
+        mode: FirstBounce,
+        pilot: &mut Pilot,
+        stats: &mut RenderStats,
+    ) -> Rgb {
         stats.rays += 1;
         let Some((mut hit, mut obj)) = self.scene.intersect(&ray, f64::INFINITY) else {
             return self.light.radiance(ray.dir);
@@ -513,13 +702,15 @@ impl Context<'_> {
                 let u = ps.pair(dims::bsdf_u(b));
                 [ps.one(dims::bsdf_uc(b)), u.x, u.y]
             };
+            // A lobe choice for the light point too: adaptive MIS may give
+            // it to BSDF sampling.
             let light_point = || {
                 let u = ps.pair(dims::light(b));
-                [0.0, u.x, u.y]
+                [ps.pair(dims::bsdf_uc(b)).y, u.x, u.y]
             };
             match strategy {
                 Strategy::Light => points[0] = light_point(),
-                Strategy::Mis(m) if m.form == MisForm::MultiSample => {
+                Strategy::Mis(m) if m.form != MisForm::OneSample => {
                     points[1] = light_point();
                     points[0] = bsdf_point();
                 }
@@ -532,7 +723,16 @@ impl Context<'_> {
                 rays: 0,
                 hit: None,
             };
-            let e = est.estimate(&sp, self.light, &points[..k], &mut vis);
+            let e = match (mode, depth) {
+                (FirstBounce::Pilot, 1) => {
+                    est.estimate_pilot(&sp, self.light, &points[..k], &mut vis, pilot)
+                }
+                (FirstBounce::Allocated(a), 1) => {
+                    est.with_allocation(a)
+                        .estimate(&sp, self.light, &points[..k], &mut vis)
+                }
+                _ => est.estimate(&sp, self.light, &points[..k], &mut vis),
+            };
             l += beta * e.value;
             if !go_on {
                 stats.rays += vis.rays;

@@ -3,7 +3,7 @@
 //! depth and the thread count. A scene file's `[render]` table sets them
 //! ([`crate::scene`]); the renderer ([`crate::render()`]) reads them.
 
-use lobe::estimator::{Heuristic, Strategy};
+use lobe::estimator::Strategy;
 use lobe::sequence::Sequence;
 
 /// Render settings.
@@ -29,7 +29,7 @@ impl Default for RenderOptions {
     fn default() -> Self {
         RenderOptions {
             spp: 64,
-            strategy: Strategy::mis(Heuristic::Balance),
+            strategy: Strategy::MIS,
             seed: 1,
             sequence: Sequence::Sobol,
             max_depth: 1,

@@ -133,14 +133,13 @@ fn a_comparison_under_a_fake_clock() {
         [
             Strategy::Bsdf(BsdfStrategy::Brdf),
             Strategy::Light,
-            Strategy::mis(Heuristic::Balance)
+            Strategy::mis(Heuristic::Balance),
+            Strategy::mis(Heuristic::Power),
+            Strategy::MIS,
         ]
     );
     let settings = CompareSettings {
-        methods: vec![
-            Strategy::Bsdf(BsdfStrategy::Cosine),
-            Strategy::mis(Heuristic::Balance),
-        ],
+        methods: vec![Strategy::Bsdf(BsdfStrategy::Cosine), Strategy::MIS],
         spp: 2,
         reference_spp: 16,
         seed: 9,

@@ -93,6 +93,7 @@ impl Strategy {
             strategy: technique,
             material: m,
             sampler,
+            allocation: Allocation::Balance,
         })
     }
 }
@@ -174,6 +175,168 @@ pub struct ShadingEstimator<'m> {
     strategy: Strategy,
     material: &'m Material,
     sampler: Option<BsdfSampler<'m>>,
+    /// Adaptive MIS only: how the draws of a sample are given out.
+    allocation: Allocation,
+}
+
+/// How adaptive MIS ([`MisForm::Adaptive`]) gives out the `n_bsdf + n_light`
+/// draws of one sample.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub enum Allocation {
+    /// All to BSDF sampling (the mean of their `f L cos / p`).
+    Bsdf,
+    /// `n_bsdf` BSDF and `n_light` light draws (from the MIS-compensated
+    /// distribution) weighted by the balance heuristic: multi-sample MIS.
+    #[default]
+    Balance,
+    /// All to light sampling from the plain distribution.
+    Light,
+}
+
+impl Allocation {
+    pub const ALL: [Allocation; 3] = [Allocation::Bsdf, Allocation::Balance, Allocation::Light];
+
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Allocation::Bsdf => "bsdf",
+            Allocation::Balance => "balance",
+            Allocation::Light => "light",
+        }
+    }
+}
+
+/// A pilot's statistics for adaptive MIS: from samples of the multi-sample
+/// balance heuristic with counts `(n_b, n_l)`, unbiased estimates of the
+/// integrals that give the per-sample variance of every [`Allocation`].
+///
+/// With `g = lum(f L cos)` (visibility included), `q = n_b p_b + n_l p_c`
+/// (`p_b` the BSDF strategy's pdf, `p_c` the compensated light pdf, `p_l`
+/// the plain one), any `∫ h` is estimated by `Σ h(d)/q(d)` over the draws
+/// `d` of a sample. Per sample of `n = n_b + n_l` draws:
+/// * all to BSDF: `(∫ g²/p_b − μ²) / n`;
+/// * all to light: `(∫ g²/p_l − μ²) / n`;
+/// * balance: `∫ g²/q − n_b (∫ g p_b/q)² − n_l (∫ g p_c/q)²`.
+///
+/// A direction with `g > 0` that a technique cannot draw (pdf 0) makes that
+/// technique's variance infinite. The light draws see what BSDF sampling
+/// misses (a small sun), so a pilot does not mistake a heavy-tailed BSDF
+/// estimator for a good one.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Pilot {
+    /// Samples recorded.
+    pub samples: u64,
+    mu: f64,
+    m_bsdf: f64,
+    m_light: f64,
+    m_q: f64,
+    mu_b: f64,
+    mu_l: f64,
+    bsdf_blind: bool,
+    light_blind: bool,
+}
+
+impl Pilot {
+    /// Below this many effective draws ([`Pilot::effective_draws`]) the
+    /// pilot's variances are too noisy to trust, and [`Pilot::choose`]
+    /// keeps the balance heuristic.
+    pub const MIN_EFFECTIVE_DRAWS: f64 = 64.0;
+
+    /// One draw `d` of a pilot sample: `g = lum(f L cos)`, the three pdfs
+    /// at it and `q`.
+    fn record(&mut self, g: f64, pb: f64, pc: f64, pl: f64, q: f64) {
+        if g <= 0.0 || q <= 0.0 || !g.is_finite() {
+            return;
+        }
+        self.mu += g / q;
+        self.m_q += g * g / (q * q);
+        self.mu_b += g * pb / (q * q);
+        self.mu_l += g * pc / (q * q);
+        if pb > 0.0 {
+            self.m_bsdf += g * g / (pb * q);
+        } else {
+            self.bsdf_blind = true;
+        }
+        if pl > 0.0 {
+            self.m_light += g * g / (pl * q);
+        } else {
+            self.light_blind = true;
+        }
+    }
+
+    pub fn merge(&mut self, o: &Pilot) {
+        self.samples += o.samples;
+        self.mu += o.mu;
+        self.m_bsdf += o.m_bsdf;
+        self.m_light += o.m_light;
+        self.m_q += o.m_q;
+        self.mu_b += o.mu_b;
+        self.mu_l += o.mu_l;
+        self.bsdf_blind |= o.bsdf_blind;
+        self.light_blind |= o.light_blind;
+    }
+
+    /// The estimated per-sample variance of the luminance under each
+    /// allocation, in the order of [`Allocation::ALL`], for counts
+    /// `(n_b, n_l)`; infinite where a technique cannot draw a direction
+    /// that carries light.
+    #[must_use]
+    pub fn variances(&self, n_b: u32, n_l: u32) -> [f64; 3] {
+        let k = self.samples.max(1) as f64;
+        let (nb, nl) = (f64::from(n_b), f64::from(n_l));
+        let n = nb + nl;
+        let mu = self.mu / k;
+        let bsdf = if self.bsdf_blind {
+            f64::INFINITY
+        } else {
+            (self.m_bsdf / k - mu * mu).max(0.0) / n
+        };
+        let light = if self.light_blind {
+            f64::INFINITY
+        } else {
+            (self.m_light / k - mu * mu).max(0.0) / n
+        };
+        let (mb, ml) = (self.mu_b / k, self.mu_l / k);
+        let balance = (self.m_q / k - nb * mb * mb - nl * ml * ml).max(0.0);
+        [bsdf, balance, light]
+    }
+
+    /// The effective number of the pilot's draws, `(Σ g/q)² / Σ (g/q)²`:
+    /// how many carried light, weighted by how evenly.
+    #[must_use]
+    pub fn effective_draws(&self) -> f64 {
+        if self.m_q > 0.0 {
+            self.mu * self.mu / self.m_q
+        } else {
+            0.0
+        }
+    }
+
+    /// The allocation of least estimated variance; a single technique only
+    /// when it beats the balance heuristic by a margin (5%), and only when
+    /// the pilot saw enough light to tell ([`Pilot::MIN_EFFECTIVE_DRAWS`]):
+    /// balance is the defensive choice.
+    #[must_use]
+    pub fn choose(&self, n_b: u32, n_l: u32) -> Allocation {
+        if self.samples == 0 || self.effective_draws() < Self::MIN_EFFECTIVE_DRAWS {
+            return Allocation::Balance;
+        }
+        let [b, m, l] = self.variances(n_b, n_l);
+        let margin = 0.95;
+        if b <= l && b < margin * m {
+            Allocation::Bsdf
+        } else if l < b && l < margin * m {
+            Allocation::Light
+        } else {
+            Allocation::Balance
+        }
+    }
+}
+
+/// Pilot samples of adaptive MIS in an estimate of `n` samples.
+#[must_use]
+pub fn pilot_samples(n: usize) -> usize {
+    (n / 16).clamp(256, 4096)
 }
 
 impl<'m> ShadingEstimator<'m> {
@@ -187,6 +350,92 @@ impl<'m> ShadingEstimator<'m> {
     #[must_use]
     pub fn sampler(&self) -> Option<BsdfSampler<'m>> {
         self.sampler
+    }
+
+    /// The allocation adaptive MIS uses (always `Balance` for any other
+    /// technique, where it means nothing).
+    #[must_use]
+    pub fn allocation(&self) -> Allocation {
+        self.allocation
+    }
+
+    /// Whether this is adaptive MIS, which wants a pilot.
+    #[must_use]
+    pub fn is_adaptive(&self) -> bool {
+        matches!(self.strategy, Strategy::Mis(m) if m.form == MisForm::Adaptive)
+    }
+
+    /// This estimator with adaptive MIS's draws given out by `a` (no
+    /// effect on any other technique).
+    #[must_use]
+    pub fn with_allocation(self, a: Allocation) -> Self {
+        ShadingEstimator {
+            allocation: if self.is_adaptive() {
+                a
+            } else {
+                Allocation::Balance
+            },
+            ..self
+        }
+    }
+
+    /// Adaptive MIS at one shading point: run a pilot of
+    /// [`pilot_samples`]`(plan.samples)` samples of its own (independent
+    /// numbers, a seed apart from the plan's, not part of the estimate) and
+    /// return this estimator with the allocation the pilot chose. Any other
+    /// technique is returned as it is.
+    #[must_use]
+    pub fn prepare(&self, sp: &ShadingPoint, light: &Light, plan: &Plan) -> Self {
+        let Strategy::Mis(mis) = self.strategy else {
+            return *self;
+        };
+        if mis.form != MisForm::Adaptive {
+            return *self;
+        }
+        let k = self.strategy.points_per_sample();
+        let n = pilot_samples(plan.samples);
+        let seed = sequence::hash64(plan.seed ^ 0x7069_6c6f_7421_0000);
+        let mut points = vec![[0.0; 3]; n * k];
+        sequence::fill(Sequence::Independent, seed, n * k, 0, 0, &mut points);
+        let mut pilot = Pilot::default();
+        for p in points.chunks_exact(k) {
+            let _ = self.estimate_pilot(sp, light, p, &mut Unoccluded, &mut pilot);
+        }
+        self.with_allocation(pilot.choose(mis.n_bsdf, mis.n_light))
+    }
+
+    /// One sample of the multi-sample balance heuristic (adaptive MIS's
+    /// pilot), recording in `pilot` what [`Pilot::choose`] needs. For a
+    /// technique that is not adaptive MIS, [`ShadingEstimator::estimate`].
+    #[must_use]
+    pub fn estimate_pilot(
+        &self,
+        sp: &ShadingPoint,
+        light: &Light,
+        points: &[[f64; 3]],
+        vis: &mut impl Visibility,
+        pilot: &mut Pilot,
+    ) -> ShadingEstimate {
+        match (self.strategy, self.sampler) {
+            (Strategy::Mis(mis), Some(s)) if mis.form == MisForm::Adaptive => {
+                let mut first = None;
+                pilot.samples += 1;
+                let value = multi_sample(
+                    self.material,
+                    &s,
+                    sp,
+                    light,
+                    Heuristic::Balance,
+                    (mis.n_bsdf, mis.n_light),
+                    points,
+                    vis,
+                    &mut first,
+                    Some(pilot),
+                );
+                ShadingEstimate { value, bsdf: first }
+            }
+            _ => self.estimate(sp, light, points, vis),
+        }
     }
 
     /// One estimate from `points`, [`Strategy::points_per_sample`] of them,
@@ -220,21 +469,58 @@ impl<'m> ShadingEstimator<'m> {
                 let (nb, nl) = (f64::from(mis.n_bsdf), f64::from(mis.n_light));
                 let h = mis.heuristic;
                 match mis.form {
-                    MisForm::MultiSample => {
-                        let mut sum = Rgb::ZERO;
-                        for p in &points[..mis.n_bsdf as usize] {
-                            if let Some((x, dir)) = draw_bsdf(&s, sp, *p, 1.0, vis, &mut first) {
-                                let w = h.weight(nb * x.pdf, nl * light.pdf(dist, dir));
-                                sum += x.weight * light.radiance(dir) * (w / nb);
+                    MisForm::MultiSample => multi_sample(
+                        m,
+                        &s,
+                        sp,
+                        light,
+                        h,
+                        (mis.n_bsdf, mis.n_light),
+                        points,
+                        vis,
+                        &mut first,
+                        None,
+                    ),
+                    MisForm::Adaptive => match self.allocation {
+                        Allocation::Balance => multi_sample(
+                            m,
+                            &s,
+                            sp,
+                            light,
+                            Heuristic::Balance,
+                            (mis.n_bsdf, mis.n_light),
+                            points,
+                            vis,
+                            &mut first,
+                            None,
+                        ),
+                        Allocation::Bsdf => {
+                            let mut sum = Rgb::ZERO;
+                            for p in points {
+                                if let Some((x, dir)) = draw_bsdf(&s, sp, *p, 1.0, vis, &mut first)
+                                {
+                                    sum += x.weight * light.radiance(dir);
+                                }
                             }
+                            sum / points.len() as f64
                         }
-                        for p in &points[mis.n_bsdf as usize..] {
-                            sum += light_value(m, Some(&s), sp, light, dist, *p, vis, |pl, pb| {
-                                (h.weight(nl * pl, nb * pb), nl)
-                            });
+                        Allocation::Light => {
+                            let mut sum = Rgb::ZERO;
+                            for p in points {
+                                sum += light_value(
+                                    m,
+                                    None,
+                                    sp,
+                                    light,
+                                    LightDistribution::Plain,
+                                    *p,
+                                    vis,
+                                    |_, _| (1.0, 1.0),
+                                );
+                            }
+                            sum / points.len() as f64
                         }
-                        sum
-                    }
+                    },
                     MisForm::OneSample => {
                         let p = points[0];
                         let cb = nb / (nb + nl);
@@ -260,6 +546,99 @@ impl<'m> ShadingEstimator<'m> {
         };
         ShadingEstimate { value, bsdf: first }
     }
+}
+
+/// Multi-sample MIS with counts `(n_b, n_l)`: `points` holds the BSDF
+/// points, then the light points. With `pilot`, every draw is recorded
+/// (balance heuristic only).
+#[allow(clippy::too_many_arguments)]
+fn multi_sample(
+    m: &Material,
+    s: &BsdfSampler,
+    sp: &ShadingPoint,
+    light: &Light,
+    h: Heuristic,
+    (n_b, n_l): (u32, u32),
+    points: &[[f64; 3]],
+    vis: &mut impl Visibility,
+    first: &mut Option<DrawnBsdf>,
+    mut pilot: Option<&mut Pilot>,
+) -> Rgb {
+    let dist = LightDistribution::Compensated;
+    let (nb, nl) = (f64::from(n_b), f64::from(n_l));
+    let mut sum = Rgb::ZERO;
+    for p in &points[..n_b as usize] {
+        if let Some((x, dir)) = draw_bsdf(s, sp, *p, 1.0, vis, first) {
+            let pc = light.pdf(dist, dir);
+            let w = h.weight(nb * x.pdf, nl * pc);
+            let v = x.weight * light.radiance(dir);
+            sum += v * (w / nb);
+            if let Some(pilot) = pilot.as_deref_mut() {
+                let g = luminance(v) * x.pdf;
+                let pl = light.pdf(LightDistribution::Plain, dir);
+                pilot.record(g, x.pdf, pc, pl, nb * x.pdf + nl * pc);
+            }
+        }
+    }
+    for p in &points[n_b as usize..] {
+        let Some(d) = light_draw(m, Some(s), sp, light, dist, *p, vis) else {
+            continue;
+        };
+        let w = h.weight(nl * d.pdf, nb * d.pdf_bsdf);
+        sum += d.f_l_cos * (w / (nl * d.pdf));
+        if let Some(pilot) = pilot.as_deref_mut() {
+            let pl = light.pdf(LightDistribution::Plain, d.dir);
+            pilot.record(
+                luminance(d.f_l_cos),
+                d.pdf_bsdf,
+                d.pdf,
+                pl,
+                nb * d.pdf_bsdf + nl * d.pdf,
+            );
+        }
+    }
+    sum
+}
+
+/// A light sample that carries light: `f L cos` at its direction, its pdf
+/// and the BSDF strategy's pdf there (0 without a sampler).
+struct LightDraw {
+    f_l_cos: Rgb,
+    pdf: f64,
+    pdf_bsdf: f64,
+    dir: DVec3,
+}
+
+/// Draw a light sample from point `p` (its `u` only); `None` for a failed
+/// one (no sample, below the horizon, `f = 0`, occluded).
+#[inline]
+fn light_draw(
+    m: &Material,
+    bsdf: Option<&BsdfSampler>,
+    sp: &ShadingPoint,
+    light: &Light,
+    dist: LightDistribution,
+    p: [f64; 3],
+    vis: &mut impl Visibility,
+) -> Option<LightDraw> {
+    let ls = light.sample(dist, DVec2::new(p[1], p[2]))?;
+    let wi = sp.frame.to_local(ls.dir);
+    if wi.z <= 0.0 {
+        return None;
+    }
+    let (f, pb) = match bsdf {
+        Some(s) => s.eval_pdf(sp.wo, wi),
+        None => (m.eval(sp.wo, wi), 0.0),
+    };
+    if f == Rgb::ZERO || !vis.unoccluded(ls.dir) {
+        return None;
+    }
+    Some(LightDraw {
+        f_l_cos: f * light.radiance(ls.dir) * wi.z,
+        pdf: ls.pdf,
+        pdf_bsdf: pb,
+        dir: ls.dir,
+    })
 }
 
 /// Draw a BSDF sample from point `p` (`uc = p[0] / uc_scale`), record the
@@ -308,25 +687,14 @@ fn light_value(
     vis: &mut impl Visibility,
     weight: impl FnOnce(f64, f64) -> (f64, f64),
 ) -> Rgb {
-    let Some(ls) = light.sample(dist, DVec2::new(p[1], p[2])) else {
+    let Some(d) = light_draw(m, bsdf, sp, light, dist, p, vis) else {
         return Rgb::ZERO;
     };
-    let wi = sp.frame.to_local(ls.dir);
-    if wi.z <= 0.0 {
-        return Rgb::ZERO;
-    }
-    let (f, pb) = match bsdf {
-        Some(s) => s.eval_pdf(sp.wo, wi),
-        None => (m.eval(sp.wo, wi), 0.0),
-    };
-    if f == Rgb::ZERO || !vis.unoccluded(ls.dir) {
-        return Rgb::ZERO;
-    }
-    let (w, n) = weight(ls.pdf, pb);
+    let (w, n) = weight(d.pdf, d.pdf_bsdf);
     if n == 1.0 {
-        f * light.radiance(ls.dir) * (wi.z * w / ls.pdf)
+        d.f_l_cos * (w / d.pdf)
     } else {
-        f * light.radiance(ls.dir) * (wi.z * w / (n * ls.pdf))
+        d.f_l_cos * (w / (n * d.pdf))
     }
 }
 
@@ -378,7 +746,7 @@ pub fn estimate(
     light: &Light,
     plan: &Plan,
 ) -> Result<Accumulator, Error> {
-    let est = plan.strategy.for_material(m)?;
+    let est = plan.strategy.for_material(m)?.prepare(sp, light, plan);
     let mut acc = Accumulator::default();
     for chunk in 0..plan.chunks() {
         acc.merge(&estimate_chunk(&est, sp, light, plan, chunk));
@@ -387,7 +755,8 @@ pub fn estimate(
 }
 
 /// The estimates of chunk `chunk` of `plan`, by `est` (the plan's technique
-/// validated for the material).
+/// validated for the material, and for adaptive MIS
+/// [`ShadingEstimator::prepare`]d at this point).
 #[must_use]
 pub fn estimate_chunk(
     est: &ShadingEstimator,

@@ -359,7 +359,9 @@ mod tests {
                 }
             }
         }
-        let pts: Vec<[f64; 2]> = (0..n).map(|i| pair_point(Sequence::Sobol, 3, n, i, 5)).collect();
+        let pts: Vec<[f64; 2]> = (0..n)
+            .map(|i| pair_point(Sequence::Sobol, 3, n, i, 5))
+            .collect();
         for kx in 0..=8u32 {
             let (bx, by) = (1u64 << kx, 1u64 << (8 - kx));
             let mut cells = vec![0u32; 256];
@@ -384,7 +386,10 @@ mod tests {
             let b = pair_point(Sequence::Sobol, 3, n, i, 1)[0];
             cells[(b * 16.0) as usize * 16 + (a * 16.0) as usize] += 1;
         }
-        assert!(cells.iter().any(|&c| c != 1), "pairs 0 and 1 are correlated");
+        assert!(
+            cells.iter().any(|&c| c != 1),
+            "pairs 0 and 1 are correlated"
+        );
         // Progressive: the sequence goes on past n.
         let later = pair_point(Sequence::Sobol, 3, n, 300, 5);
         assert!(later.iter().all(|x| (0.0..1.0).contains(x)));

@@ -100,11 +100,20 @@ impl Heuristic {
 
 /// Multi-sample MIS draws `n_bsdf` and `n_light` samples for every estimate;
 /// one-sample MIS draws one, choosing the technique with probability
-/// `n_t / (n_bsdf + n_light)`.
+/// `n_t / (n_bsdf + n_light)`; adaptive MIS draws `n_bsdf + n_light`
+/// directions per estimate and gives them to the techniques as a pilot
+/// says is best ([`crate::estimator::Allocation`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum MisForm {
     MultiSample,
     OneSample,
+    /// Variance-aware allocation (after Grittmann et al. 2019, "Variance-aware
+    /// multiple importance sampling"): from a pilot, the per-sample variance
+    /// of every allocation of the `n_bsdf + n_light` draws (all to BSDF
+    /// sampling, the multi-sample balance heuristic with the given counts,
+    /// all to light sampling) is estimated, and the least is used. Never
+    /// much worse than the better technique alone, keeping MIS's wins.
+    Adaptive,
 }
 
 /// BSDF sampling combined with light sampling.
@@ -143,11 +152,28 @@ impl From<BsdfStrategy> for Strategy {
 }
 
 /// The names of the techniques that are not BSDF strategies.
-pub const NON_BSDF_NAMES: [&str; 5] = ["light", "mis", "mis-power", "mis-one", "mis-power-one"];
+pub const NON_BSDF_NAMES: [&str; 6] = [
+    "light",
+    "mis",
+    "mis-balance",
+    "mis-power",
+    "mis-one",
+    "mis-power-one",
+];
 
 impl Strategy {
-    /// `mis` or `mis-power`: one sample of each technique, multi-sample, on
-    /// the material's best BSDF strategy.
+    /// `mis`, the default: adaptive MIS ([`MisForm::Adaptive`]), one BSDF
+    /// and one light draw per sample, on the material's best BSDF strategy.
+    pub const MIS: Strategy = Strategy::Mis(Mis {
+        bsdf: None,
+        heuristic: Heuristic::Balance,
+        form: MisForm::Adaptive,
+        n_bsdf: 1,
+        n_light: 1,
+    });
+
+    /// `mis-balance` or `mis-power`: one sample of each technique,
+    /// multi-sample, on the material's best BSDF strategy.
     #[must_use]
     pub const fn mis(heuristic: Heuristic) -> Self {
         Strategy::Mis(Mis {
@@ -160,12 +186,13 @@ impl Strategy {
     }
 
     /// Every technique by name: the BSDF strategies, `light`, `mis`,
-    /// `mis-power`, `mis-one`, `mis-power-one` (MIS on the material's best
-    /// BSDF strategy, one sample of each technique).
+    /// `mis-balance`, `mis-power`, `mis-one`, `mis-power-one` (MIS on the
+    /// material's best BSDF strategy, one sample of each technique).
     #[must_use]
     pub fn all() -> Vec<Strategy> {
         let mut v: Vec<Strategy> = BsdfStrategy::ALL.into_iter().map(Strategy::Bsdf).collect();
         v.push(Strategy::Light);
+        v.push(Strategy::MIS);
         for form in [MisForm::MultiSample, MisForm::OneSample] {
             for heuristic in [Heuristic::Balance, Heuristic::Power] {
                 v.push(Strategy::Mis(Mis {
@@ -192,26 +219,23 @@ impl Strategy {
         match self {
             Strategy::Bsdf(s) => s.name().to_string(),
             Strategy::Light => "light".into(),
-            Strategy::Mis(m) => {
-                let mut n = String::from(if m.heuristic == Heuristic::Balance {
-                    "mis"
-                } else {
-                    "mis-power"
-                });
-                if m.form == MisForm::OneSample {
-                    n.push_str("-one");
-                }
-                n
-            }
+            Strategy::Mis(m) => match (m.form, m.heuristic) {
+                (MisForm::Adaptive, Heuristic::Balance) => "mis".into(),
+                (MisForm::Adaptive, Heuristic::Power) => "mis-adaptive-power".into(),
+                (MisForm::MultiSample, Heuristic::Balance) => "mis-balance".into(),
+                (MisForm::MultiSample, Heuristic::Power) => "mis-power".into(),
+                (MisForm::OneSample, Heuristic::Balance) => "mis-one".into(),
+                (MisForm::OneSample, Heuristic::Power) => "mis-power-one".into(),
+            },
         }
     }
 
     /// Sequence points used by one estimate (`n_bsdf + n_light` for
-    /// multi-sample MIS, else 1).
+    /// multi-sample and adaptive MIS, else 1).
     #[must_use]
     pub fn points_per_sample(&self) -> usize {
         match self {
-            Strategy::Mis(m) if m.form == MisForm::MultiSample => (m.n_bsdf + m.n_light) as usize,
+            Strategy::Mis(m) if m.form != MisForm::OneSample => (m.n_bsdf + m.n_light) as usize,
             _ => 1,
         }
     }

@@ -59,7 +59,7 @@ pub fn estimate_chunked(
     plan: &Plan,
     progress: &dyn Progress,
 ) -> Result<Accumulator, Error> {
-    let est = plan.strategy.for_material(m)?;
+    let est = plan.strategy.for_material(m)?.prepare(sp, light, plan);
     let parts = map_indices(plan.chunks(), |c| {
         let a = estimate_chunk(&est, sp, light, plan, c);
         progress.advance(a.count() as u64);

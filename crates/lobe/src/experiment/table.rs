@@ -406,7 +406,7 @@ mod tests {
         )
         .unwrap();
         let names: Vec<&str> = t.strategies.iter().map(|r| r.name.as_str()).collect();
-        assert_eq!(names, ["light", "mis", "cosine"]);
+        assert_eq!(names, ["light", "mis-balance", "cosine"]);
         let all = run_table(
             &m,
             &sp,
