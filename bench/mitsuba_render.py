@@ -45,8 +45,11 @@ in, as in lobe).
 Mitsuba: `direct` with emitter_samples = 1, bsdf_samples = 1 (MIS between
 the two), for each sampler of --samplers (independent, stratified,
 multijitter, orthogonal, ldsampler: all exist in 3.9.1; stratified and
-orthogonal round the spp up to a square / the square of a prime, and the
-table gives the count they used). lobe: `lobe render --strategy mis` (one
+orthogonal round the spp up to a square / the square of a prime, ldsampler
+to a power of two, and the table gives the count they used), each without
+and with the envmap's `mis_compensation` (Karlik et al. 2019: light samples
+from max(0, luminance - mean), which lobe's `mis` also does; --mis-compensation
+picks off, on or both). lobe: `lobe render --strategy mis` (one
 BSDF and one light sample per spp, MIS) as one process per render, timed from
 spawn to exit (loading the map, rendering, writing EXR + PNG).
 
@@ -225,7 +228,7 @@ def sphere_mask(cam, spheres):
     return mask
 
 
-def build_mitsuba_scene(cam, spheres, env_path, sampler, spp):
+def build_mitsuba_scene(cam, spheres, env_path, sampler, spp, compensation=False):
     d = {
         "type": "scene",
         "integrator": {"type": "direct", "emitter_samples": 1, "bsdf_samples": 1},
@@ -239,7 +242,7 @@ def build_mitsuba_scene(cam, spheres, env_path, sampler, spp):
                      "pixel_format": "rgb"},
             "sampler": {"type": sampler, "sample_count": spp},
         },
-        "env": {"type": "envmap", "filename": env_path},
+        "env": {"type": "envmap", "filename": env_path, "mis_compensation": compensation},
     }
     for i, (c, r, m) in enumerate(spheres):
         d[f"sphere{i}"] = {"type": "sphere", "center": c.tolist(), "radius": r,
@@ -275,7 +278,7 @@ def interpolate(steps, target):
     """(spp, seconds) where the error crosses `target`, between the last
     step above it and the first at or below it."""
     for a, b in zip(steps, steps[1:]):
-        if a["err"] > target >= b["err"]:
+        if a["err"] > target >= b["err"] and b["spp"] > a["spp"]:
             s = math.log(a["err"] / b["err"]) / math.log(b["spp"] / a["spp"])
             if s <= 0:
                 return b["spp"], b["seconds"]
@@ -292,6 +295,9 @@ def ladder(name, render, start, target, max_seconds, max_spp, log):
     spp = start
     while spp <= max_spp:
         img, t, used = render(spp, len(steps))
+        if steps and used <= steps[-1]["spp"]:  # the sampler rounded up to the same count
+            spp *= 2
+            continue
         e = rel_rmse(img, *log["ref"])
         steps.append({"spp": used, "seconds": t, "err": e})
         print(f"  {name}: {used} spp, {t:.3f} s, rel. RMSE {100 * e:.3f}%", file=sys.stderr, flush=True)
@@ -310,6 +316,8 @@ def main():
                    help="threads of both renderers (default: every CPU)")
     p.add_argument("--samplers", default=",".join(SAMPLERS))
     p.add_argument("--lobe-strategy", default="mis", help="lobe render --strategy (default mis)")
+    p.add_argument("--mis-compensation", choices=["off", "on", "both"], default="both",
+                   help="Mitsuba envmap mis_compensation (Karlik et al. 2019; default: both, one row each)")
     p.add_argument("--ref-spp", type=int, default=16384)
     p.add_argument("--ref-passes", type=int, default=4)
     p.add_argument("--ref-sampler", default="multijitter")
@@ -368,9 +376,11 @@ def main():
     log = {"ref": (ref, mask), "last_img": {}}
     results = {}
 
-    for s in samplers:
-        print(f"Mitsuba {s}", file=sys.stderr, flush=True)
-        scene = build_mitsuba_scene(cam, spheres, maps["mitsuba"], s, args.start_spp)
+    comps = {"off": [False], "on": [True], "both": [False, True]}[args.mis_compensation]
+    for s, comp in [(s, c) for c in comps for s in samplers]:
+        name = f"Mitsuba {s}" + (" + mis_compensation" if comp else "")
+        print(name, file=sys.stderr, flush=True)
+        scene = build_mitsuba_scene(cam, spheres, maps["mitsuba"], s, args.start_spp, comp)
 
         def render(spp, k, scene=scene):
             img, t, compiled, used = mi_render(scene, spp, 2 * k + 1)
@@ -378,8 +388,8 @@ def main():
                 img, t, compiled, used = mi_render(scene, spp, 2 * k + 2)
             return img, t, used
 
-        results[f"Mitsuba {s}"] = ladder(f"Mitsuba {s}", render, args.start_spp, args.target,
-                                         args.max_seconds, args.max_spp, log)
+        results[name] = ladder(name, render, args.start_spp, args.target,
+                               args.max_seconds, args.max_spp, log)
 
     if not args.skip_lobe:
         print(f"lobe render --strategy {args.lobe_strategy}", file=sys.stderr, flush=True)
@@ -450,7 +460,8 @@ def main():
         with open(args.json_out, "w") as f:
             json.dump({"reference_err": ref_err, "ladders": results}, f, indent=2)
     for name in log["last_img"]:
-        save_png(os.path.join(args.out, name.replace(" ", "-") + ".png"), log["last_img"][name])
+        save_png(os.path.join(args.out, name.replace(" + ", "+").replace(" ", "-") + ".png"),
+                 log["last_img"][name])
 
 
 if __name__ == "__main__":
