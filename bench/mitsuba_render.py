@@ -75,6 +75,8 @@ import argparse
 import json
 import math
 import os
+import re
+import resource
 import subprocess
 import sys
 import time
@@ -157,6 +159,8 @@ def write_maps(out):
         p = os.path.join(out, f"sky-sun-{name}.exr")
         mi.Bitmap(img, mi.Bitmap.PixelFormat.RGB).write(p)
         paths[name] = p
+        if name == "lobe":
+            save_png(os.path.join(out, "sky-sun-preview.png"), img)
     return paths
 
 
@@ -250,14 +254,24 @@ def build_mitsuba_scene(cam, spheres, env_path, sampler, spp, compensation=False
     return mi.load_dict(d)
 
 
+def cpu_time(who):
+    r = resource.getrusage(who)
+    return r.ru_utime + r.ru_stime
+
+
+CPU_SHARE = []  # CPU time / (wall time x threads) of the last render
+
+
 def mi_render(scene, spp, seed):
     """One render; returns (image, seconds, compiled, spp the sampler used)."""
     dr.kernel_history()
+    c0 = cpu_time(resource.RUSAGE_SELF)
     t0 = time.perf_counter()
     img = mi.render(scene, spp=spp, seed=seed)
     dr.eval(img)
     dr.sync_thread()
     t = time.perf_counter() - t0
+    CPU_SHARE.append((cpu_time(resource.RUSAGE_SELF) - c0) / (t * dr.thread_count()))
     hist = dr.kernel_history()
     compiled = any(k["type"] == dr.KernelType.JIT
                    and (not k.get("cache_hit", 1) or k.get("backend_time", 0) > 0) for k in hist)
@@ -271,7 +285,9 @@ def rel_rmse(img, ref, mask):
 
 
 def save_png(path, img):
-    mi.util.write_bitmap(path, img.astype(np.float32))
+    """sRGB PNG of a linear image, one stop darker (the Lambert sphere is
+    above 1), clipped."""
+    mi.util.write_bitmap(path, (0.5 * img).astype(np.float32))
 
 
 def interpolate(steps, target):
@@ -299,8 +315,10 @@ def ladder(name, render, start, target, max_seconds, max_spp, log):
             spp *= 2
             continue
         e = rel_rmse(img, *log["ref"])
-        steps.append({"spp": used, "seconds": t, "err": e})
-        print(f"  {name}: {used} spp, {t:.3f} s, rel. RMSE {100 * e:.3f}%", file=sys.stderr, flush=True)
+        share = CPU_SHARE[-1] if CPU_SHARE else float("nan")
+        steps.append({"spp": used, "seconds": t, "err": e, "cpu_share": share})
+        print(f"  {name}: {used} spp, {t:.3f} s, rel. RMSE {100 * e:.3f}%, CPU share {100 * share:.0f}%",
+              file=sys.stderr, flush=True)
         log["last_img"][name] = img
         if e <= target or t > max_seconds:
             break
@@ -347,11 +365,17 @@ def main():
     dr.set_thread_count(args.threads)
 
     desc, cam, spheres = load_scene_desc()
-    env_lobe = os.path.normpath(os.path.join(HERE, desc["environment"]["path"]))
     maps = write_maps(args.out)
-    if os.path.abspath(maps["lobe"]) != os.path.abspath(env_lobe):
-        die(f"{SCENE}: environment.path must be out/sky-sun-lobe.exr (got {env_lobe}) "
-            "or pass --out to match")
+    # lobe renders a copy of the scene file whose environment is the map
+    # just written (the committed file names bench/out/sky-sun-lobe.exr).
+    with open(SCENE) as f:
+        text = f.read()
+    text, n = re.subn(r'(?m)^path\s*=\s*".*"', f"path = {json.dumps(os.path.abspath(maps['lobe']))}", text)
+    if n != 1:
+        die(f"{SCENE}: expected one `path = ...` line (the environment's)")
+    lobe_scene = os.path.join(args.out, "two_spheres.toml")
+    with open(lobe_scene, "w") as f:
+        f.write(text)
     mask = sphere_mask(cam, spheres)
     print(f"{int(mask.sum())} sphere pixels of {mask.size}", file=sys.stderr)
 
@@ -396,12 +420,14 @@ def main():
 
         def render_lobe(spp, k):
             out = os.path.join(args.out, f"lobe-{spp}")
-            cmd = [args.lobe, "render", SCENE, "--spp", str(spp), "--seed", str(k + 1),
+            cmd = [args.lobe, "render", lobe_scene, "--spp", str(spp), "--seed", str(k + 1),
                    "--threads", str(args.threads), "--strategy", args.lobe_strategy,
                    "--out", out, "-q"]
+            c0 = cpu_time(resource.RUSAGE_CHILDREN)
             t0 = time.perf_counter()
             r = subprocess.run(cmd, capture_output=True, text=True)
             t = time.perf_counter() - t0
+            CPU_SHARE.append((cpu_time(resource.RUSAGE_CHILDREN) - c0) / (t * args.threads))
             if r.returncode != 0:
                 die(f"{' '.join(cmd)} failed: {r.stderr.strip()}")
             img = np.array(mi.Bitmap(out + ".exr"), dtype=np.float64)[..., :3]
@@ -442,8 +468,8 @@ def main():
     best_name = next((r[0] for r in best if r[3] == best_t), None)
     tgt = f"{100 * args.target:g}%"
     print(f"| renderer / sampler | spp to {tgt} | rel. RMSE there | time to {tgt} (s) | interp. spp "
-          f"| interp. time (s) | time / Mitsuba's best | mean / reference |")
-    print("|---|---:|---:|---:|---:|---:|---:|---:|")
+          f"| interp. time (s) | time / Mitsuba's best | mean / reference | CPU share |")
+    print("|---|---:|---:|---:|---:|---:|---:|---:|---:|")
     for name, hit, n_i, t_i, last, mr in rows:
         if hit:
             a, b, c = str(hit["spp"]), f"{100 * hit['err']:.3f}%", f"{hit['seconds']:.2f}"
@@ -452,8 +478,11 @@ def main():
         ni = "—" if n_i is None else f"{n_i:.0f}"
         ti = "—" if t_i is None else f"{t_i:.2f}"
         ratio = "—" if t_i is None or best_t is None else f"{t_i / best_t:.2f}×"
+        cs = (hit or last)["cpu_share"]
         print(f"| {name} | {a} | {b} | {c} | {ni} | {ti} | {ratio} | "
-              f"{'—' if mr is None else f'{mr:.4f}'} |")
+              f"{'—' if mr is None else f'{mr:.4f}'} | {100 * cs:.0f}% |")
+    print("\nCPU share: CPU time / (wall time × threads) of the render at the step shown; about 100% "
+          "on an idle machine, less when other work competes for the cores.")
     if best_name:
         print(f"\nMitsuba's best here: {best_name} (interpolated time). Goal of issue 10: lobe at most 0.5×.")
     if args.json_out:

@@ -40,6 +40,7 @@ import argparse
 import datetime
 import json
 import os
+import resource
 import statistics
 import subprocess
 import sys
@@ -62,9 +63,21 @@ def default_mitsuba_python():
     return sys.executable
 
 
-def run_json(cmd, env=None):
-    """Runs `cmd`; returns (parsed JSON, None) or (None, first error line)."""
+SHARE = {"lobe": [], "mitsuba": []}
+
+
+def run_json(cmd, env=None, side=None, threads=1):
+    """Runs `cmd`; returns (parsed JSON, None) or (None, first error line).
+    Records the share of `threads` cores the process got (CPU time over
+    wall time): far below 100% means the machine was busy with other work."""
+    r0 = resource.getrusage(resource.RUSAGE_CHILDREN)
+    t0 = datetime.datetime.now()
     p = subprocess.run(cmd, capture_output=True, text=True, env=env)
+    wall = (datetime.datetime.now() - t0).total_seconds()
+    r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu = (r1.ru_utime - r0.ru_utime) + (r1.ru_stime - r0.ru_stime)
+    if side and wall > 0:
+        SHARE[side].append(cpu / (wall * threads))
     if p.returncode != 0:
         lines = [x for x in p.stderr.strip().splitlines() if x.strip()]
         return None, (" ".join(lines[-3:]) if lines else f"exit {p.returncode}")
@@ -131,7 +144,7 @@ def main():
     def lobe_runs(t):
         base = [args.lobe, "bench", "--json", "--threads", str(t)] + common
         for extra in ([], ["--material", BECKMANN, "--strategy", "vndf"]):
-            out, err = run_json(base + extra)
+            out, err = run_json(base + extra, side="lobe", threads=t)
             if out is None:
                 k = key(BECKMANN, "vndf") if extra else ("lobe default table", "")
                 notes[(k, t)] = err if err.startswith("lobe") else f"lobe: {err}"
@@ -147,7 +160,7 @@ def main():
                     add(k, t, "lobe_scalar", r["scalar_msps"])
 
     def mitsuba_runs(t):
-        out, err = run_json(mitsuba_cmd + ["--threads", str(t)], env=env)
+        out, err = run_json(mitsuba_cmd + ["--threads", str(t)], env=env, side="mitsuba", threads=t)
         if out is None:
             die(f"mitsuba_kernels.py failed: {err}")
         raw.append({"side": "mitsuba", "cmd": mitsuba_cmd + ["--threads", str(t)], "out": out})
@@ -186,7 +199,11 @@ def main():
           f"{mt.get('simd', '?')}).  ")
     print(f"lobe commit {commit}; {datetime.datetime.now(datetime.timezone.utc):%Y-%m-%d %H:%M} UTC; "
           f"load average at the end {load}; {args.samples} samples, median of {args.reps} warm runs "
-          f"per round, median of {args.rounds} alternating rounds; M samples/s.")
+          f"per round, median of {args.rounds} alternating rounds; M samples/s.  ")
+    share = {k: f"{100 * statistics.median(v):.0f}%" if v else "?" for k, v in SHARE.items()}
+    print(f"Share of its T cores each process got (CPU time / (wall time × T), median over the runs; "
+          f"about 100% on an idle machine, less when other work competes): lobe {share['lobe']}, "
+          f"Mitsuba {share['mitsuba']}.")
     print()
     print("| material | strategy | threads | lobe s+e+p | Mitsuba s+eval+pdf | Mitsuba s+eval_pdf "
           "| ratio | lobe sample | Mitsuba sample | ratio | lobe scalar f64 s+e+p |")
