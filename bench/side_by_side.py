@@ -153,7 +153,7 @@ def main():
             raw.append({"side": "lobe", "cmd": base + extra, "out": out})
             meta["lobe"] = out
             for r in out["results"]:
-                k = key(out["material"], r["strategy"])
+                k = key(r.get("material", out.get("material")), r["strategy"])
                 add(k, t, "lobe", r["msps"])
                 add(k, t, "lobe_sample", r["sample_msps"])
                 if "scalar_msps" in r:
