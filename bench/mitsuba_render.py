@@ -334,6 +334,9 @@ def main():
                    help="threads of both renderers (default: every CPU)")
     p.add_argument("--samplers", default=",".join(SAMPLERS))
     p.add_argument("--lobe-strategy", default="mis", help="lobe render --strategy (default mis)")
+    p.add_argument("--lobe-sequence", default="",
+                   help="comma-separated `lobe render --sequence` values, one lobe row each (issue 10 "
+                        "asks for the flag; lobe 0.1 does not have it yet: leave empty)")
     p.add_argument("--mis-compensation", choices=["off", "on", "both"], default="both",
                    help="Mitsuba envmap mis_compensation (Karlik et al. 2019; default: both, one row each)")
     p.add_argument("--ref-spp", type=int, default=16384)
@@ -415,14 +418,16 @@ def main():
         results[name] = ladder(name, render, args.start_spp, args.target,
                                args.max_seconds, args.max_spp, log)
 
-    if not args.skip_lobe:
-        print(f"lobe render --strategy {args.lobe_strategy}", file=sys.stderr, flush=True)
+    seqs = [q.strip() for q in args.lobe_sequence.split(",") if q.strip()] or [None]
+    for seq in [] if args.skip_lobe else seqs:
+        name = f"lobe {args.lobe_strategy}" + (f" --sequence {seq}" if seq else "")
+        print(name, file=sys.stderr, flush=True)
 
-        def render_lobe(spp, k):
-            out = os.path.join(args.out, f"lobe-{spp}")
+        def render_lobe(spp, k, seq=seq):
+            out = os.path.join(args.out, f"lobe-{seq + '-' if seq else ''}{spp}")
             cmd = [args.lobe, "render", lobe_scene, "--spp", str(spp), "--seed", str(k + 1),
                    "--threads", str(args.threads), "--strategy", args.lobe_strategy,
-                   "--out", out, "-q"]
+                   "--out", out, "-q"] + (["--sequence", seq] if seq else [])
             c0 = cpu_time(resource.RUSAGE_CHILDREN)
             t0 = time.perf_counter()
             r = subprocess.run(cmd, capture_output=True, text=True)
@@ -433,7 +438,6 @@ def main():
             img = np.array(mi.Bitmap(out + ".exr"), dtype=np.float64)[..., :3]
             return img, t, spp
 
-        name = f"lobe {args.lobe_strategy}"
         results[name] = ladder(name, render_lobe, args.lobe_start_spp, args.target,
                                args.max_seconds, args.max_spp, log)
 
@@ -489,7 +493,8 @@ def main():
         with open(args.json_out, "w") as f:
             json.dump({"reference_err": ref_err, "ladders": results}, f, indent=2)
     for name in log["last_img"]:
-        save_png(os.path.join(args.out, name.replace(" + ", "+").replace(" ", "-") + ".png"),
+        save_png(os.path.join(args.out, name.replace(" + ", "+").replace(" --sequence ", "-")
+                              .replace(" ", "-") + ".png"),
                  log["last_img"][name])
 
 
