@@ -135,14 +135,16 @@ class Inputs:
         self.wo = [(sin_t * np.cos(phi)).astype(np.float32),
                    (sin_t * np.sin(phi)).astype(np.float32),
                    cos_t.astype(np.float32)]
-        self.u1 = rng.random(n).astype(np.float32)
-        self.u2 = rng.random(n).astype(np.float32)
+        # 24 random bits each: uniform f32 in [0, 1), as lobe bench draws them.
+        self.u1 = rng.integers(0, 1 << 24, n, dtype=np.int64)
+        self.u2 = (rng.integers(0, 1 << 24, n) / float(1 << 24)).astype(np.float32)
 
     def fresh(self, run):
         """New Dr.Jit arrays (evaluated, outside any timing); u1 shifted by a
-        per-run offset so that each run computes different results."""
-        u1 = self.u1 + np.float32((run * 0.618034) % 1.0)
-        u1 = np.where(u1 >= 1.0, u1 - 1.0, u1).astype(np.float32)
+        per-run offset (modulo 1, on the 24-bit grid) so that each run
+        computes different results."""
+        shift = (run * 10368889) % (1 << 24)  # about 0.618 of the grid per run
+        u1 = (((self.u1 + shift) % (1 << 24)) / float(1 << 24)).astype(np.float32)
         si = dr.zeros(mi.SurfaceInteraction3f)
         si.wi = mi.Vector3f(mi.Float(self.wo[0]), mi.Float(self.wo[1]), mi.Float(self.wo[2]))
         s2 = mi.Point2f(mi.Float(u1), mi.Float(self.u2))
