@@ -14,7 +14,7 @@
 //! every other output 0.
 
 use glam::{DVec2, DVec3};
-use lobe::batch::{BatchSampler, Dirs, EvalPdfBuffers, SampleBuffers, SampleInput};
+use lobe::batch::{BatchSampler, Dirs, DirsMut, EvalPdfOutput, RgbMut, SampleInput, SampleOutput};
 use lobe::{BsdfStrategy, Material};
 use ndarray::{ArrayView1, ArrayView2, Axis};
 use rayon::prelude::*;
@@ -88,7 +88,10 @@ impl std::fmt::Display for BadInput {
 
 /// A float type the engine computes in: f32 (the batch kernels) or f64
 /// (the scalar reference).
-pub trait Real: Copy + Send + Sync + Default + PartialOrd + 'static {
+pub trait Real: Copy + Send + Sync + Default + PartialOrd + std::ops::Sub<Output = Self> + 'static {
+    /// `a² + b² + c²`.
+    fn mul_add3(a: Self, b: Self, c: Self) -> Self;
+    fn neg(self) -> Self;
     fn from_f32(x: f32) -> Self;
     fn from_f64(x: f64) -> Self;
     fn to_f64(self) -> f64;
@@ -100,6 +103,12 @@ pub trait Real: Copy + Send + Sync + Default + PartialOrd + 'static {
 }
 
 impl Real for f32 {
+    fn mul_add3(a: f32, b: f32, c: f32) -> f32 {
+        a * a + b * b + c * c
+    }
+    fn neg(self) -> f32 {
+        -self
+    }
     fn from_f32(x: f32) -> Self {
         x
     }
@@ -125,6 +134,12 @@ impl Real for f32 {
 }
 
 impl Real for f64 {
+    fn mul_add3(a: f64, b: f64, c: f64) -> f64 {
+        a * a + b * b + c * c
+    }
+    fn neg(self) -> f64 {
+        -self
+    }
     fn from_f32(x: f32) -> Self {
         f64::from(x)
     }
@@ -204,6 +219,16 @@ fn load_1<'a, T: Real>(src: &'a In1<'_>, r: std::ops::Range<usize>, buf: &'a mut
 
 /// Checks a block of directions (rows from `start`): finite and unit.
 fn check_dirs<T: Real>(name: &str, x: &[T], y: &[T], z: &[T], start: usize, zero_ok: bool) -> Result<bool, BadInput> {
+    // The common case first, in one branch-free (vectorizable) pass.
+    let tol = T::from_f64(UNIT_TOLERANCE);
+    let one = T::from_f64(1.0);
+    let all_unit = x.iter().zip(y).zip(z).fold(true, |ok, ((&a, &b), &c)| {
+        let d = T::mul_add3(a, b, c) - one;
+        ok & (d <= tol) & (d >= T::neg(tol))
+    });
+    if all_unit {
+        return Ok(false);
+    }
     let mut zeros = false;
     for i in 0..x.len() {
         let (a, b, c) = (x[i].to_f64(), y[i].to_f64(), z[i].to_f64());
@@ -241,6 +266,10 @@ fn unit(w: DVec3) -> DVec3 {
 /// Checks a block of uniforms: in `[0, 1]`; returns them with 1 moved to
 /// the largest value below one (an f64 just below one rounds to 1 in f32).
 fn check_uniform<'a, T: Real>(name: &str, v: &'a [T], start: usize, buf: &'a mut Vec<T>) -> Result<&'a [T], BadInput> {
+    let (zero, one) = (T::from_f64(0.0), T::from_f64(1.0));
+    if v.iter().fold(true, |ok, &x| ok & (x >= zero) & (x < one)) {
+        return Ok(v);
+    }
     let mut has_one = false;
     for (i, &x) in v.iter().enumerate() {
         let f = x.to_f64();
@@ -313,15 +342,14 @@ impl<'m> Engine<'m> {
 }
 
 /// The outputs of [`sample`], Fortran order for the `(N, 3)` ones (each
-/// component contiguous: `wi[c * n + i]`).
+/// component contiguous: `wi[c * n + i]`); `valid` is 1 or 0.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SampleOut<T> {
     pub n: usize,
     pub wi: Vec<T>,
-    pub f: Vec<T>,
     pub pdf: Vec<T>,
     pub weight: Vec<T>,
-    pub valid: Vec<bool>,
+    pub valid: Vec<u8>,
 }
 
 /// The outputs of [`eval_pdf`]: `f` in Fortran order, `pdf`.
@@ -338,6 +366,31 @@ pub enum Want {
     Eval,
     Pdf,
     Both,
+}
+
+/// `n` zeros, from fresh zeroed pages where the allocator maps them, which
+/// are advised to be huge pages before the first touch (fewer page faults
+/// when the blocks fill them).
+fn zeros<T: Copy + Default>(n: usize) -> Vec<T> {
+    let v = vec![T::default(); n];
+    #[cfg(target_os = "linux")]
+    {
+        const HUGE: usize = 2 << 20;
+        let bytes = n * std::mem::size_of::<T>();
+        if bytes >= 2 * HUGE {
+            let start = v.as_ptr() as usize;
+            let first = start.next_multiple_of(HUGE);
+            let end = (start + bytes) / HUGE * HUGE;
+            if end > first {
+                // SAFETY: advice on whole pages inside the allocation; it does
+                // not change the contents (zero), only how they are mapped.
+                unsafe {
+                    libc::madvise(first as *mut libc::c_void, end - first, libc::MADV_HUGEPAGE);
+                }
+            }
+        }
+    }
+    v
 }
 
 /// Splits three component vectors of length `n` (Fortran order `3n`) into
@@ -371,309 +424,399 @@ struct Scratch32 {
     wi: [Vec<f32>; 3],
     u: [Vec<f32>; 3],
     fix: [Vec<f32>; 3],
-    out: SampleBuffers,
-    ev: EvalPdfBuffers,
+    f: [Vec<f32>; 3],
+    pdf: Vec<f32>,
 }
 
 impl Scratch32 {
     fn new() -> Self {
         let v = || Vec::with_capacity(BLOCK);
+        let z = || vec![0.0f32; BLOCK];
         Scratch32 {
             wo: [v(), v(), v()],
             wi: [v(), v(), v()],
             u: [v(), v(), v()],
             fix: [v(), v(), v()],
-            out: SampleBuffers::new(BLOCK),
-            ev: EvalPdfBuffers::new(BLOCK),
+            f: [z(), z(), z()],
+            pdf: z(),
         }
     }
 }
 
-/// Sample `wi` for each `(wo[i], u[i], uc[i])`. `wo` is `(N, 3)`, `u` `(N, 2)`,
-/// `uc` `(N,)` or absent (then 0.5; it only matters where the material
-/// chooses between two lobes, where the caller must give it). On the batch
-/// path the results are the kernels' f32 values; on the scalar path
-/// `T` is the precision of the outputs (the computation is f64).
-pub fn sample<T: Real>(e: &Engine<'_>, wo: &In2<'_>, u: &In2<'_>, uc: Option<&In1<'_>>) -> Result<SampleOut<T>, BadInput> {
-    let n = wo.rows();
-    debug_assert!(u.rows() == n && uc.is_none_or(|c| c.len() == n));
-    let mut out = SampleOut {
-        n,
-        wi: vec![T::default(); 3 * n],
-        f: vec![T::default(); 3 * n],
-        pdf: vec![T::default(); n],
-        weight: vec![T::default(); 3 * n],
-        valid: vec![false; n],
-    };
-    {
-        let blocks: Vec<_> = split3(&mut out.wi, n)
-            .into_iter()
-            .zip(split3(&mut out.f, n))
-            .zip(split3(&mut out.weight, n))
-            .zip(out.pdf.chunks_mut(BLOCK).zip(out.valid.chunks_mut(BLOCK)))
-            .enumerate()
-            .map(|(k, (((wi, f), w), (pdf, valid)))| (k * BLOCK, wi, f, w, pdf, valid))
-            .collect();
-        let results: Vec<Result<(), BadInput>> = match e.batch {
-            // The batch path writes f32: T is f32 there (see the callers).
-            Some(b) if std::any::TypeId::of::<T>() == std::any::TypeId::of::<f32>() => blocks
-                .into_par_iter()
-                .map_init(Scratch32::new, |s, (start, wi, f, w, pdf, valid)| {
-                    let r = start..start + pdf.len();
-                    let len = r.len();
-                    let Scratch32 { wo: wb, u: ub, fix, out, .. } = s;
-                    let [b0, b1, b2] = wb;
-                    let (x, y, z) = (
-                        load_col::<f32>(wo, 0, r.clone(), b0),
-                        load_col::<f32>(wo, 1, r.clone(), b1),
-                        load_col::<f32>(wo, 2, r.clone(), b2),
-                    );
-                    check_dirs("wo", x, y, z, start, false)?;
-                    let [ub0, ub1, ub2] = ub;
-                    let [f0, f1, f2] = fix;
-                    let u1 = check_uniform("u", load_col::<f32>(u, 0, r.clone(), ub0), start, f0)?;
-                    let u2 = check_uniform("u", load_col::<f32>(u, 1, r.clone(), ub1), start, f1)?;
-                    let ucs = match uc {
-                        Some(c) => Some(check_uniform("uc", load_1::<f32>(c, r.clone(), ub2), start, f2)?),
-                        None => None,
-                    };
-                    let mut o = out.output();
-                    o.wi.x = &mut o.wi.x[..len];
-                    o.wi.y = &mut o.wi.y[..len];
-                    o.wi.z = &mut o.wi.z[..len];
-                    o.f.r = &mut o.f.r[..len];
-                    o.f.g = &mut o.f.g[..len];
-                    o.f.b = &mut o.f.b[..len];
-                    o.pdf = &mut o.pdf[..len];
-                    o.weight.r = &mut o.weight.r[..len];
-                    o.weight.g = &mut o.weight.g[..len];
-                    o.weight.b = &mut o.weight.b[..len];
-                    o.valid = &mut o.valid[..len];
-                    b.sample(
-                        SampleInput {
-                            wo: Dirs { x, y, z },
-                            u1,
-                            u2,
-                            uc: ucs,
-                        },
-                        o,
-                    )
-                    .expect("every block slice has the block's length");
-                    let cast = |dst: &mut [T], src: &[f32]| {
-                        for (d, &s) in dst.iter_mut().zip(src) {
-                            *d = T::from_f32(s);
-                        }
-                    };
-                    let [wx, wy, wz] = wi;
-                    cast(wx, &out.wi[0]);
-                    cast(wy, &out.wi[1]);
-                    cast(wz, &out.wi[2]);
-                    let [fr, fg, fb] = f;
-                    cast(fr, &out.f[0]);
-                    cast(fg, &out.f[1]);
-                    cast(fb, &out.f[2]);
-                    let [wr, wg, wb] = w;
-                    cast(wr, &out.weight[0]);
-                    cast(wg, &out.weight[1]);
-                    cast(wb, &out.weight[2]);
-                    cast(pdf, &out.pdf);
-                    for (d, &s) in valid.iter_mut().zip(&out.valid) {
-                        *d = s != 0;
-                    }
-                    Ok(())
-                })
-                .collect(),
-            _ => {
-                let m = e.material;
-                let strategy = e.strategy;
-                blocks
-                    .into_par_iter()
-                    .map_init(
-                        || [(); 8].map(|()| Vec::<f64>::with_capacity(BLOCK)),
-                        |s, (start, wi, f, w, pdf, valid)| {
-                            let r = start..start + pdf.len();
-                            let [b0, b1, b2, b3, b4, b5, f0, f1] = s;
-                            let (x, y, z) = (
-                                load_col::<f64>(wo, 0, r.clone(), b0),
-                                load_col::<f64>(wo, 1, r.clone(), b1),
-                                load_col::<f64>(wo, 2, r.clone(), b2),
-                            );
-                            check_dirs("wo", x, y, z, start, false)?;
-                            let u1 = check_uniform("u", load_col::<f64>(u, 0, r.clone(), b3), start, f0)?;
-                            let u2 = check_uniform("u", load_col::<f64>(u, 1, r.clone(), b4), start, f1)?;
-                            let ucs = match uc {
-                                Some(c) => {
-                                    let v = load_1::<f64>(c, r.clone(), b5);
-                                    let mut tmp = Vec::new();
-                                    Some(check_uniform("uc", v, start, &mut tmp)?.to_vec())
-                                }
-                                None => None,
-                            };
-                            for i in 0..pdf.len() {
-                                let wo = unit(DVec3::new(x[i], y[i], z[i]));
-                                let ucv = ucs.as_ref().map_or(0.5, |c| c[i]);
-                                if let Some(s) = m.sample(strategy, wo, ucv, DVec2::new(u1[i], u2[i])) {
-                                    for c in 0..3 {
-                                        wi[c][i] = T::from_f64(s.wi[c]);
-                                        f[c][i] = T::from_f64(s.f[c]);
-                                        w[c][i] = T::from_f64(s.weight[c]);
-                                    }
-                                    pdf[i] = T::from_f64(s.pdf);
-                                    valid[i] = true;
-                                }
-                            }
-                            Ok(())
-                        },
-                    )
-                    .collect()
-            }
-        };
-        first_error(results.into_iter())?;
+/// One block of sample outputs.
+type SampleBlock<'a, T> = (usize, [&'a mut [T]; 3], [&'a mut [T]; 3], &'a mut [T], &'a mut [u8]);
+
+/// Caller-owned outputs of [`sample32_into`]: `wi` and `weight` in
+/// Fortran order (`3n`), `pdf` and `valid` (`n`).
+#[derive(Debug)]
+pub struct SampleSlices<'a, T> {
+    pub n: usize,
+    pub wi: &'a mut [T],
+    pub pdf: &'a mut [T],
+    pub weight: &'a mut [T],
+    pub valid: &'a mut [u8],
+}
+
+impl<T> SampleOut<T> {
+    /// The outputs as slices.
+    pub fn slices(&mut self) -> SampleSlices<'_, T> {
+        SampleSlices {
+            n: self.n,
+            wi: &mut self.wi,
+            pdf: &mut self.pdf,
+            weight: &mut self.weight,
+            valid: &mut self.valid,
+        }
     }
+}
+
+fn sample_blocks<'a, T>(out: SampleSlices<'a, T>) -> Vec<SampleBlock<'a, T>> {
+    let n = out.n;
+    assert!(out.wi.len() == 3 * n && out.weight.len() == 3 * n && out.pdf.len() == n && out.valid.len() == n);
+    split3(out.wi, n)
+        .into_iter()
+        .zip(split3(out.weight, n))
+        .zip(out.pdf.chunks_mut(BLOCK).zip(out.valid.chunks_mut(BLOCK)))
+        .enumerate()
+        .map(|(k, ((wi, w), (pdf, valid)))| (k * BLOCK, wi, w, pdf, valid))
+        .collect()
+}
+
+fn new_sample_out<T: Copy + Default>(n: usize) -> SampleOut<T> {
+    SampleOut {
+        n,
+        wi: zeros(3 * n),
+        pdf: zeros(n),
+        weight: zeros(3 * n),
+        valid: zeros(n),
+    }
+}
+
+/// Sample `wi` for each `(wo[i], u[i], uc[i])`: on the batch kernels where
+/// the engine has them (f32), else on the scalar f64 path with `T` outputs.
+/// `wo` is `(N, 3)`, `u` `(N, 2)`, `uc` `(N,)` or absent (then 0.5; it only
+/// matters where the material chooses between two lobes, where the caller
+/// must give it).
+pub fn sample32(e: &Engine<'_>, wo: &In2<'_>, u: &In2<'_>, uc: Option<&In1<'_>>) -> Result<SampleOut<f32>, BadInput> {
+    let mut out = new_sample_out::<f32>(wo.rows());
+    sample32_into(e, wo, u, uc, out.slices())?;
     Ok(out)
 }
 
-/// `f` (no cosine) and/or the pdf (solid angle, of the engine's strategy)
-/// for each `(wo[i], wi[i])`; zero below the horizon. Outputs not wanted
-/// are left empty.
-pub fn eval_pdf<T: Real>(e: &Engine<'_>, wo: &In2<'_>, wi: &In2<'_>, want: Want) -> Result<EvalPdfOut<T>, BadInput> {
-    let n = wo.rows();
-    debug_assert_eq!(wi.rows(), n);
-    let want_f = want != Want::Pdf;
-    let want_p = want != Want::Eval;
-    let mut out = EvalPdfOut {
-        n,
-        f: vec![T::default(); if want_f { 3 * n } else { 0 }],
-        pdf: vec![T::default(); if want_p { n } else { 0 }],
+/// [`sample32`] into caller-owned outputs of `wo.rows()` samples (on an
+/// error their contents are unspecified).
+pub fn sample32_into(e: &Engine<'_>, wo: &In2<'_>, u: &In2<'_>, uc: Option<&In1<'_>>, out: SampleSlices<'_, f32>) -> Result<(), BadInput> {
+    let Some(b) = e.batch else {
+        return sample_scalar_into::<f32>(e, wo, u, uc, out);
     };
-    {
-        let nblocks = n.div_ceil(BLOCK);
-        let mut fblocks: Vec<Option<[&mut [T]; 3]>> = if want_f {
-            split3(&mut out.f, n).into_iter().map(Some).collect()
-        } else {
-            (0..nblocks).map(|_| None).collect()
-        };
-        let mut pblocks: Vec<Option<&mut [T]>> = if want_p {
-            out.pdf.chunks_mut(BLOCK).map(Some).collect()
-        } else {
-            (0..nblocks).map(|_| None).collect()
-        };
-        let blocks: Vec<_> = fblocks
-            .drain(..)
-            .zip(pblocks.drain(..))
-            .enumerate()
-            .map(|(k, (f, p))| (k * BLOCK, ((k + 1) * BLOCK).min(n), f, p))
-            .collect();
-        let results: Vec<Result<(), BadInput>> = match e.batch {
-            Some(b) if std::any::TypeId::of::<T>() == std::any::TypeId::of::<f32>() => blocks
-                .into_par_iter()
-                .map_init(Scratch32::new, |s, (start, end, f, p)| {
-                    let r = start..end;
-                    let len = r.len();
-                    let Scratch32 { wo: wb, wi: ib, ev, .. } = s;
-                    let [b0, b1, b2] = wb;
-                    let wo3 = Dirs {
-                        x: load_col::<f32>(wo, 0, r.clone(), b0),
-                        y: load_col::<f32>(wo, 1, r.clone(), b1),
-                        z: load_col::<f32>(wo, 2, r.clone(), b2),
-                    };
-                    check_dirs("wo", wo3.x, wo3.y, wo3.z, start, false)?;
-                    let [i0, i1, i2] = ib;
-                    let wi3 = Dirs {
-                        x: load_col::<f32>(wi, 0, r.clone(), i0),
-                        y: load_col::<f32>(wi, 1, r.clone(), i1),
-                        z: load_col::<f32>(wi, 2, r.clone(), i2),
-                    };
-                    let zeros = check_dirs("wi", wi3.x, wi3.y, wi3.z, start, true)?;
-                    let mut o = ev.output();
-                    o.f.r = &mut o.f.r[..len];
-                    o.f.g = &mut o.f.g[..len];
-                    o.f.b = &mut o.f.b[..len];
-                    o.pdf = &mut o.pdf[..len];
-                    b.eval_pdf(wo3, wi3, o).expect("every block slice has the block's length");
-                    if zeros {
-                        // A failed sample's wi (the zero vector): no direction, zero.
-                        for i in 0..len {
-                            if wi3.x[i] == 0.0 && wi3.y[i] == 0.0 && wi3.z[i] == 0.0 {
-                                ev.f[0][i] = 0.0;
-                                ev.f[1][i] = 0.0;
-                                ev.f[2][i] = 0.0;
-                                ev.pdf[i] = 0.0;
-                            }
-                        }
-                    }
-                    if let Some([fr, fg, fb]) = f {
-                        for (dst, src) in [(fr, &ev.f[0]), (fg, &ev.f[1]), (fb, &ev.f[2])] {
-                            for (d, &s) in dst.iter_mut().zip(src.iter()) {
-                                *d = T::from_f32(s);
-                            }
-                        }
-                    }
-                    if let Some(p) = p {
-                        for (d, &s) in p.iter_mut().zip(ev.pdf.iter()) {
-                            *d = T::from_f32(s);
-                        }
-                    }
-                    Ok(())
-                })
-                .collect(),
-            _ => {
-                let m = e.material;
-                let strategy = e.strategy;
-                blocks
-                    .into_par_iter()
-                    .map_init(
-                        || [(); 6].map(|()| Vec::<f64>::with_capacity(BLOCK)),
-                        |s, (start, end, mut f, mut p)| {
-                            let r = start..end;
-                            let [b0, b1, b2, b3, b4, b5] = s;
-                            let (x, y, z) = (
-                                load_col::<f64>(wo, 0, r.clone(), b0),
-                                load_col::<f64>(wo, 1, r.clone(), b1),
-                                load_col::<f64>(wo, 2, r.clone(), b2),
-                            );
-                            check_dirs("wo", x, y, z, start, false)?;
-                            let (ix, iy, iz) = (
-                                load_col::<f64>(wi, 0, r.clone(), b3),
-                                load_col::<f64>(wi, 1, r.clone(), b4),
-                                load_col::<f64>(wi, 2, r.clone(), b5),
-                            );
-                            check_dirs("wi", ix, iy, iz, start, true)?;
-                            for i in 0..r.len() {
-                                let a = unit(DVec3::new(x[i], y[i], z[i]));
-                                let b = DVec3::new(ix[i], iy[i], iz[i]);
-                                if b == DVec3::ZERO {
-                                    continue; // a failed sample's wi: zero
-                                }
-                                let b = unit(b);
-                                let (fv, pv) = match want {
-                                    Want::Eval => (m.eval(a, b), 0.0),
-                                    Want::Pdf => (lobe::Rgb::ZERO, m.pdf(strategy, a, b)),
-                                    Want::Both => m.eval_pdf(strategy, a, b),
-                                };
-                                if let Some(f) = f.as_mut() {
-                                    for c in 0..3 {
-                                        f[c][i] = T::from_f64(fv[c]);
-                                    }
-                                }
-                                if let Some(p) = p.as_mut() {
-                                    p[i] = T::from_f64(pv);
-                                }
-                            }
-                            Ok(())
-                        },
-                    )
-                    .collect()
-            }
-        };
-        first_error(results.into_iter())?;
-    }
+    let n = wo.rows();
+    debug_assert!(u.rows() == n && uc.is_none_or(|c| c.len() == n) && out.n == n);
+    let results: Vec<Result<(), BadInput>> = sample_blocks(out)
+        .into_par_iter()
+        .map_init(Scratch32::new, |s, (start, wi, w, pdf, valid)| {
+            let r = start..start + pdf.len();
+            let len = r.len();
+            let Scratch32 { wo: wb, u: ub, fix, f, .. } = s;
+            let [b0, b1, b2] = wb;
+            let (x, y, z) = (
+                load_col::<f32>(wo, 0, r.clone(), b0),
+                load_col::<f32>(wo, 1, r.clone(), b1),
+                load_col::<f32>(wo, 2, r.clone(), b2),
+            );
+            check_dirs("wo", x, y, z, start, false)?;
+            let [ub0, ub1, ub2] = ub;
+            let [f0, f1, f2] = fix;
+            let u1 = check_uniform("u", load_col::<f32>(u, 0, r.clone(), ub0), start, f0)?;
+            let u2 = check_uniform("u", load_col::<f32>(u, 1, r.clone(), ub1), start, f1)?;
+            let ucs = match uc {
+                Some(c) => Some(check_uniform("uc", load_1::<f32>(c, r.clone(), ub2), start, f2)?),
+                None => None,
+            };
+            let [wx, wy, wz] = wi;
+            let [wr, wg, wb] = w;
+            let [fr, fg, fb] = f;
+            b.sample(
+                SampleInput {
+                    wo: Dirs { x, y, z },
+                    u1,
+                    u2,
+                    uc: ucs,
+                },
+                SampleOutput {
+                    wi: DirsMut { x: wx, y: wy, z: wz },
+                    f: RgbMut {
+                        r: &mut fr[..len],
+                        g: &mut fg[..len],
+                        b: &mut fb[..len],
+                    },
+                    pdf,
+                    weight: RgbMut { r: wr, g: wg, b: wb },
+                    valid,
+                },
+            )
+            .expect("every block slice has the block's length");
+            Ok(())
+        })
+        .collect();
+    first_error(results.into_iter())
+}
+
+/// [`sample32`] on the scalar f64 path, outputs in `T`.
+pub fn sample_scalar<T: Real>(e: &Engine<'_>, wo: &In2<'_>, u: &In2<'_>, uc: Option<&In1<'_>>) -> Result<SampleOut<T>, BadInput> {
+    let mut out = new_sample_out::<T>(wo.rows());
+    sample_scalar_into(e, wo, u, uc, out.slices())?;
     Ok(out)
+}
+
+/// [`sample_scalar`] into caller-owned outputs.
+pub fn sample_scalar_into<T: Real>(e: &Engine<'_>, wo: &In2<'_>, u: &In2<'_>, uc: Option<&In1<'_>>, out: SampleSlices<'_, T>) -> Result<(), BadInput> {
+    let n = wo.rows();
+    debug_assert!(u.rows() == n && uc.is_none_or(|c| c.len() == n) && out.n == n);
+    let m = e.material;
+    let strategy = e.strategy;
+    let results: Vec<Result<(), BadInput>> = sample_blocks(out)
+        .into_par_iter()
+        .map_init(
+            || [(); 8].map(|()| Vec::<f64>::with_capacity(BLOCK)),
+            |s, (start, wi, w, pdf, valid)| {
+                let r = start..start + pdf.len();
+                let [b0, b1, b2, b3, b4, b5, f0, f1] = s;
+                let (x, y, z) = (
+                    load_col::<f64>(wo, 0, r.clone(), b0),
+                    load_col::<f64>(wo, 1, r.clone(), b1),
+                    load_col::<f64>(wo, 2, r.clone(), b2),
+                );
+                check_dirs("wo", x, y, z, start, false)?;
+                let u1 = check_uniform("u", load_col::<f64>(u, 0, r.clone(), b3), start, f0)?;
+                let u2 = check_uniform("u", load_col::<f64>(u, 1, r.clone(), b4), start, f1)?;
+                let ucs = match uc {
+                    Some(c) => {
+                        let v = load_1::<f64>(c, r.clone(), b5);
+                        let mut tmp = Vec::new();
+                        Some(check_uniform("uc", v, start, &mut tmp)?.to_vec())
+                    }
+                    None => None,
+                };
+                for i in 0..pdf.len() {
+                    let wo = unit(DVec3::new(x[i], y[i], z[i]));
+                    let ucv = ucs.as_ref().map_or(0.5, |c| c[i]);
+                    let s = m.sample(strategy, wo, ucv, DVec2::new(u1[i], u2[i]));
+                    let z = lobe::BsdfSample {
+                        wi: DVec3::ZERO,
+                        f: lobe::Rgb::ZERO,
+                        pdf: 0.0,
+                        weight: lobe::Rgb::ZERO,
+                        component: lobe::Component::Hemisphere,
+                    };
+                    let v = s.unwrap_or(z);
+                    for c in 0..3 {
+                        wi[c][i] = T::from_f64(v.wi[c]);
+                        w[c][i] = T::from_f64(v.weight[c]);
+                    }
+                    pdf[i] = T::from_f64(v.pdf);
+                    valid[i] = u8::from(s.is_some());
+                }
+                Ok(())
+            },
+        )
+        .collect();
+    first_error(results.into_iter())
+}
+
+/// One block of eval_pdf outputs (`None`: not wanted).
+type EvalBlock<'a, T> = (usize, usize, Option<[&'a mut [T]; 3]>, Option<&'a mut [T]>);
+
+/// Caller-owned outputs of [`eval_pdf32_into`]: `f` in Fortran order
+/// (`3n`, or empty when not wanted), `pdf` (`n`, or empty).
+#[derive(Debug)]
+pub struct EvalSlices<'a, T> {
+    pub n: usize,
+    pub f: &'a mut [T],
+    pub pdf: &'a mut [T],
+}
+
+impl<T> EvalPdfOut<T> {
+    pub fn slices(&mut self) -> EvalSlices<'_, T> {
+        EvalSlices {
+            n: self.n,
+            f: &mut self.f,
+            pdf: &mut self.pdf,
+        }
+    }
+}
+
+fn eval_blocks<'a, T>(out: EvalSlices<'a, T>) -> Vec<EvalBlock<'a, T>> {
+    let n = out.n;
+    assert!((out.f.is_empty() || out.f.len() == 3 * n) && (out.pdf.is_empty() || out.pdf.len() == n));
+    let nblocks = n.div_ceil(BLOCK);
+    let fblocks: Vec<Option<[&mut [T]; 3]>> = if out.f.is_empty() {
+        (0..nblocks).map(|_| None).collect()
+    } else {
+        split3(out.f, n).into_iter().map(Some).collect()
+    };
+    let pblocks: Vec<Option<&mut [T]>> = if out.pdf.is_empty() {
+        (0..nblocks).map(|_| None).collect()
+    } else {
+        out.pdf.chunks_mut(BLOCK).map(Some).collect()
+    };
+    fblocks
+        .into_iter()
+        .zip(pblocks)
+        .enumerate()
+        .map(|(k, (f, p))| (k * BLOCK, ((k + 1) * BLOCK).min(n), f, p))
+        .collect()
+}
+
+fn new_eval_out<T: Copy + Default>(n: usize, want: Want) -> EvalPdfOut<T> {
+    EvalPdfOut {
+        n,
+        f: if want != Want::Pdf { zeros(3 * n) } else { Vec::new() },
+        pdf: if want != Want::Eval { zeros(n) } else { Vec::new() },
+    }
+}
+
+/// `f` (no cosine) and/or the pdf (solid angle, of the engine's strategy)
+/// for each `(wo[i], wi[i])`, zero below the horizon and for a zero `wi`
+/// (a failed sample's): on the batch kernels where the engine has them,
+/// else the scalar f64 path. Outputs not wanted are left empty.
+pub fn eval_pdf32(e: &Engine<'_>, wo: &In2<'_>, wi: &In2<'_>, want: Want) -> Result<EvalPdfOut<f32>, BadInput> {
+    let mut out = new_eval_out::<f32>(wo.rows(), want);
+    eval_pdf32_into(e, wo, wi, out.slices())?;
+    Ok(out)
+}
+
+/// [`eval_pdf32`] into caller-owned outputs (an empty `f` or `pdf`: not wanted).
+pub fn eval_pdf32_into(e: &Engine<'_>, wo: &In2<'_>, wi: &In2<'_>, out: EvalSlices<'_, f32>) -> Result<(), BadInput> {
+    let Some(b) = e.batch else {
+        return eval_pdf_scalar_into::<f32>(e, wo, wi, out);
+    };
+    let n = wo.rows();
+    debug_assert!(wi.rows() == n && out.n == n);
+    let results: Vec<Result<(), BadInput>> = eval_blocks(out)
+        .into_par_iter()
+        .map_init(Scratch32::new, |s, (start, end, f, p)| {
+            let r = start..end;
+            let len = r.len();
+            let Scratch32 { wo: wb, wi: ib, f: sf, pdf: sp, .. } = s;
+            let [b0, b1, b2] = wb;
+            let wo3 = Dirs {
+                x: load_col::<f32>(wo, 0, r.clone(), b0),
+                y: load_col::<f32>(wo, 1, r.clone(), b1),
+                z: load_col::<f32>(wo, 2, r.clone(), b2),
+            };
+            check_dirs("wo", wo3.x, wo3.y, wo3.z, start, false)?;
+            let [i0, i1, i2] = ib;
+            let wi3 = Dirs {
+                x: load_col::<f32>(wi, 0, r.clone(), i0),
+                y: load_col::<f32>(wi, 1, r.clone(), i1),
+                z: load_col::<f32>(wi, 2, r.clone(), i2),
+            };
+            let zeros = check_dirs("wi", wi3.x, wi3.y, wi3.z, start, true)?;
+            let [sr, sg, sb] = sf;
+            let [fr, fg, fb] = match f {
+                Some(f) => f,
+                None => [&mut sr[..len], &mut sg[..len], &mut sb[..len]],
+            };
+            let pdf = match p {
+                Some(p) => p,
+                None => &mut sp[..len],
+            };
+            b.eval_pdf(
+                wo3,
+                wi3,
+                EvalPdfOutput {
+                    f: RgbMut { r: &mut *fr, g: &mut *fg, b: &mut *fb },
+                    pdf: &mut *pdf,
+                },
+            )
+            .expect("every block slice has the block's length");
+            if zeros {
+                // A failed sample's wi (the zero vector): no direction, zero.
+                for i in 0..len {
+                    if wi3.x[i] == 0.0 && wi3.y[i] == 0.0 && wi3.z[i] == 0.0 {
+                        fr[i] = 0.0;
+                        fg[i] = 0.0;
+                        fb[i] = 0.0;
+                        pdf[i] = 0.0;
+                    }
+                }
+            }
+            Ok(())
+        })
+        .collect();
+    first_error(results.into_iter())
+}
+
+/// [`eval_pdf32`] on the scalar f64 path, outputs in `T`.
+pub fn eval_pdf_scalar<T: Real>(e: &Engine<'_>, wo: &In2<'_>, wi: &In2<'_>, want: Want) -> Result<EvalPdfOut<T>, BadInput> {
+    let mut out = new_eval_out::<T>(wo.rows(), want);
+    eval_pdf_scalar_into(e, wo, wi, out.slices())?;
+    Ok(out)
+}
+
+/// [`eval_pdf_scalar`] into caller-owned outputs.
+pub fn eval_pdf_scalar_into<T: Real>(e: &Engine<'_>, wo: &In2<'_>, wi: &In2<'_>, out: EvalSlices<'_, T>) -> Result<(), BadInput> {
+    let n = wo.rows();
+    debug_assert!(wi.rows() == n && out.n == n);
+    let want = match (out.f.is_empty() && n > 0, out.pdf.is_empty() && n > 0) {
+        (true, _) => Want::Pdf,
+        (_, true) => Want::Eval,
+        _ => Want::Both,
+    };
+    let m = e.material;
+    let strategy = e.strategy;
+    let results: Vec<Result<(), BadInput>> = eval_blocks(out)
+        .into_par_iter()
+        .map_init(
+            || [(); 6].map(|()| Vec::<f64>::with_capacity(BLOCK)),
+            |s, (start, end, mut f, mut p)| {
+                let r = start..end;
+                let [b0, b1, b2, b3, b4, b5] = s;
+                let (x, y, z) = (
+                    load_col::<f64>(wo, 0, r.clone(), b0),
+                    load_col::<f64>(wo, 1, r.clone(), b1),
+                    load_col::<f64>(wo, 2, r.clone(), b2),
+                );
+                check_dirs("wo", x, y, z, start, false)?;
+                let (ix, iy, iz) = (
+                    load_col::<f64>(wi, 0, r.clone(), b3),
+                    load_col::<f64>(wi, 1, r.clone(), b4),
+                    load_col::<f64>(wi, 2, r.clone(), b5),
+                );
+                check_dirs("wi", ix, iy, iz, start, true)?;
+                for i in 0..r.len() {
+                    let a = unit(DVec3::new(x[i], y[i], z[i]));
+                    let b = DVec3::new(ix[i], iy[i], iz[i]);
+                    let (fv, pv) = if b == DVec3::ZERO {
+                        (lobe::Rgb::ZERO, 0.0) // a failed sample's wi: zero
+                    } else {
+                        let b = unit(b);
+                        match want {
+                        Want::Eval => (m.eval(a, b), 0.0),
+                        Want::Pdf => (lobe::Rgb::ZERO, m.pdf(strategy, a, b)),
+                        Want::Both => m.eval_pdf(strategy, a, b),
+                        }
+                    };
+                    if let Some(f) = f.as_mut() {
+                        for c in 0..3 {
+                            f[c][i] = T::from_f64(fv[c]);
+                        }
+                    }
+                    if let Some(p) = p.as_mut() {
+                        p[i] = T::from_f64(pv);
+                    }
+                }
+                Ok(())
+            },
+        )
+        .collect();
+    first_error(results.into_iter())
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use lobe::batch::SampleBuffers;
     use ndarray::{Array1, Array2, ShapeBuilder};
 
     fn ggx() -> Material {
@@ -702,13 +845,13 @@ mod tests {
         assert!(e.batch.is_some());
         let wo32 = wo.mapv(|x| x as f32);
         let u32_ = u.mapv(|x| x as f32);
-        let c = sample::<f32>(&e, &In2::F32(wo32.view()), &In2::F32(u32_.view()), None).unwrap();
+        let c = sample32(&e, &In2::F32(wo32.view()), &In2::F32(u32_.view()), None).unwrap();
         // Fortran order, and f64 inputs: the same bits.
         let mut wof = Array2::<f32>::zeros((n, 3).f());
         wof.assign(&wo32);
-        let fo = sample::<f32>(&e, &In2::F32(wof.view()), &In2::F32(u32_.view()), None).unwrap();
+        let fo = sample32(&e, &In2::F32(wof.view()), &In2::F32(u32_.view()), None).unwrap();
         assert_eq!(c, fo);
-        let d = sample::<f32>(&e, &In2::F64(wo32.mapv(f64::from).view()), &In2::F64(u32_.mapv(f64::from).view()), None).unwrap();
+        let d = sample32(&e, &In2::F64(wo32.mapv(f64::from).view()), &In2::F64(u32_.mapv(f64::from).view()), None).unwrap();
         assert_eq!(c, d);
         // The kernels called directly on the whole array.
         let b = e.batch.unwrap();
@@ -720,12 +863,12 @@ mod tests {
         assert_eq!(&c.wi[2 * n..], &bufs.wi[2][..]);
         assert_eq!(&c.weight[n..2 * n], &bufs.weight[1][..]);
         assert_eq!(c.pdf, bufs.pdf);
-        assert!(c.valid.iter().zip(&bufs.valid).all(|(&a, &b)| a == (b == 1)));
+        assert_eq!(c.valid, bufs.valid);
         // The scalar reference within the documented f32 error.
-        let r = sample::<f64>(&Engine::new(&m, BsdfStrategy::Vndf, true).unwrap(), &In2::F64(wo.view()), &In2::F64(u.view()), None).unwrap();
+        let r = sample_scalar::<f64>(&Engine::new(&m, BsdfStrategy::Vndf, true).unwrap(), &In2::F64(wo.view()), &In2::F64(u.view()), None).unwrap();
         let mut worst: f64 = 0.0;
         for i in 0..n {
-            if r.valid[i] && c.valid[i] && r.pdf[i] > 1e-3 {
+            if r.valid[i] == 1 && c.valid[i] == 1 && r.pdf[i] > 1e-3 {
                 worst = worst.max((f64::from(c.pdf[i]) - r.pdf[i]).abs() / r.pdf[i]);
             }
         }
@@ -738,19 +881,19 @@ mod tests {
         let n = BLOCK + 5;
         let (wo, u) = inputs(n);
         let e = Engine::new(&m, BsdfStrategy::Vndf, false).unwrap();
-        let s = sample::<f32>(&e, &In2::F64(wo.view()), &In2::F64(u.view()), None).unwrap();
+        let s = sample32(&e, &In2::F64(wo.view()), &In2::F64(u.view()), None).unwrap();
         let wi = Array2::from_shape_vec((n, 3).f(), s.wi.clone()).unwrap();
         let wo32 = wo.mapv(|x| x as f32);
-        let both = eval_pdf::<f32>(&e, &In2::F32(wo32.view()), &In2::F32(wi.view()), Want::Both).unwrap();
+        let both = eval_pdf32(&e, &In2::F32(wo32.view()), &In2::F32(wi.view()), Want::Both).unwrap();
         for i in 0..n {
-            if s.valid[i] {
+            if s.valid[i] == 1 {
                 assert!((both.pdf[i] - s.pdf[i]).abs() <= 1e-4 * s.pdf[i], "{i}");
             }
         }
-        let pdf = eval_pdf::<f32>(&e, &In2::F32(wo32.view()), &In2::F32(wi.view()), Want::Pdf).unwrap();
+        let pdf = eval_pdf32(&e, &In2::F32(wo32.view()), &In2::F32(wi.view()), Want::Pdf).unwrap();
         assert_eq!(pdf.pdf, both.pdf);
         assert!(pdf.f.is_empty());
-        let r = eval_pdf::<f64>(&Engine::new(&m, BsdfStrategy::Vndf, true).unwrap(), &In2::F64(wo32.mapv(f64::from).view()), &In2::F64(wi.mapv(f64::from).view()), Want::Both).unwrap();
+        let r = eval_pdf_scalar::<f64>(&Engine::new(&m, BsdfStrategy::Vndf, true).unwrap(), &In2::F64(wo32.mapv(f64::from).view()), &In2::F64(wi.mapv(f64::from).view()), Want::Both).unwrap();
         for i in 0..n {
             if r.pdf[i] > 1e-2 {
                 assert!((f64::from(both.pdf[i]) - r.pdf[i]).abs() < 1e-4 * r.pdf[i], "{i}: {} {}", both.pdf[i], r.pdf[i]);
@@ -765,21 +908,21 @@ mod tests {
         let (mut wo, mut u) = inputs(n);
         let e = Engine::new(&m, BsdfStrategy::Vndf, false).unwrap();
         wo[[BLOCK + 4, 0]] = f64::NAN;
-        let err = sample::<f32>(&e, &In2::F64(wo.view()), &In2::F64(u.view()), None).unwrap_err();
+        let err = sample32(&e, &In2::F64(wo.view()), &In2::F64(u.view()), None).unwrap_err();
         assert_eq!(err.row, BLOCK + 4);
         assert!(err.message.starts_with(&format!("wo[{}] = (NaN", BLOCK + 4)), "{}", err.message);
         assert!(err.message.ends_with("is not finite"), "{}", err.message);
         wo[[BLOCK + 4, 0]] = 0.0;
         wo[[7, 2]] = 3.0;
-        let err = sample::<f64>(&Engine::new(&m, BsdfStrategy::Vndf, true).unwrap(), &In2::F64(wo.view()), &In2::F64(u.view()), None).unwrap_err();
+        let err = sample_scalar::<f64>(&Engine::new(&m, BsdfStrategy::Vndf, true).unwrap(), &In2::F64(wo.view()), &In2::F64(u.view()), None).unwrap_err();
         assert!(err.message.starts_with("wo[7] = (") && err.message.contains("not a unit vector"), "{}", err.message);
         let (wo, _) = inputs(n);
         u[[9, 1]] = 1.5;
-        let err = sample::<f32>(&e, &In2::F64(wo.view()), &In2::F64(u.view()), None).unwrap_err();
+        let err = sample32(&e, &In2::F64(wo.view()), &In2::F64(u.view()), None).unwrap_err();
         assert_eq!(err.message, "u[9] = 1.5 is not a uniform number in [0, 1)");
         // One is moved below one, not an error.
         u[[9, 1]] = 1.0;
-        assert!(sample::<f32>(&e, &In2::F64(wo.view()), &In2::F64(u.view()), None).is_ok());
+        assert!(sample32(&e, &In2::F64(wo.view()), &In2::F64(u.view()), None).is_ok());
     }
 
     #[test]
@@ -790,11 +933,11 @@ mod tests {
         let n = 1000;
         let (wo, u) = inputs(n);
         let uc = Array1::from_shape_fn(n, |i| (i as f64 * 0.618).fract());
-        let s = sample::<f32>(&e, &In2::F64(wo.view()), &In2::F64(u.view()), Some(&In1::F64(uc.view()))).unwrap();
+        let s = sample32(&e, &In2::F64(wo.view()), &In2::F64(u.view()), Some(&In1::F64(uc.view()))).unwrap();
         for i in 0..n {
             let w = DVec3::new(wo[[i, 0]], wo[[i, 1]], wo[[i, 2]]);
             let r = m.sample(BsdfStrategy::Brdf, w, uc[i], DVec2::new(u[[i, 0]], u[[i, 1]]));
-            assert_eq!(r.is_some(), s.valid[i]);
+            assert_eq!(r.is_some(), s.valid[i] == 1);
             if let Some(r) = r {
                 assert_eq!(s.pdf[i], r.pdf as f32);
             }

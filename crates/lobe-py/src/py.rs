@@ -180,8 +180,7 @@ pub struct PyMaterial {
     desc: String,
 }
 
-/// The result of `Material.sample`: `wi` (N, 3), `f` (N, 3, no cosine),
-/// `weight` (N, 3, = f·cos θi / pdf, the Monte Carlo weight), `pdf` (N,,
+/// The result of `Material.sample`: `wi` (N, 3), `weight` (N, 3, = f·cos θi / pdf, the Monte Carlo weight), `pdf` (N,,
 /// solid angle), `valid` (N,) bool. A failed sample (below the horizon) has
 /// `valid = False` and zeros elsewhere.
 #[pyclass(module = "lobe", name = "SampleResult", frozen)]
@@ -189,13 +188,29 @@ pub struct SampleResult {
     #[pyo3(get)]
     wi: Py<PyAny>,
     #[pyo3(get)]
-    f: Py<PyAny>,
-    #[pyo3(get)]
     weight: Py<PyAny>,
     #[pyo3(get)]
     pdf: Py<PyAny>,
     #[pyo3(get)]
     valid: Py<PyAny>,
+    /// `valid`'s bytes (uint8, 0/1), for `out=`.
+    raw_valid: Py<PyAny>,
+}
+
+/// A writeable float32 array of `shape`, Fortran-contiguous, as a slice.
+fn out_slice<'py>(a: &Bound<'py, PyAny>, name: &str, shape: &[usize]) -> PyResult<numpy::PyReadwriteArrayDyn<'py, f32>> {
+    let arr = a
+        .cast::<PyArrayDyn<f32>>()
+        .map_err(|_| value_error(format!("out: {name} is not a float32 array (out= takes the result of a call without reference=True)")))?;
+    if arr.shape() != shape || !(arr.is_fortran_contiguous() || shape.len() == 1 && arr.is_contiguous()) {
+        return Err(value_error(format!(
+            "out: {name} has shape {} (Fortran-contiguous {}), expected {} Fortran-contiguous",
+            shape_text(arr.shape()),
+            arr.is_fortran_contiguous(),
+            shape_text(shape)
+        )));
+    }
+    arr.try_readwrite().map_err(|e| value_error(format!("out: {name}: {e}")))
 }
 
 #[pymethods]
@@ -226,13 +241,13 @@ impl PyMaterial {
         let v_wo = dirs(&a_wo, "wo", n, &mut h1)?;
         let v_wi = dirs(&a_wi, "wi", n, &mut h2)?;
         let (f, p) = if reference {
-            let r = py.detach(|| in_pool(|| engine::eval_pdf::<f64>(&e, &v_wo, &v_wi, want))).map_err(bad)?;
+            let r = py.detach(|| in_pool(|| engine::eval_pdf_scalar::<f64>(&e, &v_wo, &v_wi, want))).map_err(bad)?;
             (
                 (want != Want::Pdf).then(|| f32_or_64(py, n, 3, None, Some(r.f.clone()))),
                 (want != Want::Eval).then(|| f32_or_64(py, n, 1, None, Some(r.pdf.clone()))),
             )
         } else {
-            let r = py.detach(|| in_pool(|| engine::eval_pdf::<f32>(&e, &v_wo, &v_wi, want))).map_err(bad)?;
+            let r = py.detach(|| in_pool(|| engine::eval_pdf32(&e, &v_wo, &v_wi, want))).map_err(bad)?;
             let engine::EvalPdfOut { f, pdf, .. } = r;
             (
                 (want != Want::Pdf).then(|| f32_or_64(py, n, 3, Some(f), None)),
@@ -276,17 +291,50 @@ impl PyMaterial {
 
     /// `(f, pdf)` in one call: f_r WITHOUT the cosine (N, 3) and the
     /// strategy's solid-angle pdf (N,), sharing their terms. Local frame,
-    /// +z the normal, wo toward the viewer, wi toward the light.
+    /// +z the normal, wo toward the viewer, wi toward the light. `out=(f,
+    /// pdf)` (float32, Fortran-contiguous (N, 3) and (N,), e.g. a previous
+    /// result) writes into them.
     ///
     /// >>> import lobe
     /// >>> m = lobe.load_dict({"type": "cook-torrance", "distribution": "ggx", "alpha": 0.2})
     /// >>> f, pdf = m.eval_pdf([0, 0, 1], [[0, 0, 1]], strategy="vndf")
     /// >>> f.shape, pdf.shape, str(f.dtype)
     /// ((1, 3), (1,), 'float32')
-    #[pyo3(signature = (wo, wi, strategy = None, *, reference = false))]
-    fn eval_pdf<'py>(&self, py: Python<'py>, wo: &Bound<'py, PyAny>, wi: &Bound<'py, PyAny>, strategy: Option<&str>, reference: bool) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
-        let (f, p) = self.pair(py, wo, wi, strategy, reference, Want::Both)?;
-        Ok((f.expect("f"), p.expect("pdf")))
+    #[pyo3(signature = (wo, wi, strategy = None, *, reference = false, out = None))]
+    #[allow(clippy::too_many_arguments)]
+    fn eval_pdf<'py>(
+        &self,
+        py: Python<'py>,
+        wo: &Bound<'py, PyAny>,
+        wi: &Bound<'py, PyAny>,
+        strategy: Option<&str>,
+        reference: bool,
+        out: Option<(Bound<'py, PyAny>, Bound<'py, PyAny>)>,
+    ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
+        let Some((fo, po)) = out else {
+            let (f, p) = self.pair(py, wo, wi, strategy, reference, Want::Both)?;
+            return Ok((f.expect("f"), p.expect("pdf")));
+        };
+        if reference {
+            return Err(value_error("out: not with reference=True (its results are float64)"));
+        }
+        let e = Engine::new(&self.m, strategy_of(&self.m, strategy)?, false).map_err(value_error)?;
+        let (a_wo, a_wi) = (arr(wo, "wo")?, arr(wi, "wi")?);
+        let n = rows_of(&a_wi).or(rows_of(&a_wo)).unwrap_or(1);
+        let (mut h1, mut h2) = (None, None);
+        let v_wo = dirs(&a_wo, "wo", n, &mut h1)?;
+        let v_wi = dirs(&a_wi, "wi", n, &mut h2)?;
+        {
+            let mut a_f = out_slice(&fo, "f", &[n, 3])?;
+            let mut a_p = out_slice(&po, "pdf", &[n])?;
+            let slices = engine::EvalSlices {
+                n,
+                f: a_f.as_slice_mut().map_err(value_error)?,
+                pdf: a_p.as_slice_mut().map_err(value_error)?,
+            };
+            py.detach(|| in_pool(|| engine::eval_pdf32_into(&e, &v_wo, &v_wi, slices))).map_err(bad)?;
+        }
+        Ok((fo, po))
     }
 
     /// Draw wi for each wo with `strategy` (default: vndf where it applies,
@@ -294,8 +342,9 @@ impl PyMaterial {
     /// the lobe and is required where the material has two (a diffuse term
     /// and a glossy lobe, strategies other than uniform and cosine). Local
     /// frame, +z the normal, wo toward the viewer. Returns a `SampleResult`:
-    /// `.wi`, `.f` (no cosine), `.weight` (= f·cos θi / pdf), `.pdf` (solid
-    /// angle), `.valid`.
+    /// `.wi`, `.weight` (= f·cos θi / pdf), `.pdf` (solid
+    /// angle), `.valid`. `out=` a previous result of the same N writes
+    /// into its arrays (no new memory) and returns it.
     ///
     /// >>> import lobe, numpy as np
     /// >>> m = lobe.load_dict({"type": "cook-torrance", "distribution": "ggx", "alpha": 0.2})
@@ -304,7 +353,8 @@ impl PyMaterial {
     /// ((1000, 3), (1000, 3), (1000,), 'bool')
     /// >>> bool(np.all(s.wi[s.valid, 2] > 0))
     /// True
-    #[pyo3(signature = (wo, u, uc = None, strategy = None, *, reference = false))]
+    #[pyo3(signature = (wo, u, uc = None, strategy = None, *, reference = false, out = None))]
+    #[allow(clippy::too_many_arguments)]
     fn sample<'py>(
         &self,
         py: Python<'py>,
@@ -313,7 +363,8 @@ impl PyMaterial {
         uc: Option<&Bound<'py, PyAny>>,
         strategy: Option<&str>,
         reference: bool,
-    ) -> PyResult<SampleResult> {
+        out: Option<Bound<'py, SampleResult>>,
+    ) -> PyResult<Py<SampleResult>> {
         let st = strategy_of(&self.m, strategy)?;
         if uc.is_none() && self.m.chooses_lobe(st) {
             return Err(value_error(format!(
@@ -329,31 +380,61 @@ impl PyMaterial {
         let v_wo = dirs(&a_wo, "wo", n, &mut h)?;
         let a_uc = uc.map(|c| arr(c, "uc")).transpose()?;
         let v_uc = a_uc.as_ref().map(|c| view1(c, "uc", n)).transpose()?;
-        let out = |wi, f, weight, pdf, valid: Vec<bool>| SampleResult {
-            wi,
-            f,
-            weight,
-            pdf,
-            valid: Array1::from_vec(valid).into_pyarray(py).into_any().unbind(),
+        if let Some(o) = out {
+            if reference {
+                return Err(value_error("out: not with reference=True (its results are float64)"));
+            }
+            let r = o.get();
+            let (wi, weight, pdf, valid) = (r.wi.bind(py), r.weight.bind(py), r.pdf.bind(py), r.raw_valid.bind(py));
+            let mut a_wi = out_slice(wi, "wi", &[n, 3])?;
+            let mut a_w = out_slice(weight, "weight", &[n, 3])?;
+            let mut a_p = out_slice(pdf, "pdf", &[n])?;
+            let mut a_v = valid
+                .cast::<PyArrayDyn<u8>>()
+                .map_err(|_| value_error("out: valid"))?
+                .try_readwrite()
+                .map_err(|e| value_error(format!("out: valid: {e}")))?;
+            let slices = engine::SampleSlices {
+                n,
+                wi: a_wi.as_slice_mut().map_err(value_error)?,
+                pdf: a_p.as_slice_mut().map_err(value_error)?,
+                weight: a_w.as_slice_mut().map_err(value_error)?,
+                valid: a_v.as_slice_mut().map_err(value_error)?,
+            };
+            if slices.valid.len() != n {
+                return Err(value_error(format!("out: valid has {} values, expected {n}", slices.valid.len())));
+            }
+            py.detach(|| in_pool(|| engine::sample32_into(&e, &v_wo, &v_u, v_uc.as_ref(), slices))).map_err(bad)?;
+            return Ok(o.unbind());
+        }
+        // The kernels' 0/1 bytes, seen as NumPy bools without a copy.
+        let out = |wi, weight, pdf, valid: Vec<u8>| -> PyResult<Py<SampleResult>> {
+            let raw = Array1::from_vec(valid).into_pyarray(py);
+            let r = SampleResult {
+                wi,
+                weight,
+                pdf,
+                valid: raw.call_method1("view", ("bool",))?.unbind(),
+                raw_valid: raw.into_any().unbind(),
+            };
+            Py::new(py, r)
         };
         if reference {
-            let r = py.detach(|| in_pool(|| engine::sample::<f64>(&e, &v_wo, &v_u, v_uc.as_ref()))).map_err(bad)?;
-            Ok(out(
+            let r = py.detach(|| in_pool(|| engine::sample_scalar::<f64>(&e, &v_wo, &v_u, v_uc.as_ref()))).map_err(bad)?;
+            out(
                 f32_or_64(py, n, 3, None, Some(r.wi)).unbind(),
-                f32_or_64(py, n, 3, None, Some(r.f)).unbind(),
                 f32_or_64(py, n, 3, None, Some(r.weight)).unbind(),
                 f32_or_64(py, n, 1, None, Some(r.pdf)).unbind(),
                 r.valid,
-            ))
+            )
         } else {
-            let r = py.detach(|| in_pool(|| engine::sample::<f32>(&e, &v_wo, &v_u, v_uc.as_ref()))).map_err(bad)?;
-            Ok(out(
+            let r = py.detach(|| in_pool(|| engine::sample32(&e, &v_wo, &v_u, v_uc.as_ref()))).map_err(bad)?;
+            out(
                 f32_or_64(py, n, 3, Some(r.wi), None).unbind(),
-                f32_or_64(py, n, 3, Some(r.f), None).unbind(),
                 f32_or_64(py, n, 3, Some(r.weight), None).unbind(),
                 f32_or_64(py, n, 1, Some(r.pdf), None).unbind(),
                 r.valid,
-            ))
+            )
         }
     }
 
