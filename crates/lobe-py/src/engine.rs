@@ -92,6 +92,8 @@ pub trait Real: Copy + Send + Sync + Default + PartialOrd + std::ops::Sub<Output
     /// `a² + b² + c²`.
     fn mul_add3(a: Self, b: Self, c: Self) -> Self;
     fn neg(self) -> Self;
+    /// The shortest text that reads back as this value.
+    fn show(self) -> String;
     fn from_f32(x: f32) -> Self;
     fn from_f64(x: f64) -> Self;
     fn to_f64(self) -> f64;
@@ -108,6 +110,9 @@ impl Real for f32 {
     }
     fn neg(self) -> f32 {
         -self
+    }
+    fn show(self) -> String {
+        self.to_string()
     }
     fn from_f32(x: f32) -> Self {
         x
@@ -139,6 +144,9 @@ impl Real for f64 {
     }
     fn neg(self) -> f64 {
         -self
+    }
+    fn show(self) -> String {
+        self.to_string()
     }
     fn from_f32(x: f32) -> Self {
         f64::from(x)
@@ -250,7 +258,7 @@ fn check_dirs<T: Real>(name: &str, x: &[T], y: &[T], z: &[T], start: usize, zero
             };
             return Err(BadInput {
                 row,
-                message: format!("{name}[{row}] = ({a}, {b}, {c}) {what}"),
+                message: format!("{name}[{row}] = ({}, {}, {}) {what}", x[i].show(), y[i].show(), z[i].show()),
             });
         }
     }
@@ -277,7 +285,7 @@ fn check_uniform<'a, T: Real>(name: &str, v: &'a [T], start: usize, buf: &'a mut
             let row = start + i;
             return Err(BadInput {
                 row,
-                message: format!("{name}[{row}] = {f} is not a uniform number in [0, 1)"),
+                message: format!("{name}[{row}] = {} is not a uniform number in [0, 1)", x.show()),
             });
         }
         has_one |= f == 1.0;

@@ -13,7 +13,10 @@ use lobe::{BsdfStrategy, Frame, Light, Material, Rgb};
 /// The settings of one call, as `lobe estimate`'s flags.
 #[derive(Debug, Clone)]
 pub struct EstimateArgs {
-    pub wo: DVec3,
+    /// The view direction (normalized), or `None` for `theta`.
+    pub wo: Option<DVec3>,
+    /// The view angle in degrees, `wo = (sin θ, 0, cos θ)` (default 30).
+    pub theta: Option<f64>,
     pub light: String,
     pub normal: DVec3,
     pub tangent: DVec3,
@@ -183,13 +186,26 @@ pub fn parse_strategies(
 /// Runs the table and returns it as the JSON text `lobe estimate --json`
 /// prints.
 pub fn estimate_json(m: &Material, a: &EstimateArgs) -> Result<String, String> {
-    if !(a.wo.is_finite() && a.wo.z > 0.0) {
-        return Err(format!(
-            "wo {}: the view direction must be finite and above the horizon (z > 0 in the local frame)",
-            a.wo
-        ));
-    }
-    let wo = a.wo.normalize();
+    let wo = match (a.wo, a.theta) {
+        (Some(_), Some(_)) => return Err("give wo or theta, not both".into()),
+        (Some(w), None) => {
+            if !(w.is_finite() && w.z > 0.0) {
+                return Err(format!(
+                    "wo {w}: the view direction must be finite and above the horizon (z > 0 in the local frame)"
+                ));
+            }
+            w.normalize()
+        }
+        (None, t) => {
+            // As the CLI's --theta.
+            let t = t.unwrap_or(30.0);
+            if !t.is_finite() || !(0.0..90.0).contains(&t) {
+                return Err(format!("theta {t}: the view angle must be in [0, 90) degrees"));
+            }
+            let r = t.to_radians();
+            DVec3::new(r.sin(), 0.0, r.cos())
+        }
+    };
     if a.samples < 2 {
         return Err(format!(
             "samples {}: an estimate with a variance needs at least 2 samples",
@@ -258,7 +274,8 @@ mod tests {
     fn the_table_of_the_cli() {
         let m = Material::load(r#"{"type":"phong","exponent":20}"#).unwrap();
         let a = EstimateArgs {
-            wo: DVec3::new(0.5, 0.0, 0.75f64.sqrt()),
+            wo: None,
+            theta: Some(30.0),
             light: "beam:16:1,1,0".into(),
             normal: DVec3::Y,
             tangent: DVec3::X,

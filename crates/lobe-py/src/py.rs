@@ -282,7 +282,7 @@ impl PyMaterial {
     ///
     /// >>> import lobe, numpy as np
     /// >>> m = lobe.load_dict({"type": "lambert"})
-    /// >>> float(m.pdf([0, 0, 1], [[0, 0, 1]], strategy="cosine")[0]) == np.float32(1 / np.pi)
+    /// >>> bool(m.pdf([0, 0, 1], [[0, 0, 1]], strategy="cosine")[0] == np.float32(1 / np.pi))
     /// True
     #[pyo3(signature = (wo, wi, strategy = None, *, reference = false))]
     fn pdf<'py>(&self, py: Python<'py>, wo: &Bound<'py, PyAny>, wi: &Bound<'py, PyAny>, strategy: Option<&str>, reference: bool) -> PyResult<Bound<'py, PyAny>> {
@@ -528,12 +528,13 @@ fn vec3_of(v: &Bound<'_, PyAny>, name: &str) -> PyResult<DVec3> {
 
 /// The estimate table as JSON text (`lobe estimate --json`).
 #[pyfunction]
-#[pyo3(signature = (material, wo, light, normal, tangent, strategies, samples, sequence, seed, replicas, mis_bsdf, mis_samples))]
+#[pyo3(signature = (material, wo, theta, light, normal, tangent, strategies, samples, sequence, seed, replicas, mis_bsdf, mis_samples))]
 #[allow(clippy::too_many_arguments)]
 fn _estimate_json(
     py: Python<'_>,
     material: &PyMaterial,
-    wo: &Bound<'_, PyAny>,
+    wo: Option<Bound<'_, PyAny>>,
+    theta: Option<f64>,
     light: String,
     normal: &Bound<'_, PyAny>,
     tangent: &Bound<'_, PyAny>,
@@ -546,7 +547,8 @@ fn _estimate_json(
     mis_samples: (u32, u32),
 ) -> PyResult<String> {
     let a = crate::estimate::EstimateArgs {
-        wo: vec3_of(wo, "wo")?,
+        wo: wo.map(|w| vec3_of(&w, "wo")).transpose()?,
+        theta,
         light,
         normal: vec3_of(normal, "normal")?,
         tangent: vec3_of(tangent, "tangent")?,
