@@ -56,6 +56,18 @@ def _jsonable(x: Any) -> Any:
     raise ValueError(f"material: {x!r} ({type(x).__name__}) is not a number, string, list or dict")
 
 
+def _check_finite(v: Any, path: str) -> None:
+    """Non-finite numbers are not JSON: name the field instead."""
+    if isinstance(v, Mapping):
+        for k, x in v.items():
+            _check_finite(x, f"{path}.{k}" if path else str(k))
+    elif isinstance(v, (list, tuple, np.ndarray)):
+        for x in (v.tolist() if isinstance(v, np.ndarray) else v):
+            _check_finite(x, path)
+    elif isinstance(v, (float, np.floating)) and not np.isfinite(v):
+        raise ValueError(f"material: field `{path}`: {v} is not a finite number")
+
+
 def load_dict(desc: Mapping[str, Any]) -> Material:
     """A material from a dict with the keys of ``lobe --material``.
 
@@ -89,6 +101,7 @@ def load_dict(desc: Mapping[str, Any]) -> Material:
     """
     if not isinstance(desc, Mapping):
         raise TypeError(f"load_dict: expected a dict, got {type(desc).__name__}")
+    _check_finite(desc, "")
     return _lobe._load_json(json.dumps(dict(desc), default=_jsonable))
 
 
@@ -134,6 +147,9 @@ def estimate(
     True
     """
     m = _material(material)
+    for name, v in (("samples", samples), ("seed", seed), ("replicas", replicas)):
+        if int(v) < 0:
+            raise ValueError(f"{name} {v}: must be >= 0")
     names = [strategies] if isinstance(strategies, str) else list(strategies)
     if not all(isinstance(s, str) for s in names):
         raise ValueError("strategies: expected names (strings)")

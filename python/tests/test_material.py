@@ -198,3 +198,25 @@ def test_two_threads_run_at_once():
     finally:
         lobe.set_threads(None)
     assert lobe.get_threads() >= 1
+
+
+def test_bad_values_never_crash():
+    m = lobe.load_dict(GGX)
+    assert m.sample(np.zeros((0, 3)), np.zeros((0, 2))).wi.shape == (0, 3)
+    assert m.eval(np.zeros((0, 3)), np.zeros((0, 3))).shape == (0, 3)
+    with pytest.raises(ValueError, match=r"field `alpha`: nan is not a finite number"):
+        lobe.load_dict({"type": "cook-torrance", "alpha": float("nan")})
+    with pytest.raises(ValueError, match=r"dtype complex64"):
+        m.sample([0, 0, 1], np.zeros((5, 2), np.complex64))
+    with pytest.raises(ValueError, match=r"shape \(5, 2, 1\)"):
+        m.sample([0, 0, 1], np.zeros((5, 2, 1)))
+    with pytest.raises(ValueError, match=r"u\[0\] = inf"):
+        m.sample([0, 0, 1], np.full((5, 2), np.inf))
+    with pytest.raises(ValueError, match=r"out: wi has shape \(6, 3\)"):
+        m.sample([0, 0, 1], np.zeros((5, 2)), out=m.sample([0, 0, 1], np.zeros((6, 2))))
+    with pytest.raises(ValueError, match=r"uc\[0\] = NaN"):
+        lobe.load_dict({"type": "phong", "kd": 0.2}).sample([0, 0, 1], np.zeros((5, 2)), np.full(5, np.nan), "brdf")
+    # wo below the horizon: failed samples, not an error.
+    assert not m.sample([0, 0, -1], np.full((5, 2), 0.5)).valid.any()
+    with pytest.raises(ValueError, match="samples -5"):
+        lobe.estimate({"type": "phong"}, samples=-5)

@@ -90,18 +90,26 @@ mod tests {
         let cosine = |u: DVec2| {
             let r = u.x.sqrt();
             let phi = TAU * u.y;
-            Some(DVec3::new(r * phi.cos(), r * phi.sin(), (1.0 - u.x).max(0.0).sqrt()))
+            Some(DVec3::new(
+                r * phi.cos(),
+                r * phi.sin(),
+                (1.0 - u.x).max(0.0).sqrt(),
+            ))
         };
         let cell = |z0: f64, z1: f64, p0: f64, p1: f64| {
             let (a, b) = (z0.max(0.0), z1.max(0.0));
             (b * b - a * a) * 0.5 * (p1 - p0) * FRAC_1_PI
         };
-        let direct = chi2_test_cells(&cfg, |_, u| cosine(u), |z0, z1, p0, p1| Estimate {
-            value: cell(z0, z1, p0, p1),
-            error: 0.0,
-            evals: 0,
-            converged: true,
-        });
+        let direct = chi2_test_cells(
+            &cfg,
+            |_, u| cosine(u),
+            |z0, z1, p0, p1| Estimate {
+                value: cell(z0, z1, p0, p1),
+                error: 0.0,
+                evals: 0,
+                converged: true,
+            },
+        );
         let dirs: Vec<_> = uniforms(cfg.seed, cfg.samples)
             .into_iter()
             .map(|[_, x, y]| cosine(DVec2::new(x, y)))
@@ -115,7 +123,14 @@ mod tests {
         }
         let ours = test_cells(20, 40, cfg.min_expected, &dirs, &probs, &vec![0.0; 800]);
         assert_eq!(ours, direct);
-        assert!(ours.passes(0.01), "{} {} {} {:?}", ours.p_value, ours.statistic, ours.dof, ours.message);
+        assert!(
+            ours.passes(0.01),
+            "{} {} {} {:?}",
+            ours.p_value,
+            ours.statistic,
+            ours.dof,
+            ours.message
+        );
         // A wrong pdf (uniform hemisphere) fails.
         let wrong = vec![1.0 / 1600.0; 800];
         let bad = test_cells(20, 40, 5.0, &dirs, &wrong, &vec![0.0; 800]);

@@ -88,7 +88,9 @@ impl std::fmt::Display for BadInput {
 
 /// A float type the engine computes in: f32 (the batch kernels) or f64
 /// (the scalar reference).
-pub trait Real: Copy + Send + Sync + Default + PartialOrd + std::ops::Sub<Output = Self> + 'static {
+pub trait Real:
+    Copy + Send + Sync + Default + PartialOrd + std::ops::Sub<Output = Self> + 'static
+{
     /// `a² + b² + c²`.
     fn mul_add3(a: Self, b: Self, c: Self) -> Self;
     fn neg(self) -> Self;
@@ -172,7 +174,11 @@ impl Real for f64 {
     }
 }
 
-fn column_slice<'a, T>(a: &'a ArrayView2<'_, T>, c: usize, r: std::ops::Range<usize>) -> Option<&'a [T]> {
+fn column_slice<'a, T>(
+    a: &'a ArrayView2<'_, T>,
+    c: usize,
+    r: std::ops::Range<usize>,
+) -> Option<&'a [T]> {
     // A column is contiguous when the row stride is 1 (Fortran order).
     if a.strides()[0] != 1 || a.nrows() == 0 {
         return None;
@@ -201,7 +207,12 @@ fn slice1<'a, T>(a: &'a ArrayView1<'_, T>, r: std::ops::Range<usize>) -> Option<
 
 /// Reads rows `r` of column `c` of `src` as `T` into `buf` (unless the
 /// source already is a contiguous `T` column) and returns the slice.
-fn load_col<'a, T: Real>(src: &'a In2<'_>, c: usize, r: std::ops::Range<usize>, buf: &'a mut Vec<T>) -> &'a [T] {
+fn load_col<'a, T: Real>(
+    src: &'a In2<'_>,
+    c: usize,
+    r: std::ops::Range<usize>,
+    buf: &'a mut Vec<T>,
+) -> &'a [T] {
     if let Some(s) = T::column(src, c, r.clone()) {
         return s;
     }
@@ -213,7 +224,11 @@ fn load_col<'a, T: Real>(src: &'a In2<'_>, c: usize, r: std::ops::Range<usize>, 
     buf
 }
 
-fn load_1<'a, T: Real>(src: &'a In1<'_>, r: std::ops::Range<usize>, buf: &'a mut Vec<T>) -> &'a [T] {
+fn load_1<'a, T: Real>(
+    src: &'a In1<'_>,
+    r: std::ops::Range<usize>,
+    buf: &'a mut Vec<T>,
+) -> &'a [T] {
     if let Some(s) = T::column1(src, r.clone()) {
         return s;
     }
@@ -226,7 +241,14 @@ fn load_1<'a, T: Real>(src: &'a In1<'_>, r: std::ops::Range<usize>, buf: &'a mut
 }
 
 /// Checks a block of directions (rows from `start`): finite and unit.
-fn check_dirs<T: Real>(name: &str, x: &[T], y: &[T], z: &[T], start: usize, zero_ok: bool) -> Result<bool, BadInput> {
+fn check_dirs<T: Real>(
+    name: &str,
+    x: &[T],
+    y: &[T],
+    z: &[T],
+    start: usize,
+    zero_ok: bool,
+) -> Result<bool, BadInput> {
     // The common case first, in one branch-free (vectorizable) pass.
     let tol = T::from_f64(UNIT_TOLERANCE);
     let one = T::from_f64(1.0);
@@ -258,7 +280,12 @@ fn check_dirs<T: Real>(name: &str, x: &[T], y: &[T], z: &[T], start: usize, zero
             };
             return Err(BadInput {
                 row,
-                message: format!("{name}[{row}] = ({}, {}, {}) {what}", x[i].show(), y[i].show(), z[i].show()),
+                message: format!(
+                    "{name}[{row}] = ({}, {}, {}) {what}",
+                    x[i].show(),
+                    y[i].show(),
+                    z[i].show()
+                ),
             });
         }
     }
@@ -268,12 +295,21 @@ fn check_dirs<T: Real>(name: &str, x: &[T], y: &[T], z: &[T], start: usize, zero
 /// `w` normalized where it is further from unit length than the library's
 /// own check (`1e-6` in `|w|²`); within [`UNIT_TOLERANCE`] as checked.
 fn unit(w: DVec3) -> DVec3 {
-    if (w.length_squared() - 1.0).abs() < 1e-6 { w } else { w.normalize() }
+    if (w.length_squared() - 1.0).abs() < 1e-6 {
+        w
+    } else {
+        w.normalize()
+    }
 }
 
 /// Checks a block of uniforms: in `[0, 1]`; returns them with 1 moved to
 /// the largest value below one (an f64 just below one rounds to 1 in f32).
-fn check_uniform<'a, T: Real>(name: &str, v: &'a [T], start: usize, buf: &'a mut Vec<T>) -> Result<&'a [T], BadInput> {
+fn check_uniform<'a, T: Real>(
+    name: &str,
+    v: &'a [T],
+    start: usize,
+    buf: &'a mut Vec<T>,
+) -> Result<&'a [T], BadInput> {
     let (zero, one) = (T::from_f64(0.0), T::from_f64(1.0));
     if v.iter().fold(true, |ok, &x| ok & (x >= zero) & (x < one)) {
         return Ok(v);
@@ -285,7 +321,10 @@ fn check_uniform<'a, T: Real>(name: &str, v: &'a [T], start: usize, buf: &'a mut
             let row = start + i;
             return Err(BadInput {
                 row,
-                message: format!("{name}[{row}] = {} is not a uniform number in [0, 1)", x.show()),
+                message: format!(
+                    "{name}[{row}] = {} is not a uniform number in [0, 1)",
+                    x.show()
+                ),
             });
         }
         has_one |= f == 1.0;
@@ -294,7 +333,10 @@ fn check_uniform<'a, T: Real>(name: &str, v: &'a [T], start: usize, buf: &'a mut
         return Ok(v);
     }
     buf.clear();
-    buf.extend(v.iter().map(|&x| if x.to_f64() == 1.0 { T::BELOW_ONE } else { x }));
+    buf.extend(
+        v.iter()
+            .map(|&x| if x.to_f64() == 1.0 { T::BELOW_ONE } else { x }),
+    );
     Ok(buf)
 }
 
@@ -310,7 +352,11 @@ pub struct Engine<'m> {
 impl<'m> Engine<'m> {
     /// For `material` and `strategy` (checked: an error says why the strategy
     /// does not apply). `reference` forces the scalar f64 path.
-    pub fn new(material: &'m Material, strategy: BsdfStrategy, reference: bool) -> Result<Self, lobe::Error> {
+    pub fn new(
+        material: &'m Material,
+        strategy: BsdfStrategy,
+        reference: bool,
+    ) -> Result<Self, lobe::Error> {
         material.check(strategy)?;
         let batch = if reference {
             None
@@ -452,7 +498,13 @@ impl Scratch32 {
 }
 
 /// One block of sample outputs.
-type SampleBlock<'a, T> = (usize, [&'a mut [T]; 3], [&'a mut [T]; 3], &'a mut [T], &'a mut [u8]);
+type SampleBlock<'a, T> = (
+    usize,
+    [&'a mut [T]; 3],
+    [&'a mut [T]; 3],
+    &'a mut [T],
+    &'a mut [u8],
+);
 
 /// Caller-owned outputs of [`sample32_into`]: `wi` and `weight` in
 /// Fortran order (`3n`), `pdf` and `valid` (`n`).
@@ -480,7 +532,12 @@ impl<T> SampleOut<T> {
 
 fn sample_blocks<'a, T>(out: SampleSlices<'a, T>) -> Vec<SampleBlock<'a, T>> {
     let n = out.n;
-    assert!(out.wi.len() == 3 * n && out.weight.len() == 3 * n && out.pdf.len() == n && out.valid.len() == n);
+    assert!(
+        out.wi.len() == 3 * n
+            && out.weight.len() == 3 * n
+            && out.pdf.len() == n
+            && out.valid.len() == n
+    );
     split3(out.wi, n)
         .into_iter()
         .zip(split3(out.weight, n))
@@ -505,7 +562,12 @@ fn new_sample_out<T: Copy + Default>(n: usize) -> SampleOut<T> {
 /// `wo` is `(N, 3)`, `u` `(N, 2)`, `uc` `(N,)` or absent (then 0.5; it only
 /// matters where the material chooses between two lobes, where the caller
 /// must give it).
-pub fn sample32(e: &Engine<'_>, wo: &In2<'_>, u: &In2<'_>, uc: Option<&In1<'_>>) -> Result<SampleOut<f32>, BadInput> {
+pub fn sample32(
+    e: &Engine<'_>,
+    wo: &In2<'_>,
+    u: &In2<'_>,
+    uc: Option<&In1<'_>>,
+) -> Result<SampleOut<f32>, BadInput> {
     let mut out = new_sample_out::<f32>(wo.rows());
     sample32_into(e, wo, u, uc, out.slices())?;
     Ok(out)
@@ -513,7 +575,13 @@ pub fn sample32(e: &Engine<'_>, wo: &In2<'_>, u: &In2<'_>, uc: Option<&In1<'_>>)
 
 /// [`sample32`] into caller-owned outputs of `wo.rows()` samples (on an
 /// error their contents are unspecified).
-pub fn sample32_into(e: &Engine<'_>, wo: &In2<'_>, u: &In2<'_>, uc: Option<&In1<'_>>, out: SampleSlices<'_, f32>) -> Result<(), BadInput> {
+pub fn sample32_into(
+    e: &Engine<'_>,
+    wo: &In2<'_>,
+    u: &In2<'_>,
+    uc: Option<&In1<'_>>,
+    out: SampleSlices<'_, f32>,
+) -> Result<(), BadInput> {
     let Some(b) = e.batch else {
         return sample_scalar_into::<f32>(e, wo, u, uc, out);
     };
@@ -524,7 +592,13 @@ pub fn sample32_into(e: &Engine<'_>, wo: &In2<'_>, u: &In2<'_>, uc: Option<&In1<
         .map_init(Scratch32::new, |s, (start, wi, w, pdf, valid)| {
             let r = start..start + pdf.len();
             let len = r.len();
-            let Scratch32 { wo: wb, u: ub, fix, f, .. } = s;
+            let Scratch32 {
+                wo: wb,
+                u: ub,
+                fix,
+                f,
+                ..
+            } = s;
             let [b0, b1, b2] = wb;
             let (x, y, z) = (
                 load_col::<f32>(wo, 0, r.clone(), b0),
@@ -537,7 +611,12 @@ pub fn sample32_into(e: &Engine<'_>, wo: &In2<'_>, u: &In2<'_>, uc: Option<&In1<
             let u1 = check_uniform("u", load_col::<f32>(u, 0, r.clone(), ub0), start, f0)?;
             let u2 = check_uniform("u", load_col::<f32>(u, 1, r.clone(), ub1), start, f1)?;
             let ucs = match uc {
-                Some(c) => Some(check_uniform("uc", load_1::<f32>(c, r.clone(), ub2), start, f2)?),
+                Some(c) => Some(check_uniform(
+                    "uc",
+                    load_1::<f32>(c, r.clone(), ub2),
+                    start,
+                    f2,
+                )?),
                 None => None,
             };
             let [wx, wy, wz] = wi;
@@ -551,14 +630,22 @@ pub fn sample32_into(e: &Engine<'_>, wo: &In2<'_>, u: &In2<'_>, uc: Option<&In1<
                     uc: ucs,
                 },
                 SampleOutput {
-                    wi: DirsMut { x: wx, y: wy, z: wz },
+                    wi: DirsMut {
+                        x: wx,
+                        y: wy,
+                        z: wz,
+                    },
                     f: RgbMut {
                         r: &mut fr[..len],
                         g: &mut fg[..len],
                         b: &mut fb[..len],
                     },
                     pdf,
-                    weight: RgbMut { r: wr, g: wg, b: wb },
+                    weight: RgbMut {
+                        r: wr,
+                        g: wg,
+                        b: wb,
+                    },
                     valid,
                 },
             )
@@ -570,14 +657,25 @@ pub fn sample32_into(e: &Engine<'_>, wo: &In2<'_>, u: &In2<'_>, uc: Option<&In1<
 }
 
 /// [`sample32`] on the scalar f64 path, outputs in `T`.
-pub fn sample_scalar<T: Real>(e: &Engine<'_>, wo: &In2<'_>, u: &In2<'_>, uc: Option<&In1<'_>>) -> Result<SampleOut<T>, BadInput> {
+pub fn sample_scalar<T: Real>(
+    e: &Engine<'_>,
+    wo: &In2<'_>,
+    u: &In2<'_>,
+    uc: Option<&In1<'_>>,
+) -> Result<SampleOut<T>, BadInput> {
     let mut out = new_sample_out::<T>(wo.rows());
     sample_scalar_into(e, wo, u, uc, out.slices())?;
     Ok(out)
 }
 
 /// [`sample_scalar`] into caller-owned outputs.
-pub fn sample_scalar_into<T: Real>(e: &Engine<'_>, wo: &In2<'_>, u: &In2<'_>, uc: Option<&In1<'_>>, out: SampleSlices<'_, T>) -> Result<(), BadInput> {
+pub fn sample_scalar_into<T: Real>(
+    e: &Engine<'_>,
+    wo: &In2<'_>,
+    u: &In2<'_>,
+    uc: Option<&In1<'_>>,
+    out: SampleSlices<'_, T>,
+) -> Result<(), BadInput> {
     let n = wo.rows();
     debug_assert!(u.rows() == n && uc.is_none_or(|c| c.len() == n) && out.n == n);
     let m = e.material;
@@ -655,7 +753,9 @@ impl<T> EvalPdfOut<T> {
 
 fn eval_blocks<'a, T>(out: EvalSlices<'a, T>) -> Vec<EvalBlock<'a, T>> {
     let n = out.n;
-    assert!((out.f.is_empty() || out.f.len() == 3 * n) && (out.pdf.is_empty() || out.pdf.len() == n));
+    assert!(
+        (out.f.is_empty() || out.f.len() == 3 * n) && (out.pdf.is_empty() || out.pdf.len() == n)
+    );
     let nblocks = n.div_ceil(BLOCK);
     let fblocks: Vec<Option<[&mut [T]; 3]>> = if out.f.is_empty() {
         (0..nblocks).map(|_| None).collect()
@@ -678,8 +778,16 @@ fn eval_blocks<'a, T>(out: EvalSlices<'a, T>) -> Vec<EvalBlock<'a, T>> {
 fn new_eval_out<T: Copy + Default>(n: usize, want: Want) -> EvalPdfOut<T> {
     EvalPdfOut {
         n,
-        f: if want != Want::Pdf { zeros(3 * n) } else { Vec::new() },
-        pdf: if want != Want::Eval { zeros(n) } else { Vec::new() },
+        f: if want != Want::Pdf {
+            zeros(3 * n)
+        } else {
+            Vec::new()
+        },
+        pdf: if want != Want::Eval {
+            zeros(n)
+        } else {
+            Vec::new()
+        },
     }
 }
 
@@ -687,14 +795,24 @@ fn new_eval_out<T: Copy + Default>(n: usize, want: Want) -> EvalPdfOut<T> {
 /// for each `(wo[i], wi[i])`, zero below the horizon and for a zero `wi`
 /// (a failed sample's): on the batch kernels where the engine has them,
 /// else the scalar f64 path. Outputs not wanted are left empty.
-pub fn eval_pdf32(e: &Engine<'_>, wo: &In2<'_>, wi: &In2<'_>, want: Want) -> Result<EvalPdfOut<f32>, BadInput> {
+pub fn eval_pdf32(
+    e: &Engine<'_>,
+    wo: &In2<'_>,
+    wi: &In2<'_>,
+    want: Want,
+) -> Result<EvalPdfOut<f32>, BadInput> {
     let mut out = new_eval_out::<f32>(wo.rows(), want);
     eval_pdf32_into(e, wo, wi, out.slices())?;
     Ok(out)
 }
 
 /// [`eval_pdf32`] into caller-owned outputs (an empty `f` or `pdf`: not wanted).
-pub fn eval_pdf32_into(e: &Engine<'_>, wo: &In2<'_>, wi: &In2<'_>, out: EvalSlices<'_, f32>) -> Result<(), BadInput> {
+pub fn eval_pdf32_into(
+    e: &Engine<'_>,
+    wo: &In2<'_>,
+    wi: &In2<'_>,
+    out: EvalSlices<'_, f32>,
+) -> Result<(), BadInput> {
     let Some(b) = e.batch else {
         return eval_pdf_scalar_into::<f32>(e, wo, wi, out);
     };
@@ -705,7 +823,13 @@ pub fn eval_pdf32_into(e: &Engine<'_>, wo: &In2<'_>, wi: &In2<'_>, out: EvalSlic
         .map_init(Scratch32::new, |s, (start, end, f, p)| {
             let r = start..end;
             let len = r.len();
-            let Scratch32 { wo: wb, wi: ib, f: sf, pdf: sp, .. } = s;
+            let Scratch32 {
+                wo: wb,
+                wi: ib,
+                f: sf,
+                pdf: sp,
+                ..
+            } = s;
             let [b0, b1, b2] = wb;
             let wo3 = Dirs {
                 x: load_col::<f32>(wo, 0, r.clone(), b0),
@@ -733,7 +857,11 @@ pub fn eval_pdf32_into(e: &Engine<'_>, wo: &In2<'_>, wi: &In2<'_>, out: EvalSlic
                 wo3,
                 wi3,
                 EvalPdfOutput {
-                    f: RgbMut { r: &mut *fr, g: &mut *fg, b: &mut *fb },
+                    f: RgbMut {
+                        r: &mut *fr,
+                        g: &mut *fg,
+                        b: &mut *fb,
+                    },
                     pdf: &mut *pdf,
                 },
             )
@@ -756,14 +884,24 @@ pub fn eval_pdf32_into(e: &Engine<'_>, wo: &In2<'_>, wi: &In2<'_>, out: EvalSlic
 }
 
 /// [`eval_pdf32`] on the scalar f64 path, outputs in `T`.
-pub fn eval_pdf_scalar<T: Real>(e: &Engine<'_>, wo: &In2<'_>, wi: &In2<'_>, want: Want) -> Result<EvalPdfOut<T>, BadInput> {
+pub fn eval_pdf_scalar<T: Real>(
+    e: &Engine<'_>,
+    wo: &In2<'_>,
+    wi: &In2<'_>,
+    want: Want,
+) -> Result<EvalPdfOut<T>, BadInput> {
     let mut out = new_eval_out::<T>(wo.rows(), want);
     eval_pdf_scalar_into(e, wo, wi, out.slices())?;
     Ok(out)
 }
 
 /// [`eval_pdf_scalar`] into caller-owned outputs.
-pub fn eval_pdf_scalar_into<T: Real>(e: &Engine<'_>, wo: &In2<'_>, wi: &In2<'_>, out: EvalSlices<'_, T>) -> Result<(), BadInput> {
+pub fn eval_pdf_scalar_into<T: Real>(
+    e: &Engine<'_>,
+    wo: &In2<'_>,
+    wi: &In2<'_>,
+    out: EvalSlices<'_, T>,
+) -> Result<(), BadInput> {
     let n = wo.rows();
     debug_assert!(wi.rows() == n && out.n == n);
     let want = match (out.f.is_empty() && n > 0, out.pdf.is_empty() && n > 0) {
@@ -800,9 +938,9 @@ pub fn eval_pdf_scalar_into<T: Real>(e: &Engine<'_>, wo: &In2<'_>, wi: &In2<'_>,
                     } else {
                         let b = unit(b);
                         match want {
-                        Want::Eval => (m.eval(a, b), 0.0),
-                        Want::Pdf => (lobe::Rgb::ZERO, m.pdf(strategy, a, b)),
-                        Want::Both => m.eval_pdf(strategy, a, b),
+                            Want::Eval => (m.eval(a, b), 0.0),
+                            Want::Pdf => (lobe::Rgb::ZERO, m.pdf(strategy, a, b)),
+                            Want::Both => m.eval_pdf(strategy, a, b),
                         }
                     };
                     if let Some(f) = f.as_mut() {
@@ -837,7 +975,11 @@ mod tests {
         for i in 0..n {
             let t = 1.4 * (i as f64 + 0.5) / n as f64;
             let p = 0.37 * i as f64;
-            wo.row_mut(i).assign(&Array1::from(vec![t.sin() * p.cos(), t.sin() * p.sin(), t.cos()]));
+            wo.row_mut(i).assign(&Array1::from(vec![
+                t.sin() * p.cos(),
+                t.sin() * p.sin(),
+                t.cos(),
+            ]));
             u[[i, 0]] = ((i * 7919) % n) as f64 / n as f64;
             u[[i, 1]] = ((i * 104_729) % n) as f64 / n as f64;
         }
@@ -859,21 +1001,52 @@ mod tests {
         wof.assign(&wo32);
         let fo = sample32(&e, &In2::F32(wof.view()), &In2::F32(u32_.view()), None).unwrap();
         assert_eq!(c, fo);
-        let d = sample32(&e, &In2::F64(wo32.mapv(f64::from).view()), &In2::F64(u32_.mapv(f64::from).view()), None).unwrap();
+        let d = sample32(
+            &e,
+            &In2::F64(wo32.mapv(f64::from).view()),
+            &In2::F64(u32_.mapv(f64::from).view()),
+            None,
+        )
+        .unwrap();
         assert_eq!(c, d);
         // The kernels called directly on the whole array.
         let b = e.batch.unwrap();
         let col = |a: &Array2<f32>, j: usize| a.column(j).to_vec();
-        let (x, y, z, u1, u2) = (col(&wo32, 0), col(&wo32, 1), col(&wo32, 2), col(&u32_, 0), col(&u32_, 1));
+        let (x, y, z, u1, u2) = (
+            col(&wo32, 0),
+            col(&wo32, 1),
+            col(&wo32, 2),
+            col(&u32_, 0),
+            col(&u32_, 1),
+        );
         let mut bufs = SampleBuffers::new(n);
-        b.sample(SampleInput { wo: Dirs { x: &x, y: &y, z: &z }, u1: &u1, u2: &u2, uc: None }, bufs.output()).unwrap();
+        b.sample(
+            SampleInput {
+                wo: Dirs {
+                    x: &x,
+                    y: &y,
+                    z: &z,
+                },
+                u1: &u1,
+                u2: &u2,
+                uc: None,
+            },
+            bufs.output(),
+        )
+        .unwrap();
         assert_eq!(&c.wi[..n], &bufs.wi[0][..]);
         assert_eq!(&c.wi[2 * n..], &bufs.wi[2][..]);
         assert_eq!(&c.weight[n..2 * n], &bufs.weight[1][..]);
         assert_eq!(c.pdf, bufs.pdf);
         assert_eq!(c.valid, bufs.valid);
         // The scalar reference within the documented f32 error.
-        let r = sample_scalar::<f64>(&Engine::new(&m, BsdfStrategy::Vndf, true).unwrap(), &In2::F64(wo.view()), &In2::F64(u.view()), None).unwrap();
+        let r = sample_scalar::<f64>(
+            &Engine::new(&m, BsdfStrategy::Vndf, true).unwrap(),
+            &In2::F64(wo.view()),
+            &In2::F64(u.view()),
+            None,
+        )
+        .unwrap();
         let mut worst: f64 = 0.0;
         for i in 0..n {
             if r.valid[i] == 1 && c.valid[i] == 1 && r.pdf[i] > 1e-3 {
@@ -892,7 +1065,8 @@ mod tests {
         let s = sample32(&e, &In2::F64(wo.view()), &In2::F64(u.view()), None).unwrap();
         let wi = Array2::from_shape_vec((n, 3).f(), s.wi.clone()).unwrap();
         let wo32 = wo.mapv(|x| x as f32);
-        let both = eval_pdf32(&e, &In2::F32(wo32.view()), &In2::F32(wi.view()), Want::Both).unwrap();
+        let both =
+            eval_pdf32(&e, &In2::F32(wo32.view()), &In2::F32(wi.view()), Want::Both).unwrap();
         for i in 0..n {
             if s.valid[i] == 1 {
                 assert!((both.pdf[i] - s.pdf[i]).abs() <= 1e-4 * s.pdf[i], "{i}");
@@ -901,10 +1075,21 @@ mod tests {
         let pdf = eval_pdf32(&e, &In2::F32(wo32.view()), &In2::F32(wi.view()), Want::Pdf).unwrap();
         assert_eq!(pdf.pdf, both.pdf);
         assert!(pdf.f.is_empty());
-        let r = eval_pdf_scalar::<f64>(&Engine::new(&m, BsdfStrategy::Vndf, true).unwrap(), &In2::F64(wo32.mapv(f64::from).view()), &In2::F64(wi.mapv(f64::from).view()), Want::Both).unwrap();
+        let r = eval_pdf_scalar::<f64>(
+            &Engine::new(&m, BsdfStrategy::Vndf, true).unwrap(),
+            &In2::F64(wo32.mapv(f64::from).view()),
+            &In2::F64(wi.mapv(f64::from).view()),
+            Want::Both,
+        )
+        .unwrap();
         for i in 0..n {
             if r.pdf[i] > 1e-2 {
-                assert!((f64::from(both.pdf[i]) - r.pdf[i]).abs() < 1e-4 * r.pdf[i], "{i}: {} {}", both.pdf[i], r.pdf[i]);
+                assert!(
+                    (f64::from(both.pdf[i]) - r.pdf[i]).abs() < 1e-4 * r.pdf[i],
+                    "{i}: {} {}",
+                    both.pdf[i],
+                    r.pdf[i]
+                );
             }
         }
     }
@@ -918,12 +1103,27 @@ mod tests {
         wo[[BLOCK + 4, 0]] = f64::NAN;
         let err = sample32(&e, &In2::F64(wo.view()), &In2::F64(u.view()), None).unwrap_err();
         assert_eq!(err.row, BLOCK + 4);
-        assert!(err.message.starts_with(&format!("wo[{}] = (NaN", BLOCK + 4)), "{}", err.message);
+        assert!(
+            err.message
+                .starts_with(&format!("wo[{}] = (NaN", BLOCK + 4)),
+            "{}",
+            err.message
+        );
         assert!(err.message.ends_with("is not finite"), "{}", err.message);
         wo[[BLOCK + 4, 0]] = 0.0;
         wo[[7, 2]] = 3.0;
-        let err = sample_scalar::<f64>(&Engine::new(&m, BsdfStrategy::Vndf, true).unwrap(), &In2::F64(wo.view()), &In2::F64(u.view()), None).unwrap_err();
-        assert!(err.message.starts_with("wo[7] = (") && err.message.contains("not a unit vector"), "{}", err.message);
+        let err = sample_scalar::<f64>(
+            &Engine::new(&m, BsdfStrategy::Vndf, true).unwrap(),
+            &In2::F64(wo.view()),
+            &In2::F64(u.view()),
+            None,
+        )
+        .unwrap_err();
+        assert!(
+            err.message.starts_with("wo[7] = (") && err.message.contains("not a unit vector"),
+            "{}",
+            err.message
+        );
         let (wo, _) = inputs(n);
         u[[9, 1]] = 1.5;
         let err = sample32(&e, &In2::F64(wo.view()), &In2::F64(u.view()), None).unwrap_err();
@@ -941,10 +1141,21 @@ mod tests {
         let n = 1000;
         let (wo, u) = inputs(n);
         let uc = Array1::from_shape_fn(n, |i| (i as f64 * 0.618).fract());
-        let s = sample32(&e, &In2::F64(wo.view()), &In2::F64(u.view()), Some(&In1::F64(uc.view()))).unwrap();
+        let s = sample32(
+            &e,
+            &In2::F64(wo.view()),
+            &In2::F64(u.view()),
+            Some(&In1::F64(uc.view())),
+        )
+        .unwrap();
         for i in 0..n {
             let w = DVec3::new(wo[[i, 0]], wo[[i, 1]], wo[[i, 2]]);
-            let r = m.sample(BsdfStrategy::Brdf, w, uc[i], DVec2::new(u[[i, 0]], u[[i, 1]]));
+            let r = m.sample(
+                BsdfStrategy::Brdf,
+                w,
+                uc[i],
+                DVec2::new(u[[i, 0]], u[[i, 1]]),
+            );
             assert_eq!(r.is_some(), s.valid[i] == 1);
             if let Some(r) = r {
                 assert_eq!(s.pdf[i], r.pdf as f32);

@@ -40,7 +40,9 @@ fn is_envmap_path(spec: &str) -> bool {
 fn vec3(what: &str, spec: &str, s: &str) -> Result<DVec3, String> {
     let parts: Vec<&str> = s.split(',').map(str::trim).collect();
     if parts.len() != 3 {
-        return Err(format!("light {spec}: {what}: expected three numbers x,y,z"));
+        return Err(format!(
+            "light {spec}: {what}: expected three numbers x,y,z"
+        ));
     }
     let mut v = [0.0; 3];
     for (slot, p) in v.iter_mut().zip(&parts) {
@@ -52,7 +54,9 @@ fn vec3(what: &str, spec: &str, s: &str) -> Result<DVec3, String> {
     }
     let v = DVec3::from_array(v);
     if v.length_squared() == 0.0 {
-        return Err(format!("light {spec}: {what}: the zero vector has no direction"));
+        return Err(format!(
+            "light {spec}: {what}: the zero vector has no direction"
+        ));
     }
     Ok(v)
 }
@@ -82,9 +86,9 @@ pub fn parse_light(spec: &str, frame: &Frame) -> Result<Light, String> {
         }
         "beam" => {
             let k = parts.next().map_or(Ok(8.0), |s| number("exponent K", s))?;
-            let d = parts
-                .next()
-                .map_or(Ok(DVec3::new(0.0, 1.0, 0.5)), |s| vec3("direction", spec, s))?;
+            let d = parts.next().map_or(Ok(DVec3::new(0.0, 1.0, 0.5)), |s| {
+                vec3("direction", spec, s)
+            })?;
             let v = parts.next().map_or(Ok(1.0), |s| number("value", s))?;
             if parts.next().is_some() {
                 return Err(format!("light {spec}: expected beam[:K[:X,Y,Z[:VALUE]]]"));
@@ -102,9 +106,13 @@ pub fn parse_light(spec: &str, frame: &Frame) -> Result<Light, String> {
                 .map_or(Ok(default_elevation), |s| number("sun elevation", s))?;
             let azimuth = match parts.next() {
                 None => default_azimuth,
-                Some(s) => s.parse::<f64>().ok().filter(|a| a.is_finite()).ok_or_else(|| {
-                    format!("light {spec}: sun azimuth `{s}` is not a finite number of degrees")
-                })?,
+                Some(s) => s
+                    .parse::<f64>()
+                    .ok()
+                    .filter(|a| a.is_finite())
+                    .ok_or_else(|| {
+                        format!("light {spec}: sun azimuth `{s}` is not a finite number of degrees")
+                    })?,
             };
             if parts.next().is_some() || elevation > 90.0 {
                 return Err(format!(
@@ -200,7 +208,9 @@ pub fn estimate_json(m: &Material, a: &EstimateArgs) -> Result<String, String> {
             // As the CLI's --theta.
             let t = t.unwrap_or(30.0);
             if !t.is_finite() || !(0.0..90.0).contains(&t) {
-                return Err(format!("theta {t}: the view angle must be in [0, 90) degrees"));
+                return Err(format!(
+                    "theta {t}: the view angle must be in [0, 90) degrees"
+                ));
             }
             let r = t.to_radians();
             DVec3::new(r.sin(), 0.0, r.cos())
@@ -212,8 +222,12 @@ pub fn estimate_json(m: &Material, a: &EstimateArgs) -> Result<String, String> {
             a.samples
         ));
     }
-    let frame = Frame::from_normal_tangent(a.normal, a.tangent)
-        .ok_or_else(|| format!("tangent {} is parallel to normal {} (or one is zero)", a.tangent, a.normal))?;
+    let frame = Frame::from_normal_tangent(a.normal, a.tangent).ok_or_else(|| {
+        format!(
+            "tangent {} is parallel to normal {} (or one is zero)",
+            a.tangent, a.normal
+        )
+    })?;
     let light = parse_light(&a.light, &frame)?;
     let mis_bsdf = match &a.mis_bsdf {
         Some(name) => {
@@ -225,7 +239,9 @@ pub fn estimate_json(m: &Material, a: &EstimateArgs) -> Result<String, String> {
     };
     let (b, l) = a.mis_samples;
     if !(1..=64).contains(&b) || !(1..=64).contains(&l) {
-        return Err(format!("mis_samples ({b}, {l}): expected two counts, each 1 to 64"));
+        return Err(format!(
+            "mis_samples ({b}, {l}): expected two counts, each 1 to 64"
+        ));
     }
     let strategies = parse_strategies(&a.strategies, m, mis_bsdf, a.mis_samples)?;
     let sequence: Sequence = a.sequence.parse().map_err(|_| {
@@ -292,9 +308,26 @@ mod tests {
         assert_eq!(rows.len(), 2);
         assert_eq!(rows[0]["name"], "brdf");
         assert!(rows[0]["mean"][0].as_f64().unwrap() > 0.0);
-        let e = estimate_json(&m, &EstimateArgs { strategies: vec!["vndf".into()], ..a.clone() }).unwrap_err();
-        assert!(e.starts_with("strategies: strategy `vndf` does not apply"), "{e}");
-        let e = estimate_json(&m, &EstimateArgs { light: "lamp".into(), ..a }).unwrap_err();
+        let e = estimate_json(
+            &m,
+            &EstimateArgs {
+                strategies: vec!["vndf".into()],
+                ..a.clone()
+            },
+        )
+        .unwrap_err();
+        assert!(
+            e.starts_with("strategies: strategy `vndf` does not apply"),
+            "{e}"
+        );
+        let e = estimate_json(
+            &m,
+            &EstimateArgs {
+                light: "lamp".into(),
+                ..a
+            },
+        )
+        .unwrap_err();
         assert!(e.contains("unknown light `lamp`"), "{e}");
     }
 }

@@ -40,7 +40,9 @@ fn colour(plugin: &str, field: &str, v: &Value) -> Result<Value, String> {
         Value::Object(o) => {
             let kind = o.get("type").and_then(Value::as_str);
             match (kind, o.get("value")) {
-                (Some("rgb" | "spectrum"), Some(inner)) if o.len() == 2 => colour(plugin, field, inner),
+                (Some("rgb" | "spectrum"), Some(inner)) if o.len() == 2 => {
+                    colour(plugin, field, inner)
+                }
                 _ => Err(err(
                     plugin,
                     field,
@@ -48,7 +50,11 @@ fn colour(plugin: &str, field: &str, v: &Value) -> Result<Value, String> {
                 )),
             }
         }
-        _ => Err(err(plugin, field, format!("{v} is not a number or an [r, g, b] array"))),
+        _ => Err(err(
+            plugin,
+            field,
+            format!("{v} is not a number or an [r, g, b] array"),
+        )),
     }
 }
 
@@ -90,7 +96,11 @@ fn sample_visible(plugin: &str, o: &Map<String, Value>) -> Result<(), String> {
             "sample_visible",
             "false is not a material parameter in lobe: pass strategy=\"brdf\" to sample, pdf and eval_pdf instead",
         )),
-        Some(v) => Err(err(plugin, "sample_visible", format!("{v} is not true or false"))),
+        Some(v) => Err(err(
+            plugin,
+            "sample_visible",
+            format!("{v} is not true or false"),
+        )),
     }
 }
 
@@ -117,7 +127,17 @@ pub fn translate(v: Value) -> Result<Value, String> {
             check_keys(
                 kind,
                 o,
-                &["distribution", "alpha", "alpha_u", "alpha_v", "material", "eta", "k", "specular_reflectance", "sample_visible"],
+                &[
+                    "distribution",
+                    "alpha",
+                    "alpha_u",
+                    "alpha_v",
+                    "material",
+                    "eta",
+                    "k",
+                    "specular_reflectance",
+                    "sample_visible",
+                ],
             )?;
             sample_visible(kind, o)?;
             let mut out = Map::new();
@@ -132,7 +152,11 @@ pub fn translate(v: Value) -> Result<Value, String> {
             }
             let fresnel = match (o.get("material"), o.get("eta"), o.get("k")) {
                 (Some(_), Some(_), _) | (Some(_), _, Some(_)) => {
-                    return Err(err(kind, "material", "give either material or eta and k, not both"));
+                    return Err(err(
+                        kind,
+                        "material",
+                        "give either material or eta and k, not both",
+                    ));
                 }
                 (None, None, None) => json!({"type": "none"}),
                 (Some(Value::String(name)), None, None) => {
@@ -151,11 +175,17 @@ pub fn translate(v: Value) -> Result<Value, String> {
                         ));
                     }
                 }
-                (Some(m), None, None) => return Err(err(kind, "material", format!("{m} is not a name"))),
+                (Some(m), None, None) => {
+                    return Err(err(kind, "material", format!("{m} is not a name")));
+                }
                 (None, eta, k) => {
                     let (Some(eta), Some(k)) = (eta, k) else {
                         let missing = if eta.is_none() { "eta" } else { "k" };
-                        return Err(err(kind, missing, "eta and k go together (a conductor's complex index)"));
+                        return Err(err(
+                            kind,
+                            missing,
+                            "eta and k go together (a conductor's complex index)",
+                        ));
                     };
                     json!({"type": "conductor", "eta": colour(kind, "eta", eta)?, "k": colour(kind, "k", k)?})
                 }
@@ -167,40 +197,77 @@ pub fn translate(v: Value) -> Result<Value, String> {
             check_keys(
                 kind,
                 o,
-                &["distribution", "alpha", "int_ior", "ext_ior", "specular_reflectance", "diffuse_reflectance", "nonlinear", "sample_visible"],
+                &[
+                    "distribution",
+                    "alpha",
+                    "int_ior",
+                    "ext_ior",
+                    "specular_reflectance",
+                    "diffuse_reflectance",
+                    "nonlinear",
+                    "sample_visible",
+                ],
             )?;
             sample_visible(kind, o)?;
             match o.get("nonlinear") {
                 None | Some(Value::Bool(false)) => {}
                 Some(v) => {
-                    return Err(err(kind, "nonlinear", format!("{v}: lobe has only the linear (default) form")));
+                    return Err(err(
+                        kind,
+                        "nonlinear",
+                        format!("{v}: lobe has only the linear (default) form"),
+                    ));
                 }
             }
-            let int_ior = o.get("int_ior").map_or(Ok(1.49), |v| number(kind, "int_ior", v))?;
-            let ext_ior = o.get("ext_ior").map_or(Ok(1.000_277), |v| number(kind, "ext_ior", v))?;
+            let int_ior = o
+                .get("int_ior")
+                .map_or(Ok(1.49), |v| number(kind, "int_ior", v))?;
+            let ext_ior = o
+                .get("ext_ior")
+                .map_or(Ok(1.000_277), |v| number(kind, "ext_ior", v))?;
             if !(int_ior > 0.0 && ext_ior > 0.0 && int_ior.is_finite() && ext_ior.is_finite()) {
-                return Err(err(kind, "int_ior", "int_ior and ext_ior must be finite numbers > 0"));
+                return Err(err(
+                    kind,
+                    "int_ior",
+                    "int_ior and ext_ior must be finite numbers > 0",
+                ));
             }
             let mut out = Map::new();
             out.insert("type".into(), json!("cook-torrance"));
             out.insert("distribution".into(), distribution(kind, o)?);
             alpha(kind, o, &mut out, false)?;
             out.insert("shadowing".into(), json!("smith-separable"));
-            let ks = o.get("specular_reflectance").map_or(Ok(json!(1.0)), |c| colour(kind, "specular_reflectance", c))?;
-            let kd = o.get("diffuse_reflectance").map_or(Ok(json!(0.5)), |c| colour(kind, "diffuse_reflectance", c))?;
+            let ks = o
+                .get("specular_reflectance")
+                .map_or(Ok(json!(1.0)), |c| colour(kind, "specular_reflectance", c))?;
+            let kd = o
+                .get("diffuse_reflectance")
+                .map_or(Ok(json!(0.5)), |c| colour(kind, "diffuse_reflectance", c))?;
             out.insert("ks".into(), ks);
             out.insert("kd".into(), kd);
-            out.insert("fresnel".into(), json!({"type": "dielectric", "eta": int_ior / ext_ior}));
+            out.insert(
+                "fresnel".into(),
+                json!({"type": "dielectric", "eta": int_ior / ext_ior}),
+            );
             Ok(Value::Object(out))
         }
         _ => Ok(v),
     }
 }
 
-fn alpha(plugin: &str, o: &Map<String, Value>, out: &mut Map<String, Value>, anisotropic: bool) -> Result<(), String> {
+fn alpha(
+    plugin: &str,
+    o: &Map<String, Value>,
+    out: &mut Map<String, Value>,
+    anisotropic: bool,
+) -> Result<(), String> {
     let (a, au, av) = (o.get("alpha"), o.get("alpha_u"), o.get("alpha_v"));
     if a.is_some() && (au.is_some() || av.is_some()) {
-        return Err(err(plugin, "alpha", "give either alpha or alpha_u and alpha_v, not both"));
+        return Err(err(
+            plugin,
+            "alpha",
+            "give either alpha or alpha_u and alpha_v, not both",
+        ));
     }
     if anisotropic && (au.is_some() || av.is_some()) {
         let (Some(u), Some(v)) = (au, av) else {
@@ -227,29 +294,50 @@ mod tests {
 
     #[test]
     fn plugins_become_lobe_materials() {
-        let m = load(json!({"type": "diffuse", "reflectance": {"type": "rgb", "value": [0.2, 0.4, 0.6]}})).unwrap();
+        let m = load(
+            json!({"type": "diffuse", "reflectance": {"type": "rgb", "value": [0.2, 0.4, 0.6]}}),
+        )
+        .unwrap();
         assert_eq!(m.diffuse.albedo, lobe::Rgb::new(0.2, 0.4, 0.6));
-        let m = load(json!({"type": "roughconductor", "distribution": "ggx", "alpha": 0.2})).unwrap();
-        let lobe::Glossy::CookTorrance(c) = m.glossy else { panic!() };
+        let m =
+            load(json!({"type": "roughconductor", "distribution": "ggx", "alpha": 0.2})).unwrap();
+        let lobe::Glossy::CookTorrance(c) = m.glossy else {
+            panic!()
+        };
         assert_eq!(c.microfacet.alpha(), (0.2, 0.2));
         assert_eq!(c.microfacet.ndf(), lobe::Ndf::Ggx);
         assert_eq!(c.shadowing, lobe::Shadowing::SmithSeparable);
         assert_eq!(c.fresnel, lobe::Fresnel::None);
-        let m = load(json!({"type": "roughconductor", "material": "Cu", "alpha_u": 0.1, "alpha_v": 0.3})).unwrap();
-        let lobe::Glossy::CookTorrance(c) = m.glossy else { panic!() };
+        let m = load(
+            json!({"type": "roughconductor", "material": "Cu", "alpha_u": 0.1, "alpha_v": 0.3}),
+        )
+        .unwrap();
+        let lobe::Glossy::CookTorrance(c) = m.glossy else {
+            panic!()
+        };
         assert_eq!(c.microfacet.ndf(), lobe::Ndf::Beckmann);
         assert_eq!(c.microfacet.alpha(), (0.1, 0.3));
         assert!(matches!(c.fresnel, lobe::Fresnel::Conductor { .. }));
         let m = load(json!({"type": "roughplastic", "distribution": "ggx", "int_ior": 1.5, "ext_ior": 1.0, "diffuse_reflectance": 0.3})).unwrap();
         assert_eq!(m.diffuse.albedo, lobe::Rgb::splat(0.3));
-        let lobe::Glossy::CookTorrance(c) = m.glossy else { panic!() };
-        assert_eq!(c.fresnel, lobe::Fresnel::Dielectric { eta: lobe::Rgb::splat(1.5) });
+        let lobe::Glossy::CookTorrance(c) = m.glossy else {
+            panic!()
+        };
+        assert_eq!(
+            c.fresnel,
+            lobe::Fresnel::Dielectric {
+                eta: lobe::Rgb::splat(1.5)
+            }
+        );
     }
 
     #[test]
     fn bad_keys_are_named() {
         let e = load(json!({"type": "roughconductor", "alpha": 0.1, "alpah_u": 2})).unwrap_err();
-        assert!(e.starts_with("material: field `alpah_u`: unknown parameter"), "{e}");
+        assert!(
+            e.starts_with("material: field `alpah_u`: unknown parameter"),
+            "{e}"
+        );
         let e = load(json!({"type": "roughconductor", "material": "Xx"})).unwrap_err();
         assert!(e.contains("`material`: unknown conductor `Xx`"), "{e}");
         let e = load(json!({"type": "roughconductor", "alpha": -1})).unwrap_err();

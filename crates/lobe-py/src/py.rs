@@ -39,10 +39,16 @@ fn arr<'py>(obj: &Bound<'py, PyAny>, name: &str) -> PyResult<Arr<'py>> {
         .call_method1("asarray", (obj,))
         .map_err(|e| value_error(format!("{name}: not an array of numbers ({e})")))?;
     if let Ok(x) = a.cast::<PyArrayDyn<f32>>() {
-        return Ok(Arr::F32(x.try_readonly().map_err(|e| value_error(format!("{name}: {e}")))?));
+        return Ok(Arr::F32(
+            x.try_readonly()
+                .map_err(|e| value_error(format!("{name}: {e}")))?,
+        ));
     }
     if let Ok(x) = a.cast::<PyArrayDyn<f64>>() {
-        return Ok(Arr::F64(x.try_readonly().map_err(|e| value_error(format!("{name}: {e}")))?));
+        return Ok(Arr::F64(
+            x.try_readonly()
+                .map_err(|e| value_error(format!("{name}: {e}")))?,
+        ));
     }
     let dtype = a.getattr("dtype")?;
     let kind: String = dtype.getattr("kind")?.extract()?;
@@ -53,8 +59,13 @@ fn arr<'py>(obj: &Bound<'py, PyAny>, name: &str) -> PyResult<Arr<'py>> {
         )));
     }
     let b = a.call_method1("astype", ("float64",))?;
-    let x = b.cast_into::<PyArrayDyn<f64>>().map_err(|e| value_error(format!("{name}: {e}")))?;
-    Ok(Arr::F64(x.try_readonly().map_err(|e| value_error(format!("{name}: {e}")))?))
+    let x = b
+        .cast_into::<PyArrayDyn<f64>>()
+        .map_err(|e| value_error(format!("{name}: {e}")))?;
+    Ok(Arr::F64(
+        x.try_readonly()
+            .map_err(|e| value_error(format!("{name}: {e}")))?,
+    ))
 }
 
 impl Arr<'_> {
@@ -69,7 +80,13 @@ impl Arr<'_> {
 fn shape_text(s: &[usize]) -> String {
     match s {
         [a] => format!("({a},)"),
-        _ => format!("({})", s.iter().map(ToString::to_string).collect::<Vec<_>>().join(", ")),
+        _ => format!(
+            "({})",
+            s.iter()
+                .map(ToString::to_string)
+                .collect::<Vec<_>>()
+                .join(", ")
+        ),
     }
 }
 
@@ -82,7 +99,10 @@ fn view2<'a>(a: &'a Arr<'_>, name: &str, cols: usize, n: Option<usize>) -> PyRes
             Some(n) => format!("({n}, {cols})"),
             None => format!("(N, {cols})"),
         };
-        return Err(value_error(format!("{name}: shape {} where {want} is expected", shape_text(&s))));
+        return Err(value_error(format!(
+            "{name}: shape {} where {want} is expected",
+            shape_text(&s)
+        )));
     }
     Ok(match a {
         Arr::F32(x) => In2::F32(x.as_array().into_dimensionality::<Ix2>().expect("2-D")),
@@ -93,7 +113,10 @@ fn view2<'a>(a: &'a Arr<'_>, name: &str, cols: usize, n: Option<usize>) -> PyRes
 fn view1<'a>(a: &'a Arr<'_>, name: &str, n: usize) -> PyResult<In1<'a>> {
     let s = a.shape();
     if s != [n] {
-        return Err(value_error(format!("{name}: shape {} where ({n},) is expected", shape_text(&s))));
+        return Err(value_error(format!(
+            "{name}: shape {} where ({n},) is expected",
+            shape_text(&s)
+        )));
     }
     Ok(match a {
         Arr::F32(x) => In1::F32(x.as_array().into_dimensionality::<Ix1>().expect("1-D")),
@@ -152,12 +175,24 @@ fn strategy_of(m: &Material, s: Option<&str>) -> PyResult<BsdfStrategy> {
     }
 }
 
-fn f32_or_64<'py>(py: Python<'py>, n: usize, cols: usize, v32: Option<Vec<f32>>, v64: Option<Vec<f64>>) -> Bound<'py, PyAny> {
+fn f32_or_64<'py>(
+    py: Python<'py>,
+    n: usize,
+    cols: usize,
+    v32: Option<Vec<f32>>,
+    v64: Option<Vec<f64>>,
+) -> Bound<'py, PyAny> {
     match (v32, v64) {
         (Some(v), _) if cols == 1 => Array1::from_vec(v).into_pyarray(py).into_any(),
-        (Some(v), _) => Array2::from_shape_vec((n, cols).f(), v).expect("n × cols").into_pyarray(py).into_any(),
+        (Some(v), _) => Array2::from_shape_vec((n, cols).f(), v)
+            .expect("n × cols")
+            .into_pyarray(py)
+            .into_any(),
         (None, Some(v)) if cols == 1 => Array1::from_vec(v).into_pyarray(py).into_any(),
-        (None, Some(v)) => Array2::from_shape_vec((n, cols).f(), v).expect("n × cols").into_pyarray(py).into_any(),
+        (None, Some(v)) => Array2::from_shape_vec((n, cols).f(), v)
+            .expect("n × cols")
+            .into_pyarray(py)
+            .into_any(),
         (None, None) => unreachable!("one of the two"),
     }
 }
@@ -183,6 +218,8 @@ pub struct PyMaterial {
 /// The result of `Material.sample`: `wi` (N, 3), `weight` (N, 3, = f·cos θi / pdf, the Monte Carlo weight), `pdf` (N,,
 /// solid angle), `valid` (N,) bool. A failed sample (below the horizon) has
 /// `valid = False` and zeros elsewhere.
+/// Conventions: local frame (+z the normal), wo toward the viewer, wi
+/// toward the light, f without the cosine, weight = f·cos θi / pdf.
 #[pyclass(module = "lobe", name = "SampleResult", frozen)]
 pub struct SampleResult {
     #[pyo3(get)]
@@ -198,11 +235,17 @@ pub struct SampleResult {
 }
 
 /// A writeable float32 array of `shape`, Fortran-contiguous, as a slice.
-fn out_slice<'py>(a: &Bound<'py, PyAny>, name: &str, shape: &[usize]) -> PyResult<numpy::PyReadwriteArrayDyn<'py, f32>> {
+fn out_slice<'py>(
+    a: &Bound<'py, PyAny>,
+    name: &str,
+    shape: &[usize],
+) -> PyResult<numpy::PyReadwriteArrayDyn<'py, f32>> {
     let arr = a
         .cast::<PyArrayDyn<f32>>()
         .map_err(|_| value_error(format!("out: {name} is not a float32 array (out= takes the result of a call without reference=True)")))?;
-    if arr.shape() != shape || !(arr.is_fortran_contiguous() || shape.len() == 1 && arr.is_contiguous()) {
+    if arr.shape() != shape
+        || !(arr.is_fortran_contiguous() || shape.len() == 1 && arr.is_contiguous())
+    {
         return Err(value_error(format!(
             "out: {name} has shape {} (Fortran-contiguous {}), expected {} Fortran-contiguous",
             shape_text(arr.shape()),
@@ -210,7 +253,8 @@ fn out_slice<'py>(a: &Bound<'py, PyAny>, name: &str, shape: &[usize]) -> PyResul
             shape_text(shape)
         )));
     }
-    arr.try_readwrite().map_err(|e| value_error(format!("out: {name}: {e}")))
+    arr.try_readwrite()
+        .map_err(|e| value_error(format!("out: {name}: {e}")))
 }
 
 #[pymethods]
@@ -233,7 +277,8 @@ impl PyMaterial {
     ) -> PyResult<(Option<Bound<'py, PyAny>>, Option<Bound<'py, PyAny>>)> {
         let e = match want {
             Want::Eval => Engine::for_eval(&self.m, reference),
-            _ => Engine::new(&self.m, strategy_of(&self.m, strategy)?, reference).map_err(value_error)?,
+            _ => Engine::new(&self.m, strategy_of(&self.m, strategy)?, reference)
+                .map_err(value_error)?,
         };
         let (a_wo, a_wi) = (arr(wo, "wo")?, arr(wi, "wi")?);
         let n = rows_of(&a_wi).or(rows_of(&a_wo)).unwrap_or(1);
@@ -241,13 +286,17 @@ impl PyMaterial {
         let v_wo = dirs(&a_wo, "wo", n, &mut h1)?;
         let v_wi = dirs(&a_wi, "wi", n, &mut h2)?;
         let (f, p) = if reference {
-            let r = py.detach(|| in_pool(|| engine::eval_pdf_scalar::<f64>(&e, &v_wo, &v_wi, want))).map_err(bad)?;
+            let r = py
+                .detach(|| in_pool(|| engine::eval_pdf_scalar::<f64>(&e, &v_wo, &v_wi, want)))
+                .map_err(bad)?;
             (
                 (want != Want::Pdf).then(|| f32_or_64(py, n, 3, None, Some(r.f.clone()))),
                 (want != Want::Eval).then(|| f32_or_64(py, n, 1, None, Some(r.pdf.clone()))),
             )
         } else {
-            let r = py.detach(|| in_pool(|| engine::eval_pdf32(&e, &v_wo, &v_wi, want))).map_err(bad)?;
+            let r = py
+                .detach(|| in_pool(|| engine::eval_pdf32(&e, &v_wo, &v_wi, want)))
+                .map_err(bad)?;
             let engine::EvalPdfOut { f, pdf, .. } = r;
             (
                 (want != Want::Pdf).then(|| f32_or_64(py, n, 3, Some(f), None)),
@@ -262,8 +311,8 @@ impl PyMaterial {
 impl PyMaterial {
     /// f_r(wo, wi) WITHOUT the cosine, (N, 3); zero unless both directions
     /// are above the horizon (local frame, +z the normal, wo toward the
-    /// viewer, wi toward the light). A zero vector as wi (a failed sample's)
-    /// gives zero.
+    /// viewer, wi toward the light; a sample's weight is f·cos θi / pdf).
+    /// A zero vector as wi (a failed sample's) gives zero.
     ///
     /// >>> import lobe, numpy as np
     /// >>> m = lobe.load_dict({"type": "lambert", "albedo": 0.5})
@@ -271,27 +320,48 @@ impl PyMaterial {
     /// >>> bool(np.allclose(f, 0.5 / np.pi))
     /// True
     #[pyo3(signature = (wo, wi, *, reference = false))]
-    fn eval<'py>(&self, py: Python<'py>, wo: &Bound<'py, PyAny>, wi: &Bound<'py, PyAny>, reference: bool) -> PyResult<Bound<'py, PyAny>> {
-        Ok(self.pair(py, wo, wi, None, reference, Want::Eval)?.0.expect("eval"))
+    fn eval<'py>(
+        &self,
+        py: Python<'py>,
+        wo: &Bound<'py, PyAny>,
+        wi: &Bound<'py, PyAny>,
+        reference: bool,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        Ok(self
+            .pair(py, wo, wi, None, reference, Want::Eval)?
+            .0
+            .expect("eval"))
     }
 
     /// The density in solid angle with which `sample(wo, ..., strategy)`
     /// draws wi, (N,); zero below the horizon. `strategy`: one of
     /// `Material.strategies` (default: vndf where it applies, else brdf).
-    /// Local frame, +z the normal, wo toward the viewer, wi toward the light.
+    /// Local frame, +z the normal, wo toward the viewer, wi toward the light;
+    /// eval is without the cosine, a sample's weight is f·cos θi / pdf.
     ///
     /// >>> import lobe, numpy as np
     /// >>> m = lobe.load_dict({"type": "lambert"})
     /// >>> bool(m.pdf([0, 0, 1], [[0, 0, 1]], strategy="cosine")[0] == np.float32(1 / np.pi))
     /// True
     #[pyo3(signature = (wo, wi, strategy = None, *, reference = false))]
-    fn pdf<'py>(&self, py: Python<'py>, wo: &Bound<'py, PyAny>, wi: &Bound<'py, PyAny>, strategy: Option<&str>, reference: bool) -> PyResult<Bound<'py, PyAny>> {
-        Ok(self.pair(py, wo, wi, strategy, reference, Want::Pdf)?.1.expect("pdf"))
+    fn pdf<'py>(
+        &self,
+        py: Python<'py>,
+        wo: &Bound<'py, PyAny>,
+        wi: &Bound<'py, PyAny>,
+        strategy: Option<&str>,
+        reference: bool,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        Ok(self
+            .pair(py, wo, wi, strategy, reference, Want::Pdf)?
+            .1
+            .expect("pdf"))
     }
 
     /// `(f, pdf)` in one call: f_r WITHOUT the cosine (N, 3) and the
     /// strategy's solid-angle pdf (N,), sharing their terms. Local frame,
-    /// +z the normal, wo toward the viewer, wi toward the light. `out=(f,
+    /// +z the normal, wo toward the viewer, wi toward the light; a sample's
+    /// weight is f·cos θi / pdf. `out=(f,
     /// pdf)` (float32, Fortran-contiguous (N, 3) and (N,), e.g. a previous
     /// result) writes into them.
     ///
@@ -316,9 +386,12 @@ impl PyMaterial {
             return Ok((f.expect("f"), p.expect("pdf")));
         };
         if reference {
-            return Err(value_error("out: not with reference=True (its results are float64)"));
+            return Err(value_error(
+                "out: not with reference=True (its results are float64)",
+            ));
         }
-        let e = Engine::new(&self.m, strategy_of(&self.m, strategy)?, false).map_err(value_error)?;
+        let e =
+            Engine::new(&self.m, strategy_of(&self.m, strategy)?, false).map_err(value_error)?;
         let (a_wo, a_wi) = (arr(wo, "wo")?, arr(wi, "wi")?);
         let n = rows_of(&a_wi).or(rows_of(&a_wo)).unwrap_or(1);
         let (mut h1, mut h2) = (None, None);
@@ -332,7 +405,8 @@ impl PyMaterial {
                 f: a_f.as_slice_mut().map_err(value_error)?,
                 pdf: a_p.as_slice_mut().map_err(value_error)?,
             };
-            py.detach(|| in_pool(|| engine::eval_pdf32_into(&e, &v_wo, &v_wi, slices))).map_err(bad)?;
+            py.detach(|| in_pool(|| engine::eval_pdf32_into(&e, &v_wo, &v_wi, slices)))
+                .map_err(bad)?;
         }
         Ok((fo, po))
     }
@@ -382,10 +456,17 @@ impl PyMaterial {
         let v_uc = a_uc.as_ref().map(|c| view1(c, "uc", n)).transpose()?;
         if let Some(o) = out {
             if reference {
-                return Err(value_error("out: not with reference=True (its results are float64)"));
+                return Err(value_error(
+                    "out: not with reference=True (its results are float64)",
+                ));
             }
             let r = o.get();
-            let (wi, weight, pdf, valid) = (r.wi.bind(py), r.weight.bind(py), r.pdf.bind(py), r.raw_valid.bind(py));
+            let (wi, weight, pdf, valid) = (
+                r.wi.bind(py),
+                r.weight.bind(py),
+                r.pdf.bind(py),
+                r.raw_valid.bind(py),
+            );
             let mut a_wi = out_slice(wi, "wi", &[n, 3])?;
             let mut a_w = out_slice(weight, "weight", &[n, 3])?;
             let mut a_p = out_slice(pdf, "pdf", &[n])?;
@@ -402,9 +483,13 @@ impl PyMaterial {
                 valid: a_v.as_slice_mut().map_err(value_error)?,
             };
             if slices.valid.len() != n {
-                return Err(value_error(format!("out: valid has {} values, expected {n}", slices.valid.len())));
+                return Err(value_error(format!(
+                    "out: valid has {} values, expected {n}",
+                    slices.valid.len()
+                )));
             }
-            py.detach(|| in_pool(|| engine::sample32_into(&e, &v_wo, &v_u, v_uc.as_ref(), slices))).map_err(bad)?;
+            py.detach(|| in_pool(|| engine::sample32_into(&e, &v_wo, &v_u, v_uc.as_ref(), slices)))
+                .map_err(bad)?;
             return Ok(o.unbind());
         }
         // The kernels' 0/1 bytes, seen as NumPy bools without a copy.
@@ -420,7 +505,9 @@ impl PyMaterial {
             Py::new(py, r)
         };
         if reference {
-            let r = py.detach(|| in_pool(|| engine::sample_scalar::<f64>(&e, &v_wo, &v_u, v_uc.as_ref()))).map_err(bad)?;
+            let r = py
+                .detach(|| in_pool(|| engine::sample_scalar::<f64>(&e, &v_wo, &v_u, v_uc.as_ref())))
+                .map_err(bad)?;
             out(
                 f32_or_64(py, n, 3, None, Some(r.wi)).unbind(),
                 f32_or_64(py, n, 3, None, Some(r.weight)).unbind(),
@@ -428,7 +515,9 @@ impl PyMaterial {
                 r.valid,
             )
         } else {
-            let r = py.detach(|| in_pool(|| engine::sample32(&e, &v_wo, &v_u, v_uc.as_ref()))).map_err(bad)?;
+            let r = py
+                .detach(|| in_pool(|| engine::sample32(&e, &v_wo, &v_u, v_uc.as_ref())))
+                .map_err(bad)?;
             out(
                 f32_or_64(py, n, 3, Some(r.wi), None).unbind(),
                 f32_or_64(py, n, 3, Some(r.weight), None).unbind(),
@@ -439,9 +528,15 @@ impl PyMaterial {
     }
 
     /// The strategies that apply to this material (names for `strategy=`).
+    /// Conventions: local frame (+z the normal), wo toward the viewer, wi
+    /// toward the light, f without the cosine, weight = f·cos θi / pdf.
     #[getter]
     fn strategies(&self) -> Vec<&'static str> {
-        self.m.strategies().into_iter().map(BsdfStrategy::name).collect()
+        self.m
+            .strategies()
+            .into_iter()
+            .map(BsdfStrategy::name)
+            .collect()
     }
 
     /// Whether `strategy` (default: vndf where it applies, else brdf) runs
@@ -453,6 +548,8 @@ impl PyMaterial {
     }
 
     /// Whether `strategy` chooses between two lobes with `uc`.
+    /// Conventions: local frame (+z the normal), wo toward the viewer, wi
+    /// toward the light, f without the cosine, weight = f·cos θi / pdf.
     #[pyo3(signature = (strategy = None))]
     fn chooses_lobe(&self, strategy: Option<&str>) -> PyResult<bool> {
         Ok(self.m.chooses_lobe(strategy_of(&self.m, strategy)?))
@@ -479,7 +576,8 @@ impl PyMaterial {
 /// Mitsuba dict as JSON); errors name the field.
 #[pyfunction]
 fn _load_json(text: &str) -> PyResult<PyMaterial> {
-    let v: serde_json::Value = serde_json::from_str(text).map_err(|e| value_error(format!("material: invalid JSON: {e}")))?;
+    let v: serde_json::Value = serde_json::from_str(text)
+        .map_err(|e| value_error(format!("material: invalid JSON: {e}")))?;
     if !v.is_object() {
         return Err(PyTypeError::new_err("material: expected a dict"));
     }
@@ -498,10 +596,15 @@ fn set_threads(n: Option<usize>) -> PyResult<()> {
         None => None,
         Some(0) => return Err(value_error("set_threads: at least 1 thread")),
         Some(n) => Some(Arc::new(
-            rayon::ThreadPoolBuilder::new().num_threads(n).build().map_err(value_error)?,
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(n)
+                .build()
+                .map_err(value_error)?,
         )),
     };
-    *POOL.write().map_err(|_| value_error("thread pool lock poisoned"))? = pool;
+    *POOL
+        .write()
+        .map_err(|_| value_error("thread pool lock poisoned"))? = pool;
     Ok(())
 }
 
@@ -515,13 +618,19 @@ fn get_threads() -> usize {
 /// The SIMD level of the batch kernels (`avx512`, `avx2`, `scalar`).
 #[pyfunction]
 fn simd_level() -> PyResult<&'static str> {
-    lobe::batch::SimdLevel::from_env().map(|l| l.name()).map_err(value_error)
+    lobe::batch::SimdLevel::from_env()
+        .map(|l| l.name())
+        .map_err(value_error)
 }
 
 fn vec3_of(v: &Bound<'_, PyAny>, name: &str) -> PyResult<DVec3> {
-    let a: Vec<f64> = v.extract().map_err(|_| value_error(format!("{name}: expected three numbers x, y, z")))?;
+    let a: Vec<f64> = v
+        .extract()
+        .map_err(|_| value_error(format!("{name}: expected three numbers x, y, z")))?;
     if a.len() != 3 || !a.iter().all(|x| x.is_finite()) {
-        return Err(value_error(format!("{name}: expected three finite numbers x, y, z")));
+        return Err(value_error(format!(
+            "{name}: expected three finite numbers x, y, z"
+        )));
     }
     Ok(DVec3::new(a[0], a[1], a[2]))
 }
@@ -561,7 +670,8 @@ fn _estimate_json(
         mis_samples,
     };
     let m = material.m;
-    py.detach(|| crate::estimate::estimate_json(&m, &a)).map_err(value_error)
+    py.detach(|| crate::estimate::estimate_json(&m, &a))
+        .map_err(value_error)
 }
 
 /// Render a scene (TOML text as if read from `path`) to an (H, W, 3)
@@ -579,7 +689,8 @@ fn _render<'py>(
     max_depth: Option<u32>,
     threads: Option<usize>,
 ) -> PyResult<Bound<'py, PyAny>> {
-    let mut scene = lobe_render::parse_scene(text, std::path::Path::new(path)).map_err(value_error)?;
+    let mut scene =
+        lobe_render::parse_scene(text, std::path::Path::new(path)).map_err(value_error)?;
     let mut opts = scene.options;
     if let Some(n) = spp {
         if n == 0 {
@@ -588,7 +699,9 @@ fn _render<'py>(
         opts.spp = n;
     }
     if let Some(s) = strategy {
-        opts.strategy = s.parse().map_err(|e| value_error(format!("strategy: {e}")))?;
+        opts.strategy = s
+            .parse()
+            .map_err(|e| value_error(format!("strategy: {e}")))?;
     }
     if let Some(s) = seed {
         opts.seed = s;
@@ -617,7 +730,8 @@ fn _render<'py>(
 /// JSON text to TOML text (for a scene given as a dict).
 #[pyfunction]
 fn _json_to_toml(text: &str) -> PyResult<String> {
-    let v: serde_json::Value = serde_json::from_str(text).map_err(|e| value_error(format!("scene: {e}")))?;
+    let v: serde_json::Value =
+        serde_json::from_str(text).map_err(|e| value_error(format!("scene: {e}")))?;
     let t = toml::Value::try_from(v).map_err(|e| value_error(format!("scene: {e}")))?;
     toml::to_string(&t).map_err(|e| value_error(format!("scene: {e}")))
 }
@@ -627,7 +741,10 @@ fn _json_to_toml(text: &str) -> PyResult<String> {
 fn _chi2_uniforms(py: Python<'_>, seed: u64, samples: usize) -> Bound<'_, PyAny> {
     let u = py.detach(|| crate::chi2::uniforms(seed, samples));
     let flat: Vec<f64> = u.into_iter().flatten().collect();
-    Array2::from_shape_vec((samples, 3), flat).expect("n × 3").into_pyarray(py).into_any()
+    Array2::from_shape_vec((samples, 3), flat)
+        .expect("n × 3")
+        .into_pyarray(py)
+        .into_any()
 }
 
 /// lobe's chi-square harness on precomputed samples and cell probabilities.
@@ -660,8 +777,18 @@ fn _chi2_test<'py>(
     out.set_item("statistic", r.statistic)?;
     out.set_item("dof", r.dof)?;
     out.set_item("p_value", r.p_value)?;
-    out.set_item("observed", Array2::from_shape_vec((n_z, n_phi), r.observed).expect("cells").into_pyarray(py))?;
-    out.set_item("expected", Array2::from_shape_vec((n_z, n_phi), r.expected).expect("cells").into_pyarray(py))?;
+    out.set_item(
+        "observed",
+        Array2::from_shape_vec((n_z, n_phi), r.observed)
+            .expect("cells")
+            .into_pyarray(py),
+    )?;
+    out.set_item(
+        "expected",
+        Array2::from_shape_vec((n_z, n_phi), r.expected)
+            .expect("cells")
+            .into_pyarray(py),
+    )?;
     out.set_item("lost_observed", r.lost_observed)?;
     out.set_item("lost_expected", r.lost_expected)?;
     out.set_item("pdf_integral", r.pdf_integral)?;
