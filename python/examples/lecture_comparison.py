@@ -46,11 +46,11 @@ def main() -> None:
         for ax, name in zip(axes, MATERIALS):
             for (mat, strategy), err in curves.items():
                 if mat == name:
-                    ax.loglog(np.arange(1, len(err) + 1), np.maximum(err, 1e-7), label=strategy)
+                    ax.loglog(np.arange(1, len(err) + 1), np.maximum(err, 1e-6), label=strategy)
             ax.set_title(name)
             ax.set_xlabel("samples")
-        axes[0].set_ylabel("relative error")
-        axes[0].legend()
+            ax.legend(loc="lower left")
+        axes[0].set_ylabel("relative error of the running estimate")
         fig.tight_layout()
         fig.savefig(a.out, dpi=120)
         print(f"wrote {a.out}")
