@@ -268,7 +268,12 @@ fn check_dirs<T: Real>(
             continue;
         }
         // NaN fails the comparison.
-        if !((n2 - 1.0).abs() <= UNIT_TOLERANCE) {
+        // NaN fails `is_some_and`.
+        if !(n2 - 1.0)
+            .abs()
+            .partial_cmp(&UNIT_TOLERANCE)
+            .is_some_and(|o| o.is_le())
+        {
             let row = start + i;
             let what = if !(a.is_finite() && b.is_finite() && c.is_finite()) {
                 "is not finite".to_string()
@@ -463,10 +468,10 @@ fn split3<T>(v: &mut [T], n: usize) -> Vec<[&mut [T]; 3]> {
 fn first_error(errors: impl Iterator<Item = Result<(), BadInput>>) -> Result<(), BadInput> {
     let mut worst: Option<BadInput> = None;
     for e in errors {
-        if let Err(e) = e {
-            if worst.as_ref().is_none_or(|w| e.row < w.row) {
-                worst = Some(e);
-            }
+        if let Err(e) = e
+            && worst.as_ref().is_none_or(|w| e.row < w.row)
+        {
+            worst = Some(e);
         }
     }
     worst.map_or(Ok(()), Err)

@@ -265,6 +265,9 @@ impl SampleResult {
     }
 }
 
+/// `f` and `pdf` of [`PyMaterial::pair`], each only where wanted.
+type Pair<'py> = (Option<Bound<'py, PyAny>>, Option<Bound<'py, PyAny>>);
+
 impl PyMaterial {
     fn pair<'py>(
         &self,
@@ -274,7 +277,7 @@ impl PyMaterial {
         strategy: Option<&str>,
         reference: bool,
         want: Want,
-    ) -> PyResult<(Option<Bound<'py, PyAny>>, Option<Bound<'py, PyAny>>)> {
+    ) -> PyResult<Pair<'py>> {
         let e = match want {
             Want::Eval => Engine::for_eval(&self.m, reference),
             _ => Engine::new(&self.m, strategy_of(&self.m, strategy)?, reference)
@@ -750,6 +753,7 @@ fn _chi2_uniforms(py: Python<'_>, seed: u64, samples: usize) -> Bound<'_, PyAny>
 /// lobe's chi-square harness on precomputed samples and cell probabilities.
 #[pyfunction]
 #[pyo3(signature = (n_z, n_phi, min_expected, dirs, valid, probs, errors))]
+#[allow(clippy::too_many_arguments)]
 fn _chi2_test<'py>(
     py: Python<'py>,
     n_z: usize,
