@@ -174,7 +174,7 @@ def test_two_threads_run_at_once():
     lobe.set_threads(1)
     try:
         best = None
-        for _ in range(3):
+        for _ in range(6):  # a shared machine: the best of a few tries
             t0 = time.perf_counter()
             for _ in range(2):
                 m.sample(wo, u)
