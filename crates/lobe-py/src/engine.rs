@@ -1,0 +1,1171 @@
+//! The array engine behind `lobe.Material`: blocks of inputs in any dtype
+//! (f32 or f64) and any memory order, checked, run on the batch SIMD
+//! kernels of [`lobe::batch`] where they cover the material and strategy and
+//! on the scalar f64 path otherwise, split over rayon's threads in fixed
+//! blocks of [`BLOCK`] samples.
+//!
+//! Pure Rust (no Python): the bindings (`py.rs`) only turn NumPy arrays into
+//! the views of this module and back.
+//!
+//! Conventions (the library's): local shading frame, `+z` the normal; `wo`
+//! toward the viewer, `wi` toward the light, unit, away from the surface;
+//! `f` is `f_r` **without** the cosine; pdfs are solid-angle densities;
+//! `weight = f · cos θi / pdf`; a failed sample is `valid = false` with
+//! every other output 0.
+
+use glam::{DVec2, DVec3};
+use lobe::batch::{BatchSampler, Dirs, DirsMut, EvalPdfOutput, RgbMut, SampleInput, SampleOutput};
+use lobe::{BsdfStrategy, Material};
+use ndarray::{ArrayView1, ArrayView2, Axis};
+use rayon::prelude::*;
+
+/// Samples per block: every block is one call of the batch kernels, whose
+/// scratch stays in the caches. Blocks are independent, so the results do
+/// not depend on the thread count.
+pub const BLOCK: usize = 4096;
+
+/// Largest accepted `|‖w‖² − 1|` of an input direction.
+pub const UNIT_TOLERANCE: f64 = 1e-4;
+
+/// An `(N, 3)` (or `(N, 2)`) input in f32 or f64, any strides.
+#[derive(Debug, Clone)]
+pub enum In2<'a> {
+    F32(ArrayView2<'a, f32>),
+    F64(ArrayView2<'a, f64>),
+}
+
+/// An `(N,)` input in f32 or f64, any stride.
+#[derive(Debug, Clone)]
+pub enum In1<'a> {
+    F32(ArrayView1<'a, f32>),
+    F64(ArrayView1<'a, f64>),
+}
+
+impl In2<'_> {
+    #[must_use]
+    pub fn rows(&self) -> usize {
+        match self {
+            In2::F32(a) => a.nrows(),
+            In2::F64(a) => a.nrows(),
+        }
+    }
+    #[must_use]
+    pub fn cols(&self) -> usize {
+        match self {
+            In2::F32(a) => a.ncols(),
+            In2::F64(a) => a.ncols(),
+        }
+    }
+}
+
+impl In1<'_> {
+    #[must_use]
+    pub fn len(&self) -> usize {
+        match self {
+            In1::F32(a) => a.len(),
+            In1::F64(a) => a.len(),
+        }
+    }
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+}
+
+/// An input value that is wrong: which array, which row (and column), and
+/// what is wrong, in words.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BadInput {
+    pub row: usize,
+    pub message: String,
+}
+
+impl std::fmt::Display for BadInput {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.message)
+    }
+}
+
+/// A float type the engine computes in: f32 (the batch kernels) or f64
+/// (the scalar reference).
+pub trait Real:
+    Copy + Send + Sync + Default + PartialOrd + std::ops::Sub<Output = Self> + 'static
+{
+    /// `a² + b² + c²`.
+    fn mul_add3(a: Self, b: Self, c: Self) -> Self;
+    fn neg(self) -> Self;
+    /// The shortest text that reads back as this value.
+    fn show(self) -> String;
+    fn from_f32(x: f32) -> Self;
+    fn from_f64(x: f64) -> Self;
+    fn to_f64(self) -> f64;
+    /// The largest value below one.
+    const BELOW_ONE: Self;
+    /// The contiguous part `r` of column `c` when the source has this type.
+    fn column<'a>(src: &'a In2<'_>, c: usize, r: std::ops::Range<usize>) -> Option<&'a [Self]>;
+    fn column1<'a>(src: &'a In1<'_>, r: std::ops::Range<usize>) -> Option<&'a [Self]>;
+}
+
+impl Real for f32 {
+    fn mul_add3(a: f32, b: f32, c: f32) -> f32 {
+        a * a + b * b + c * c
+    }
+    fn neg(self) -> f32 {
+        -self
+    }
+    fn show(self) -> String {
+        self.to_string()
+    }
+    fn from_f32(x: f32) -> Self {
+        x
+    }
+    fn from_f64(x: f64) -> Self {
+        x as f32
+    }
+    fn to_f64(self) -> f64 {
+        f64::from(self)
+    }
+    const BELOW_ONE: f32 = 1.0 - f32::EPSILON / 2.0;
+    fn column<'a>(src: &'a In2<'_>, c: usize, r: std::ops::Range<usize>) -> Option<&'a [f32]> {
+        match src {
+            In2::F32(a) => column_slice(a, c, r),
+            In2::F64(_) => None,
+        }
+    }
+    fn column1<'a>(src: &'a In1<'_>, r: std::ops::Range<usize>) -> Option<&'a [f32]> {
+        match src {
+            In1::F32(a) => slice1(a, r),
+            In1::F64(_) => None,
+        }
+    }
+}
+
+impl Real for f64 {
+    fn mul_add3(a: f64, b: f64, c: f64) -> f64 {
+        a * a + b * b + c * c
+    }
+    fn neg(self) -> f64 {
+        -self
+    }
+    fn show(self) -> String {
+        self.to_string()
+    }
+    fn from_f32(x: f32) -> Self {
+        f64::from(x)
+    }
+    fn from_f64(x: f64) -> Self {
+        x
+    }
+    fn to_f64(self) -> f64 {
+        self
+    }
+    const BELOW_ONE: f64 = 1.0 - f64::EPSILON / 2.0;
+    fn column<'a>(src: &'a In2<'_>, c: usize, r: std::ops::Range<usize>) -> Option<&'a [f64]> {
+        match src {
+            In2::F64(a) => column_slice(a, c, r),
+            In2::F32(_) => None,
+        }
+    }
+    fn column1<'a>(src: &'a In1<'_>, r: std::ops::Range<usize>) -> Option<&'a [f64]> {
+        match src {
+            In1::F64(a) => slice1(a, r),
+            In1::F32(_) => None,
+        }
+    }
+}
+
+fn column_slice<'a, T>(
+    a: &'a ArrayView2<'_, T>,
+    c: usize,
+    r: std::ops::Range<usize>,
+) -> Option<&'a [T]> {
+    // A column is contiguous when the row stride is 1 (Fortran order).
+    if a.strides()[0] != 1 || a.nrows() == 0 {
+        return None;
+    }
+    let col = a.index_axis(Axis(1), c);
+    let ptr = col.as_ptr();
+    // SAFETY: the column has `nrows` elements at stride 1 starting at `ptr`,
+    // borrowed from `a` for 'a; `r` is within `0..nrows` (checked).
+    if r.end > a.nrows() {
+        return None;
+    }
+    Some(unsafe { std::slice::from_raw_parts(ptr.add(r.start), r.len()) })
+}
+
+fn slice1<'a, T>(a: &'a ArrayView1<'_, T>, r: std::ops::Range<usize>) -> Option<&'a [T]> {
+    if r.end > a.len() {
+        return None;
+    }
+    if a.strides()[0] == 1 || a.len() <= 1 {
+        let ptr = a.as_ptr();
+        // SAFETY: stride 1, `r` within the length, borrowed for 'a.
+        return Some(unsafe { std::slice::from_raw_parts(ptr.add(r.start), r.len()) });
+    }
+    None
+}
+
+/// Reads rows `r` of column `c` of `src` as `T` into `buf` (unless the
+/// source already is a contiguous `T` column) and returns the slice.
+fn load_col<'a, T: Real>(
+    src: &'a In2<'_>,
+    c: usize,
+    r: std::ops::Range<usize>,
+    buf: &'a mut Vec<T>,
+) -> &'a [T] {
+    if let Some(s) = T::column(src, c, r.clone()) {
+        return s;
+    }
+    buf.clear();
+    match src {
+        In2::F32(a) => buf.extend(a.slice(ndarray::s![r, c]).iter().map(|&x| T::from_f32(x))),
+        In2::F64(a) => buf.extend(a.slice(ndarray::s![r, c]).iter().map(|&x| T::from_f64(x))),
+    }
+    buf
+}
+
+fn load_1<'a, T: Real>(
+    src: &'a In1<'_>,
+    r: std::ops::Range<usize>,
+    buf: &'a mut Vec<T>,
+) -> &'a [T] {
+    if let Some(s) = T::column1(src, r.clone()) {
+        return s;
+    }
+    buf.clear();
+    match src {
+        In1::F32(a) => buf.extend(a.slice(ndarray::s![r]).iter().map(|&x| T::from_f32(x))),
+        In1::F64(a) => buf.extend(a.slice(ndarray::s![r]).iter().map(|&x| T::from_f64(x))),
+    }
+    buf
+}
+
+/// Checks a block of directions (rows from `start`): finite and unit.
+fn check_dirs<T: Real>(
+    name: &str,
+    x: &[T],
+    y: &[T],
+    z: &[T],
+    start: usize,
+    zero_ok: bool,
+) -> Result<bool, BadInput> {
+    // The common case first, in one branch-free (vectorizable) pass.
+    let tol = T::from_f64(UNIT_TOLERANCE);
+    let one = T::from_f64(1.0);
+    let all_unit = x.iter().zip(y).zip(z).fold(true, |ok, ((&a, &b), &c)| {
+        let d = T::mul_add3(a, b, c) - one;
+        ok & (d <= tol) & (d >= T::neg(tol))
+    });
+    if all_unit {
+        return Ok(false);
+    }
+    let mut zeros = false;
+    for i in 0..x.len() {
+        let (a, b, c) = (x[i].to_f64(), y[i].to_f64(), z[i].to_f64());
+        let n2 = a * a + b * b + c * c;
+        if zero_ok && n2 == 0.0 {
+            zeros = true;
+            continue;
+        }
+        // NaN fails the comparison.
+        // NaN fails `is_some_and`.
+        if !(n2 - 1.0)
+            .abs()
+            .partial_cmp(&UNIT_TOLERANCE)
+            .is_some_and(|o| o.is_le())
+        {
+            let row = start + i;
+            let what = if !(a.is_finite() && b.is_finite() && c.is_finite()) {
+                "is not finite".to_string()
+            } else {
+                format!(
+                    "is not a unit vector (length {:.6}); directions must be unit vectors in the local frame (+z the normal)",
+                    n2.sqrt()
+                )
+            };
+            return Err(BadInput {
+                row,
+                message: format!(
+                    "{name}[{row}] = ({}, {}, {}) {what}",
+                    x[i].show(),
+                    y[i].show(),
+                    z[i].show()
+                ),
+            });
+        }
+    }
+    Ok(zeros)
+}
+
+/// `w` normalized where it is further from unit length than the library's
+/// own check (`1e-6` in `|w|²`); within [`UNIT_TOLERANCE`] as checked.
+fn unit(w: DVec3) -> DVec3 {
+    if (w.length_squared() - 1.0).abs() < 1e-6 {
+        w
+    } else {
+        w.normalize()
+    }
+}
+
+/// Checks a block of uniforms: in `[0, 1]`; returns them with 1 moved to
+/// the largest value below one (an f64 just below one rounds to 1 in f32).
+fn check_uniform<'a, T: Real>(
+    name: &str,
+    v: &'a [T],
+    start: usize,
+    buf: &'a mut Vec<T>,
+) -> Result<&'a [T], BadInput> {
+    let (zero, one) = (T::from_f64(0.0), T::from_f64(1.0));
+    if v.iter().fold(true, |ok, &x| ok & (x >= zero) & (x < one)) {
+        return Ok(v);
+    }
+    let mut has_one = false;
+    for (i, &x) in v.iter().enumerate() {
+        let f = x.to_f64();
+        if !(0.0..=1.0).contains(&f) {
+            let row = start + i;
+            return Err(BadInput {
+                row,
+                message: format!(
+                    "{name}[{row}] = {} is not a uniform number in [0, 1)",
+                    x.show()
+                ),
+            });
+        }
+        has_one |= f == 1.0;
+    }
+    if !has_one {
+        return Ok(v);
+    }
+    buf.clear();
+    buf.extend(
+        v.iter()
+            .map(|&x| if x.to_f64() == 1.0 { T::BELOW_ONE } else { x }),
+    );
+    Ok(buf)
+}
+
+/// How one call runs.
+#[derive(Debug, Clone, Copy)]
+pub struct Engine<'m> {
+    pub material: &'m Material,
+    pub strategy: BsdfStrategy,
+    /// The batch kernels, where they cover the material and strategy.
+    pub batch: Option<BatchSampler>,
+}
+
+impl<'m> Engine<'m> {
+    /// For `material` and `strategy` (checked: an error says why the strategy
+    /// does not apply). `reference` forces the scalar f64 path.
+    pub fn new(
+        material: &'m Material,
+        strategy: BsdfStrategy,
+        reference: bool,
+    ) -> Result<Self, lobe::Error> {
+        material.check(strategy)?;
+        let batch = if reference {
+            None
+        } else {
+            BatchSampler::new(material, strategy).ok()
+        };
+        Ok(Engine {
+            material,
+            strategy,
+            batch,
+        })
+    }
+
+    /// For `eval` alone (no strategy): the batch kernels of any strategy
+    /// they cover (`f` does not depend on the strategy), else the scalar
+    /// path (`strategy` is then only a placeholder).
+    #[must_use]
+    pub fn for_eval(material: &'m Material, reference: bool) -> Self {
+        let strategies = material.strategies();
+        if !reference {
+            for &s in &strategies {
+                if let Ok(b) = BatchSampler::new(material, s) {
+                    return Engine {
+                        material,
+                        strategy: s,
+                        batch: Some(b),
+                    };
+                }
+            }
+        }
+        Engine {
+            material,
+            strategy: strategies.first().copied().unwrap_or(BsdfStrategy::Uniform),
+            batch: None,
+        }
+    }
+}
+
+/// The outputs of [`sample`], Fortran order for the `(N, 3)` ones (each
+/// component contiguous: `wi[c * n + i]`); `valid` is 1 or 0.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SampleOut<T> {
+    pub n: usize,
+    pub wi: Vec<T>,
+    pub pdf: Vec<T>,
+    pub weight: Vec<T>,
+    pub valid: Vec<u8>,
+}
+
+/// The outputs of [`eval_pdf`]: `f` in Fortran order, `pdf`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct EvalPdfOut<T> {
+    pub n: usize,
+    pub f: Vec<T>,
+    pub pdf: Vec<T>,
+}
+
+/// What [`eval_pdf`] computes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Want {
+    Eval,
+    Pdf,
+    Both,
+}
+
+/// `n` zeros, from fresh zeroed pages where the allocator maps them, which
+/// are advised to be huge pages before the first touch (fewer page faults
+/// when the blocks fill them).
+fn zeros<T: Copy + Default>(n: usize) -> Vec<T> {
+    let v = vec![T::default(); n];
+    #[cfg(target_os = "linux")]
+    {
+        const HUGE: usize = 2 << 20;
+        let bytes = n * std::mem::size_of::<T>();
+        if bytes >= 2 * HUGE {
+            let start = v.as_ptr() as usize;
+            let first = start.next_multiple_of(HUGE);
+            let end = (start + bytes) / HUGE * HUGE;
+            if end > first {
+                // SAFETY: advice on whole pages inside the allocation; it does
+                // not change the contents (zero), only how they are mapped.
+                unsafe {
+                    libc::madvise(first as *mut libc::c_void, end - first, libc::MADV_HUGEPAGE);
+                }
+            }
+        }
+    }
+    v
+}
+
+/// Splits three component vectors of length `n` (Fortran order `3n`) into
+/// per-block mutable slices.
+fn split3<T>(v: &mut [T], n: usize) -> Vec<[&mut [T]; 3]> {
+    let (a, rest) = v.split_at_mut(n);
+    let (b, c) = rest.split_at_mut(n);
+    a.chunks_mut(BLOCK)
+        .zip(b.chunks_mut(BLOCK))
+        .zip(c.chunks_mut(BLOCK))
+        .map(|((a, b), c)| [a, b, c])
+        .collect()
+}
+
+/// The first error of the blocks (lowest row).
+fn first_error(errors: impl Iterator<Item = Result<(), BadInput>>) -> Result<(), BadInput> {
+    let mut worst: Option<BadInput> = None;
+    for e in errors {
+        if let Err(e) = e
+            && worst.as_ref().is_none_or(|w| e.row < w.row)
+        {
+            worst = Some(e);
+        }
+    }
+    worst.map_or(Ok(()), Err)
+}
+
+/// Per-thread scratch of the batch path.
+struct Scratch32 {
+    wo: [Vec<f32>; 3],
+    wi: [Vec<f32>; 3],
+    u: [Vec<f32>; 3],
+    fix: [Vec<f32>; 3],
+    f: [Vec<f32>; 3],
+    pdf: Vec<f32>,
+}
+
+impl Scratch32 {
+    fn new() -> Self {
+        let v = || Vec::with_capacity(BLOCK);
+        let z = || vec![0.0f32; BLOCK];
+        Scratch32 {
+            wo: [v(), v(), v()],
+            wi: [v(), v(), v()],
+            u: [v(), v(), v()],
+            fix: [v(), v(), v()],
+            f: [z(), z(), z()],
+            pdf: z(),
+        }
+    }
+}
+
+/// One block of sample outputs.
+type SampleBlock<'a, T> = (
+    usize,
+    [&'a mut [T]; 3],
+    [&'a mut [T]; 3],
+    &'a mut [T],
+    &'a mut [u8],
+);
+
+/// Caller-owned outputs of [`sample32_into`]: `wi` and `weight` in
+/// Fortran order (`3n`), `pdf` and `valid` (`n`).
+#[derive(Debug)]
+pub struct SampleSlices<'a, T> {
+    pub n: usize,
+    pub wi: &'a mut [T],
+    pub pdf: &'a mut [T],
+    pub weight: &'a mut [T],
+    pub valid: &'a mut [u8],
+}
+
+impl<T> SampleOut<T> {
+    /// The outputs as slices.
+    pub fn slices(&mut self) -> SampleSlices<'_, T> {
+        SampleSlices {
+            n: self.n,
+            wi: &mut self.wi,
+            pdf: &mut self.pdf,
+            weight: &mut self.weight,
+            valid: &mut self.valid,
+        }
+    }
+}
+
+fn sample_blocks<'a, T>(out: SampleSlices<'a, T>) -> Vec<SampleBlock<'a, T>> {
+    let n = out.n;
+    assert!(
+        out.wi.len() == 3 * n
+            && out.weight.len() == 3 * n
+            && out.pdf.len() == n
+            && out.valid.len() == n
+    );
+    split3(out.wi, n)
+        .into_iter()
+        .zip(split3(out.weight, n))
+        .zip(out.pdf.chunks_mut(BLOCK).zip(out.valid.chunks_mut(BLOCK)))
+        .enumerate()
+        .map(|(k, ((wi, w), (pdf, valid)))| (k * BLOCK, wi, w, pdf, valid))
+        .collect()
+}
+
+fn new_sample_out<T: Copy + Default>(n: usize) -> SampleOut<T> {
+    SampleOut {
+        n,
+        wi: zeros(3 * n),
+        pdf: zeros(n),
+        weight: zeros(3 * n),
+        valid: zeros(n),
+    }
+}
+
+/// Sample `wi` for each `(wo[i], u[i], uc[i])`: on the batch kernels where
+/// the engine has them (f32), else on the scalar f64 path with `T` outputs.
+/// `wo` is `(N, 3)`, `u` `(N, 2)`, `uc` `(N,)` or absent (then 0.5; it only
+/// matters where the material chooses between two lobes, where the caller
+/// must give it).
+pub fn sample32(
+    e: &Engine<'_>,
+    wo: &In2<'_>,
+    u: &In2<'_>,
+    uc: Option<&In1<'_>>,
+) -> Result<SampleOut<f32>, BadInput> {
+    let mut out = new_sample_out::<f32>(wo.rows());
+    sample32_into(e, wo, u, uc, out.slices())?;
+    Ok(out)
+}
+
+/// [`sample32`] into caller-owned outputs of `wo.rows()` samples (on an
+/// error their contents are unspecified).
+pub fn sample32_into(
+    e: &Engine<'_>,
+    wo: &In2<'_>,
+    u: &In2<'_>,
+    uc: Option<&In1<'_>>,
+    out: SampleSlices<'_, f32>,
+) -> Result<(), BadInput> {
+    let Some(b) = e.batch else {
+        return sample_scalar_into::<f32>(e, wo, u, uc, out);
+    };
+    let n = wo.rows();
+    debug_assert!(u.rows() == n && uc.is_none_or(|c| c.len() == n) && out.n == n);
+    let results: Vec<Result<(), BadInput>> = sample_blocks(out)
+        .into_par_iter()
+        .map_init(Scratch32::new, |s, (start, wi, w, pdf, valid)| {
+            let r = start..start + pdf.len();
+            let len = r.len();
+            let Scratch32 {
+                wo: wb,
+                u: ub,
+                fix,
+                f,
+                ..
+            } = s;
+            let [b0, b1, b2] = wb;
+            let (x, y, z) = (
+                load_col::<f32>(wo, 0, r.clone(), b0),
+                load_col::<f32>(wo, 1, r.clone(), b1),
+                load_col::<f32>(wo, 2, r.clone(), b2),
+            );
+            check_dirs("wo", x, y, z, start, false)?;
+            let [ub0, ub1, ub2] = ub;
+            let [f0, f1, f2] = fix;
+            let u1 = check_uniform("u", load_col::<f32>(u, 0, r.clone(), ub0), start, f0)?;
+            let u2 = check_uniform("u", load_col::<f32>(u, 1, r.clone(), ub1), start, f1)?;
+            let ucs = match uc {
+                Some(c) => Some(check_uniform(
+                    "uc",
+                    load_1::<f32>(c, r.clone(), ub2),
+                    start,
+                    f2,
+                )?),
+                None => None,
+            };
+            let [wx, wy, wz] = wi;
+            let [wr, wg, wb] = w;
+            let [fr, fg, fb] = f;
+            b.sample(
+                SampleInput {
+                    wo: Dirs { x, y, z },
+                    u1,
+                    u2,
+                    uc: ucs,
+                },
+                SampleOutput {
+                    wi: DirsMut {
+                        x: wx,
+                        y: wy,
+                        z: wz,
+                    },
+                    f: RgbMut {
+                        r: &mut fr[..len],
+                        g: &mut fg[..len],
+                        b: &mut fb[..len],
+                    },
+                    pdf,
+                    weight: RgbMut {
+                        r: wr,
+                        g: wg,
+                        b: wb,
+                    },
+                    valid,
+                },
+            )
+            .expect("every block slice has the block's length");
+            Ok(())
+        })
+        .collect();
+    first_error(results.into_iter())
+}
+
+/// [`sample32`] on the scalar f64 path, outputs in `T`.
+pub fn sample_scalar<T: Real>(
+    e: &Engine<'_>,
+    wo: &In2<'_>,
+    u: &In2<'_>,
+    uc: Option<&In1<'_>>,
+) -> Result<SampleOut<T>, BadInput> {
+    let mut out = new_sample_out::<T>(wo.rows());
+    sample_scalar_into(e, wo, u, uc, out.slices())?;
+    Ok(out)
+}
+
+/// [`sample_scalar`] into caller-owned outputs.
+pub fn sample_scalar_into<T: Real>(
+    e: &Engine<'_>,
+    wo: &In2<'_>,
+    u: &In2<'_>,
+    uc: Option<&In1<'_>>,
+    out: SampleSlices<'_, T>,
+) -> Result<(), BadInput> {
+    let n = wo.rows();
+    debug_assert!(u.rows() == n && uc.is_none_or(|c| c.len() == n) && out.n == n);
+    let m = e.material;
+    let strategy = e.strategy;
+    let results: Vec<Result<(), BadInput>> = sample_blocks(out)
+        .into_par_iter()
+        .map_init(
+            || [(); 8].map(|()| Vec::<f64>::with_capacity(BLOCK)),
+            |s, (start, wi, w, pdf, valid)| {
+                let r = start..start + pdf.len();
+                let [b0, b1, b2, b3, b4, b5, f0, f1] = s;
+                let (x, y, z) = (
+                    load_col::<f64>(wo, 0, r.clone(), b0),
+                    load_col::<f64>(wo, 1, r.clone(), b1),
+                    load_col::<f64>(wo, 2, r.clone(), b2),
+                );
+                check_dirs("wo", x, y, z, start, false)?;
+                let u1 = check_uniform("u", load_col::<f64>(u, 0, r.clone(), b3), start, f0)?;
+                let u2 = check_uniform("u", load_col::<f64>(u, 1, r.clone(), b4), start, f1)?;
+                let ucs = match uc {
+                    Some(c) => {
+                        let v = load_1::<f64>(c, r.clone(), b5);
+                        let mut tmp = Vec::new();
+                        Some(check_uniform("uc", v, start, &mut tmp)?.to_vec())
+                    }
+                    None => None,
+                };
+                for i in 0..pdf.len() {
+                    let wo = unit(DVec3::new(x[i], y[i], z[i]));
+                    let ucv = ucs.as_ref().map_or(0.5, |c| c[i]);
+                    let s = m.sample(strategy, wo, ucv, DVec2::new(u1[i], u2[i]));
+                    let z = lobe::BsdfSample {
+                        wi: DVec3::ZERO,
+                        f: lobe::Rgb::ZERO,
+                        pdf: 0.0,
+                        weight: lobe::Rgb::ZERO,
+                        component: lobe::Component::Hemisphere,
+                    };
+                    let v = s.unwrap_or(z);
+                    for c in 0..3 {
+                        wi[c][i] = T::from_f64(v.wi[c]);
+                        w[c][i] = T::from_f64(v.weight[c]);
+                    }
+                    pdf[i] = T::from_f64(v.pdf);
+                    valid[i] = u8::from(s.is_some());
+                }
+                Ok(())
+            },
+        )
+        .collect();
+    first_error(results.into_iter())
+}
+
+/// One block of eval_pdf outputs (`None`: not wanted).
+type EvalBlock<'a, T> = (usize, usize, Option<[&'a mut [T]; 3]>, Option<&'a mut [T]>);
+
+/// Caller-owned outputs of [`eval_pdf32_into`]: `f` in Fortran order
+/// (`3n`, or empty when not wanted), `pdf` (`n`, or empty).
+#[derive(Debug)]
+pub struct EvalSlices<'a, T> {
+    pub n: usize,
+    pub f: &'a mut [T],
+    pub pdf: &'a mut [T],
+}
+
+impl<T> EvalPdfOut<T> {
+    pub fn slices(&mut self) -> EvalSlices<'_, T> {
+        EvalSlices {
+            n: self.n,
+            f: &mut self.f,
+            pdf: &mut self.pdf,
+        }
+    }
+}
+
+fn eval_blocks<'a, T>(out: EvalSlices<'a, T>) -> Vec<EvalBlock<'a, T>> {
+    let n = out.n;
+    assert!(
+        (out.f.is_empty() || out.f.len() == 3 * n) && (out.pdf.is_empty() || out.pdf.len() == n)
+    );
+    let nblocks = n.div_ceil(BLOCK);
+    let fblocks: Vec<Option<[&mut [T]; 3]>> = if out.f.is_empty() {
+        (0..nblocks).map(|_| None).collect()
+    } else {
+        split3(out.f, n).into_iter().map(Some).collect()
+    };
+    let pblocks: Vec<Option<&mut [T]>> = if out.pdf.is_empty() {
+        (0..nblocks).map(|_| None).collect()
+    } else {
+        out.pdf.chunks_mut(BLOCK).map(Some).collect()
+    };
+    fblocks
+        .into_iter()
+        .zip(pblocks)
+        .enumerate()
+        .map(|(k, (f, p))| (k * BLOCK, ((k + 1) * BLOCK).min(n), f, p))
+        .collect()
+}
+
+fn new_eval_out<T: Copy + Default>(n: usize, want: Want) -> EvalPdfOut<T> {
+    EvalPdfOut {
+        n,
+        f: if want != Want::Pdf {
+            zeros(3 * n)
+        } else {
+            Vec::new()
+        },
+        pdf: if want != Want::Eval {
+            zeros(n)
+        } else {
+            Vec::new()
+        },
+    }
+}
+
+/// `f` (no cosine) and/or the pdf (solid angle, of the engine's strategy)
+/// for each `(wo[i], wi[i])`, zero below the horizon and for a zero `wi`
+/// (a failed sample's): on the batch kernels where the engine has them,
+/// else the scalar f64 path. Outputs not wanted are left empty.
+pub fn eval_pdf32(
+    e: &Engine<'_>,
+    wo: &In2<'_>,
+    wi: &In2<'_>,
+    want: Want,
+) -> Result<EvalPdfOut<f32>, BadInput> {
+    let mut out = new_eval_out::<f32>(wo.rows(), want);
+    eval_pdf32_into(e, wo, wi, out.slices())?;
+    Ok(out)
+}
+
+/// [`eval_pdf32`] into caller-owned outputs (an empty `f` or `pdf`: not wanted).
+pub fn eval_pdf32_into(
+    e: &Engine<'_>,
+    wo: &In2<'_>,
+    wi: &In2<'_>,
+    out: EvalSlices<'_, f32>,
+) -> Result<(), BadInput> {
+    let Some(b) = e.batch else {
+        return eval_pdf_scalar_into::<f32>(e, wo, wi, out);
+    };
+    let n = wo.rows();
+    debug_assert!(wi.rows() == n && out.n == n);
+    let results: Vec<Result<(), BadInput>> = eval_blocks(out)
+        .into_par_iter()
+        .map_init(Scratch32::new, |s, (start, end, f, p)| {
+            let r = start..end;
+            let len = r.len();
+            let Scratch32 {
+                wo: wb,
+                wi: ib,
+                f: sf,
+                pdf: sp,
+                ..
+            } = s;
+            let [b0, b1, b2] = wb;
+            let wo3 = Dirs {
+                x: load_col::<f32>(wo, 0, r.clone(), b0),
+                y: load_col::<f32>(wo, 1, r.clone(), b1),
+                z: load_col::<f32>(wo, 2, r.clone(), b2),
+            };
+            check_dirs("wo", wo3.x, wo3.y, wo3.z, start, false)?;
+            let [i0, i1, i2] = ib;
+            let wi3 = Dirs {
+                x: load_col::<f32>(wi, 0, r.clone(), i0),
+                y: load_col::<f32>(wi, 1, r.clone(), i1),
+                z: load_col::<f32>(wi, 2, r.clone(), i2),
+            };
+            let zeros = check_dirs("wi", wi3.x, wi3.y, wi3.z, start, true)?;
+            let [sr, sg, sb] = sf;
+            let [fr, fg, fb] = match f {
+                Some(f) => f,
+                None => [&mut sr[..len], &mut sg[..len], &mut sb[..len]],
+            };
+            let pdf = match p {
+                Some(p) => p,
+                None => &mut sp[..len],
+            };
+            b.eval_pdf(
+                wo3,
+                wi3,
+                EvalPdfOutput {
+                    f: RgbMut {
+                        r: &mut *fr,
+                        g: &mut *fg,
+                        b: &mut *fb,
+                    },
+                    pdf: &mut *pdf,
+                },
+            )
+            .expect("every block slice has the block's length");
+            if zeros {
+                // A failed sample's wi (the zero vector): no direction, zero.
+                for i in 0..len {
+                    if wi3.x[i] == 0.0 && wi3.y[i] == 0.0 && wi3.z[i] == 0.0 {
+                        fr[i] = 0.0;
+                        fg[i] = 0.0;
+                        fb[i] = 0.0;
+                        pdf[i] = 0.0;
+                    }
+                }
+            }
+            Ok(())
+        })
+        .collect();
+    first_error(results.into_iter())
+}
+
+/// [`eval_pdf32`] on the scalar f64 path, outputs in `T`.
+pub fn eval_pdf_scalar<T: Real>(
+    e: &Engine<'_>,
+    wo: &In2<'_>,
+    wi: &In2<'_>,
+    want: Want,
+) -> Result<EvalPdfOut<T>, BadInput> {
+    let mut out = new_eval_out::<T>(wo.rows(), want);
+    eval_pdf_scalar_into(e, wo, wi, out.slices())?;
+    Ok(out)
+}
+
+/// [`eval_pdf_scalar`] into caller-owned outputs.
+pub fn eval_pdf_scalar_into<T: Real>(
+    e: &Engine<'_>,
+    wo: &In2<'_>,
+    wi: &In2<'_>,
+    out: EvalSlices<'_, T>,
+) -> Result<(), BadInput> {
+    let n = wo.rows();
+    debug_assert!(wi.rows() == n && out.n == n);
+    let want = match (out.f.is_empty() && n > 0, out.pdf.is_empty() && n > 0) {
+        (true, _) => Want::Pdf,
+        (_, true) => Want::Eval,
+        _ => Want::Both,
+    };
+    let m = e.material;
+    let strategy = e.strategy;
+    let results: Vec<Result<(), BadInput>> = eval_blocks(out)
+        .into_par_iter()
+        .map_init(
+            || [(); 6].map(|()| Vec::<f64>::with_capacity(BLOCK)),
+            |s, (start, end, mut f, mut p)| {
+                let r = start..end;
+                let [b0, b1, b2, b3, b4, b5] = s;
+                let (x, y, z) = (
+                    load_col::<f64>(wo, 0, r.clone(), b0),
+                    load_col::<f64>(wo, 1, r.clone(), b1),
+                    load_col::<f64>(wo, 2, r.clone(), b2),
+                );
+                check_dirs("wo", x, y, z, start, false)?;
+                let (ix, iy, iz) = (
+                    load_col::<f64>(wi, 0, r.clone(), b3),
+                    load_col::<f64>(wi, 1, r.clone(), b4),
+                    load_col::<f64>(wi, 2, r.clone(), b5),
+                );
+                check_dirs("wi", ix, iy, iz, start, true)?;
+                for i in 0..r.len() {
+                    let a = unit(DVec3::new(x[i], y[i], z[i]));
+                    let b = DVec3::new(ix[i], iy[i], iz[i]);
+                    let (fv, pv) = if b == DVec3::ZERO {
+                        (lobe::Rgb::ZERO, 0.0) // a failed sample's wi: zero
+                    } else {
+                        let b = unit(b);
+                        match want {
+                            Want::Eval => (m.eval(a, b), 0.0),
+                            Want::Pdf => (lobe::Rgb::ZERO, m.pdf(strategy, a, b)),
+                            Want::Both => m.eval_pdf(strategy, a, b),
+                        }
+                    };
+                    if let Some(f) = f.as_mut() {
+                        for c in 0..3 {
+                            f[c][i] = T::from_f64(fv[c]);
+                        }
+                    }
+                    if let Some(p) = p.as_mut() {
+                        p[i] = T::from_f64(pv);
+                    }
+                }
+                Ok(())
+            },
+        )
+        .collect();
+    first_error(results.into_iter())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use lobe::batch::SampleBuffers;
+    use ndarray::{Array1, Array2, ShapeBuilder};
+
+    fn ggx() -> Material {
+        Material::load(r#"{"type":"cook-torrance","distribution":"ggx","alpha":0.2}"#).unwrap()
+    }
+
+    fn inputs(n: usize) -> (Array2<f64>, Array2<f64>) {
+        let mut wo = Array2::<f64>::zeros((n, 3));
+        let mut u = Array2::<f64>::zeros((n, 2));
+        for i in 0..n {
+            let t = 1.4 * (i as f64 + 0.5) / n as f64;
+            let p = 0.37 * i as f64;
+            wo.row_mut(i).assign(&Array1::from(vec![
+                t.sin() * p.cos(),
+                t.sin() * p.sin(),
+                t.cos(),
+            ]));
+            u[[i, 0]] = ((i * 7919) % n) as f64 / n as f64;
+            u[[i, 1]] = ((i * 104_729) % n) as f64 / n as f64;
+        }
+        (wo, u)
+    }
+
+    #[test]
+    fn batch_path_equals_the_kernels_in_any_order_and_dtype() {
+        let m = ggx();
+        let n = 3 * BLOCK + 17;
+        let (wo, u) = inputs(n);
+        let e = Engine::new(&m, BsdfStrategy::Vndf, false).unwrap();
+        assert!(e.batch.is_some());
+        let wo32 = wo.mapv(|x| x as f32);
+        let u32_ = u.mapv(|x| x as f32);
+        let c = sample32(&e, &In2::F32(wo32.view()), &In2::F32(u32_.view()), None).unwrap();
+        // Fortran order, and f64 inputs: the same bits.
+        let mut wof = Array2::<f32>::zeros((n, 3).f());
+        wof.assign(&wo32);
+        let fo = sample32(&e, &In2::F32(wof.view()), &In2::F32(u32_.view()), None).unwrap();
+        assert_eq!(c, fo);
+        let d = sample32(
+            &e,
+            &In2::F64(wo32.mapv(f64::from).view()),
+            &In2::F64(u32_.mapv(f64::from).view()),
+            None,
+        )
+        .unwrap();
+        assert_eq!(c, d);
+        // The kernels called directly on the whole array.
+        let b = e.batch.unwrap();
+        let col = |a: &Array2<f32>, j: usize| a.column(j).to_vec();
+        let (x, y, z, u1, u2) = (
+            col(&wo32, 0),
+            col(&wo32, 1),
+            col(&wo32, 2),
+            col(&u32_, 0),
+            col(&u32_, 1),
+        );
+        let mut bufs = SampleBuffers::new(n);
+        b.sample(
+            SampleInput {
+                wo: Dirs {
+                    x: &x,
+                    y: &y,
+                    z: &z,
+                },
+                u1: &u1,
+                u2: &u2,
+                uc: None,
+            },
+            bufs.output(),
+        )
+        .unwrap();
+        assert_eq!(&c.wi[..n], &bufs.wi[0][..]);
+        assert_eq!(&c.wi[2 * n..], &bufs.wi[2][..]);
+        assert_eq!(&c.weight[n..2 * n], &bufs.weight[1][..]);
+        assert_eq!(c.pdf, bufs.pdf);
+        assert_eq!(c.valid, bufs.valid);
+        // The scalar reference within the documented f32 error.
+        let r = sample_scalar::<f64>(
+            &Engine::new(&m, BsdfStrategy::Vndf, true).unwrap(),
+            &In2::F64(wo.view()),
+            &In2::F64(u.view()),
+            None,
+        )
+        .unwrap();
+        let mut worst: f64 = 0.0;
+        for i in 0..n {
+            if r.valid[i] == 1 && c.valid[i] == 1 && r.pdf[i] > 1e-3 {
+                worst = worst.max((f64::from(c.pdf[i]) - r.pdf[i]).abs() / r.pdf[i]);
+            }
+        }
+        assert!(worst < 1e-3, "{worst}");
+    }
+
+    #[test]
+    fn eval_pdf_batch_and_scalar_agree() {
+        let m = ggx();
+        let n = BLOCK + 5;
+        let (wo, u) = inputs(n);
+        let e = Engine::new(&m, BsdfStrategy::Vndf, false).unwrap();
+        let s = sample32(&e, &In2::F64(wo.view()), &In2::F64(u.view()), None).unwrap();
+        let wi = Array2::from_shape_vec((n, 3).f(), s.wi.clone()).unwrap();
+        let wo32 = wo.mapv(|x| x as f32);
+        let both =
+            eval_pdf32(&e, &In2::F32(wo32.view()), &In2::F32(wi.view()), Want::Both).unwrap();
+        for i in 0..n {
+            if s.valid[i] == 1 {
+                assert!((both.pdf[i] - s.pdf[i]).abs() <= 1e-4 * s.pdf[i], "{i}");
+            }
+        }
+        let pdf = eval_pdf32(&e, &In2::F32(wo32.view()), &In2::F32(wi.view()), Want::Pdf).unwrap();
+        assert_eq!(pdf.pdf, both.pdf);
+        assert!(pdf.f.is_empty());
+        let r = eval_pdf_scalar::<f64>(
+            &Engine::new(&m, BsdfStrategy::Vndf, true).unwrap(),
+            &In2::F64(wo32.mapv(f64::from).view()),
+            &In2::F64(wi.mapv(f64::from).view()),
+            Want::Both,
+        )
+        .unwrap();
+        for i in 0..n {
+            if r.pdf[i] > 1e-2 {
+                assert!(
+                    (f64::from(both.pdf[i]) - r.pdf[i]).abs() < 1e-4 * r.pdf[i],
+                    "{i}: {} {}",
+                    both.pdf[i],
+                    r.pdf[i]
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn bad_inputs_name_the_row() {
+        let m = ggx();
+        let n = 2 * BLOCK + 3;
+        let (mut wo, mut u) = inputs(n);
+        let e = Engine::new(&m, BsdfStrategy::Vndf, false).unwrap();
+        wo[[BLOCK + 4, 0]] = f64::NAN;
+        let err = sample32(&e, &In2::F64(wo.view()), &In2::F64(u.view()), None).unwrap_err();
+        assert_eq!(err.row, BLOCK + 4);
+        assert!(
+            err.message
+                .starts_with(&format!("wo[{}] = (NaN", BLOCK + 4)),
+            "{}",
+            err.message
+        );
+        assert!(err.message.ends_with("is not finite"), "{}", err.message);
+        wo[[BLOCK + 4, 0]] = 0.0;
+        wo[[7, 2]] = 3.0;
+        let err = sample_scalar::<f64>(
+            &Engine::new(&m, BsdfStrategy::Vndf, true).unwrap(),
+            &In2::F64(wo.view()),
+            &In2::F64(u.view()),
+            None,
+        )
+        .unwrap_err();
+        assert!(
+            err.message.starts_with("wo[7] = (") && err.message.contains("not a unit vector"),
+            "{}",
+            err.message
+        );
+        let (wo, _) = inputs(n);
+        u[[9, 1]] = 1.5;
+        let err = sample32(&e, &In2::F64(wo.view()), &In2::F64(u.view()), None).unwrap_err();
+        assert_eq!(err.message, "u[9] = 1.5 is not a uniform number in [0, 1)");
+        // One is moved below one, not an error.
+        u[[9, 1]] = 1.0;
+        assert!(sample32(&e, &In2::F64(wo.view()), &In2::F64(u.view()), None).is_ok());
+    }
+
+    #[test]
+    fn scalar_fallback_for_what_the_kernels_lack() {
+        let m = Material::load(r#"{"type":"phong","exponent":20,"kd":0.3}"#).unwrap();
+        let e = Engine::new(&m, BsdfStrategy::Brdf, false).unwrap();
+        assert!(e.batch.is_none());
+        let n = 1000;
+        let (wo, u) = inputs(n);
+        let uc = Array1::from_shape_fn(n, |i| (i as f64 * 0.618).fract());
+        let s = sample32(
+            &e,
+            &In2::F64(wo.view()),
+            &In2::F64(u.view()),
+            Some(&In1::F64(uc.view())),
+        )
+        .unwrap();
+        for i in 0..n {
+            let w = DVec3::new(wo[[i, 0]], wo[[i, 1]], wo[[i, 2]]);
+            let r = m.sample(
+                BsdfStrategy::Brdf,
+                w,
+                uc[i],
+                DVec2::new(u[[i, 0]], u[[i, 1]]),
+            );
+            assert_eq!(r.is_some(), s.valid[i] == 1);
+            if let Some(r) = r {
+                assert_eq!(s.pdf[i], r.pdf as f32);
+            }
+        }
+        assert!(Engine::new(&m, BsdfStrategy::Vndf, false).is_err());
+    }
+}
