@@ -85,6 +85,7 @@ pub mod sample;
 pub mod sequence;
 pub mod stats;
 pub mod strategy;
+pub mod tabulate;
 pub mod warp;
 
 #[cfg(feature = "desc")]
