@@ -172,15 +172,27 @@ impl HalfVectorTable {
             return (wi.z > 0.0).then_some(wi);
         }
         let ux = ((u.x - COSINE_SHARE) / (1.0 - COSINE_SHARE)).min(1.0);
+        let h = self.sample_half(wo, DVec2::new(ux, u.y))?;
+        let wi = crate::math::reflect(wo, h);
+        if wi.z <= 0.0 {
+            return None;
+        }
+        Some(wi.normalize())
+    }
+
+    /// The tabulated branch alone: a half vector for `wo` (in the world's
+    /// azimuth), `None` when the table of `wo`'s bin is empty.
+    #[must_use]
+    pub fn sample_half(&self, wo: DVec3, u: DVec2) -> Option<DVec3> {
         let k = bin_of(wo);
         let rows = &self.row_cdf[k * N_U..(k + 1) * N_U];
         if rows[N_U - 1] <= 0.0 {
             return None;
         }
-        let iu = find(rows, ux);
+        let iu = find(rows, u.x);
         let r0 = if iu > 0 { rows[iu - 1] } else { 0.0 };
         let r1 = rows[iu];
-        let a = if r1 > r0 { ((ux - r0) / (r1 - r0)).clamp(0.0, 1.0) } else { 0.5 };
+        let a = if r1 > r0 { ((u.x - r0) / (r1 - r0)).clamp(0.0, 1.0) } else { 0.5 };
         let cols = &self.col_cdf[(k * N_U + iu) * N_V..(k * N_U + iu + 1) * N_V];
         let iv = find(cols, u.y);
         let c0 = if iv > 0 { cols[iv - 1] } else { 0.0 };
@@ -192,12 +204,29 @@ impl HalfVectorTable {
         let phi = (iv as f64 + b) / N_V as f64 * TAU;
         let (cp, sp) = azimuth(wo);
         let (x, y) = (r * phi.cos(), r * phi.sin());
-        let h = DVec3::new(cp * x - sp * y, sp * x + cp * y, z);
-        let wi = crate::math::reflect(wo, h);
-        if wi.z <= 0.0 {
-            return None;
-        }
-        Some(wi.normalize())
+        Some(DVec3::new(cp * x - sp * y, sp * x + cp * y, z))
+    }
+
+    /// The cell `(iu, iv)` of a half vector `h` for `wo`: `iu` over
+    /// `√(θh/(π/2))`, `iv` over `φh − φo`.
+    #[must_use]
+    pub fn cell_of(wo: DVec3, h: DVec3) -> (usize, usize) {
+        let theta = crate::math::safe_acos(h.z);
+        let iu = (((theta / FRAC_PI_2).max(0.0).sqrt() * N_U as f64) as usize).min(N_U - 1);
+        let (cp, sp) = azimuth(wo);
+        let x = cp * h.x + sp * h.y;
+        let y = -sp * h.x + cp * h.y;
+        let phi = y.atan2(x).rem_euclid(TAU);
+        let iv = ((phi / TAU * N_V as f64) as usize).min(N_V - 1);
+        (iu, iv)
+    }
+
+    /// The probability of cell `(iu, iv)` in the tabulated branch for `wo`.
+    #[must_use]
+    pub fn cell_probability(&self, wo: DVec3, iu: usize, iv: usize) -> f64 {
+        let (z0, z1) = (theta_edge(iu).cos(), theta_edge(iu + 1).cos());
+        let omega = (z0 - z1) * TAU / N_V as f64;
+        f64::from(self.density[(bin_of(wo) * N_U + iu) * N_V + iv]) * omega
     }
 
     /// The solid-angle density of `sample` at `wi` (both above the horizon).
@@ -214,15 +243,7 @@ impl HalfVectorTable {
         if c <= 0.0 {
             return cosine;
         }
-        let theta = crate::math::safe_acos(h.z);
-        let iu = ((theta / FRAC_PI_2).max(0.0).sqrt() * N_U as f64) as usize;
-        let iu = iu.min(N_U - 1);
-        let (cp, sp) = azimuth(wo);
-        // φh − φo, in [0, 2π).
-        let x = cp * h.x + sp * h.y;
-        let y = -sp * h.x + cp * h.y;
-        let phi = y.atan2(x).rem_euclid(TAU);
-        let iv = ((phi / TAU * N_V as f64) as usize).min(N_V - 1);
+        let (iu, iv) = Self::cell_of(wo, h);
         let k = bin_of(wo);
         let d = f64::from(self.density[(k * N_U + iu) * N_V + iv]);
         (1.0 - COSINE_SHARE) * d / (4.0 * c) + cosine
@@ -233,13 +254,11 @@ impl HalfVectorTable {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use rand::{RngExt, SeedableRng};
+    use crate::stats::chi2::{Chi2Config, chi2_test_cells};
+    use crate::stats::quadrature::Estimate;
 
-    /// The tabulated branch puts each half-vector row's share of samples
-    /// where its table says.
-    #[test]
-    fn rows_get_their_probability() {
-        let m = crate::Material::with_diffuse(
+    fn glossy() -> crate::Material {
+        crate::Material::with_diffuse(
             Rgb::ZERO,
             crate::Glossy::CookTorrance(
                 crate::models::CookTorrance::new(
@@ -251,54 +270,56 @@ mod tests {
                 .unwrap(),
             ),
         )
-        .unwrap();
+        .unwrap()
+    }
+
+    /// Chi-square of the tabulated branch in its own cells, with their
+    /// exact probabilities: a half vector of cell `(iu, iv)` is binned as
+    /// the direction `z = 1 − √(θh/(π/2))`, `φ = φh − φo`, so that the test's
+    /// `2 N_U × N_V` equal-area cells are the table's cells one for one.
+    #[test]
+    fn chi2_of_the_half_vector_cells_is_exact() {
+        let m = glossy();
         // Not symmetric in φ, with holes.
         let t = HalfVectorTable::build(|o, i| {
             let bump = 1.0 + 0.8 * (5.0 * i.y.atan2(i.x)).sin();
             let hole = if (i.x * 40.0).floor() as i64 % 7 == 0 { 0.0 } else { 1.0 };
             m.eval(o, i) * bump * hole
         });
-        let wo = DVec3::new(0.3f64.sin(), 0.0, 0.3f64.cos());
-        let mut rng = rand_pcg::Pcg64::seed_from_u64(1);
-        let n = 400_000;
-        let mut rows = vec![0usize; N_U];
-        let mut cells = vec![0usize; N_U * N_V];
-        for _ in 0..n {
-            let u = DVec2::new(
-                COSINE_SHARE + (1.0 - COSINE_SHARE) * rng.random::<f64>(),
-                rng.random(),
+        let cfg = Chi2Config {
+            n_z: 2 * N_U,
+            n_phi: N_V,
+            samples: 1_000_000,
+            ..Chi2Config::default()
+        };
+        let alpha = crate::stats::chi2::sidak(0.01, 4);
+        for theta in [0.0f64, 20.0, 55.0, 85.0] {
+            let t0 = theta.to_radians();
+            let wo = DVec3::new(t0.sin() * 0.6, t0.sin() * 0.8, t0.cos());
+            let r = chi2_test_cells(
+                &cfg,
+                |_, u| {
+                    let h = t.sample_half(wo, u)?;
+                    let u_h = (crate::math::safe_acos(h.z) / FRAC_PI_2).sqrt();
+                    let (cp, sp) = azimuth(wo);
+                    let phi = (-sp * h.x + cp * h.y).atan2(cp * h.x + sp * h.y).rem_euclid(TAU);
+                    let z = 1.0 - u_h;
+                    let r = crate::math::safe_sqrt(1.0 - z * z);
+                    Some(DVec3::new(r * phi.cos(), r * phi.sin(), z))
+                },
+                |z0, z1, p0, _| {
+                    let value = if z0 < 0.0 {
+                        0.0
+                    } else {
+                        let iu = ((1.0 - z1) * N_U as f64).round() as usize;
+                        let iv = (p0 / TAU * N_V as f64).round() as usize;
+                        t.cell_probability(wo, iu.min(N_U - 1), iv.min(N_V - 1))
+                    };
+                    Estimate { value, error: 0.0, evals: 1, converged: true }
+                },
             );
-            if let Some(wi) = t.sample(wo, u) {
-                let h = (wo + wi).normalize();
-                let iu = ((crate::math::safe_acos(h.z) / FRAC_PI_2).sqrt() * N_U as f64) as usize;
-                rows[iu.min(N_U - 1)] += 1;
-                let phi = h.y.atan2(h.x).rem_euclid(TAU);
-                let iv = ((phi / TAU * N_V as f64) as usize).min(N_V - 1);
-                cells[iu.min(N_U - 1) * N_V + iv] += 1;
-            }
+            eprintln!("half-vector cells, θo={theta}: χ² = {:.1}, dof {}, p = {:.3}", r.statistic, r.dof, r.p_value);
+            assert!(r.passes(alpha), "θo={theta}: p = {:.3e} {:?}", r.p_value, r.message);
         }
-        let k = bin_of(wo);
-        for iu in 0..N_U {
-            let r = &t.row_cdf[k * N_U..];
-            let p = r[iu] - if iu > 0 { r[iu - 1] } else { 0.0 };
-            let e = p * n as f64;
-            let o = rows[iu] as f64;
-            assert!((o - e).abs() <= 5.0 * e.sqrt() + 2.0, "row {iu}: {o} vs {e}");
-        }
-        let mut chi = 0.0;
-        let mut dof = 0;
-        for iu in 0..N_U {
-            let (z0, z1) = (theta_edge(iu).cos(), theta_edge(iu + 1).cos());
-            let omega = (z0 - z1) * TAU / N_V as f64;
-            for iv in 0..N_V {
-                let e = f64::from(t.density[(k * N_U + iu) * N_V + iv]) * omega * n as f64;
-                let o = cells[iu * N_V + iv] as f64;
-                if e > 20.0 {
-                    chi += (o - e).powi(2) / e;
-                    dof += 1;
-                }
-            }
-        }
-        assert!(chi < dof as f64 + 5.0 * (2.0 * dof as f64).sqrt(), "χ² {chi} over {dof} cells");
     }
 }
