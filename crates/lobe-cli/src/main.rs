@@ -15,6 +15,7 @@ mod figures;
 mod plot;
 mod render;
 mod report;
+mod tabulate;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -45,6 +46,7 @@ enum Command {
     Render(render::RenderArgs),
     Compare(compare::CompareArgs),
     Bench(bench::BenchArgs),
+    Tabulate(tabulate::TabulateArgs),
 }
 
 fn main() -> ExitCode {
@@ -59,6 +61,7 @@ fn main() -> ExitCode {
         Command::Render(args) => render::run(&args),
         Command::Compare(args) => compare::run(&args),
         Command::Bench(args) => bench::run(&args),
+        Command::Tabulate(args) => tabulate::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
