@@ -73,6 +73,7 @@ pub mod envmap;
 pub mod error;
 pub mod estimator;
 pub mod experiment;
+pub mod fit;
 pub mod frame;
 pub mod fresnel;
 pub mod light;

@@ -469,3 +469,44 @@ fn a_measured_material_names_its_file_in_errors() {
     let _ = Measured::load(&p, None).unwrap_err();
 }
 
+
+/// `lobe fit` recovers the parameters of a tabulated analytic material:
+/// alpha within 5%, kd and f0 within 0.02.
+#[test]
+fn fit_recovers_a_tabulated_material() {
+    for (json, name, ndf, alpha, f0, kd) in [
+        (
+            r#"{"type":"cook-torrance","distribution":"ggx","alpha":0.15,"kd":[0.1,0.2,0.05],"fresnel":{"type":"schlick","f0":[0.9,0.6,0.3]}}"#,
+            "fit-ggx.binary",
+            lobe::Ndf::Ggx,
+            0.15,
+            Rgb::new(0.9, 0.6, 0.3),
+            Rgb::new(0.1, 0.2, 0.05),
+        ),
+        (
+            r#"{"type":"cook-torrance","distribution":"beckmann","alpha":0.35,"kd":0.3,"fresnel":{"type":"schlick","f0":0.04}}"#,
+            "fit-beckmann.binary",
+            lobe::Ndf::Beckmann,
+            0.35,
+            Rgb::splat(0.04),
+            Rgb::splat(0.3),
+        ),
+    ] {
+        let m = merl_material(json, name, "nearest");
+        let t0 = std::time::Instant::now();
+        let fit = lobe::fit::fit_cook_torrance(&m, ndf).unwrap();
+        eprintln!(
+            "{name}: {} error {:.3e} ({} evaluations over {} pairs, {:.1} s)",
+            fit.to_json(),
+            fit.error,
+            fit.evaluations,
+            fit.pairs,
+            t0.elapsed().as_secs_f64()
+        );
+        assert!((fit.alpha - alpha).abs() <= 0.05 * alpha, "{name}: alpha {}", fit.alpha);
+        assert!((fit.f0 - f0).abs().max_element() <= 0.02, "{name}: f0 {}", fit.f0);
+        assert!((fit.kd - kd).abs().max_element() <= 0.02, "{name}: kd {}", fit.kd);
+        // The printed material is accepted by --material.
+        assert!(Material::load(&fit.to_json()).is_ok());
+    }
+}
