@@ -12,6 +12,7 @@ mod demo;
 mod estimate;
 mod eval;
 mod figures;
+mod fit;
 mod plot;
 mod render;
 mod report;
@@ -47,6 +48,7 @@ enum Command {
     Compare(compare::CompareArgs),
     Bench(bench::BenchArgs),
     Tabulate(tabulate::TabulateArgs),
+    Fit(fit::FitArgs),
 }
 
 fn main() -> ExitCode {
@@ -62,6 +64,7 @@ fn main() -> ExitCode {
         Command::Compare(args) => compare::run(&args),
         Command::Bench(args) => bench::run(&args),
         Command::Tabulate(args) => tabulate::run(&args),
+        Command::Fit(args) => fit::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
