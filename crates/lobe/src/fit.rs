@@ -268,3 +268,22 @@ pub fn fit_cook_torrance(target_material: &Material, distribution: Ndf) -> crate
         pairs: t.pairs.len(),
     })
 }
+
+/// `lum(f(wo, wi) cos θi)` in the plane of incidence of the view at
+/// `theta_o_deg` (`wo = (sin θo, 0, cos θo)`): `steps + 1` points
+/// `(θi in degrees, value)`, `θi` from −90° (the side of the mirror
+/// direction) to 90°, `wi = (sin θi, 0, cos θi)`.
+#[must_use]
+pub fn incidence_plane(m: &Material, theta_o_deg: f64, steps: usize) -> Vec<(f64, f64)> {
+    let t = theta_o_deg.to_radians();
+    let wo = DVec3::new(t.sin(), 0.0, t.cos());
+    (0..=steps.max(1))
+        .map(|i| {
+            let a = -90.0 + 180.0 * i as f64 / steps.max(1) as f64;
+            let r = a.to_radians();
+            let wi = DVec3::new(r.sin(), 0.0, r.cos());
+            let v = if wi.z > 0.0 { crate::math::luminance(m.eval(wo, wi)) * wi.z } else { 0.0 };
+            (a, v)
+        })
+        .collect()
+}
