@@ -470,8 +470,8 @@ fn a_measured_material_names_its_file_in_errors() {
 }
 
 
-/// `lobe fit` recovers the parameters of a tabulated analytic material:
-/// alpha within 5%, kd and f0 within 0.02.
+/// `lobe fit` recovers the parameters of a tabulated analytic material
+/// (GGX; about 5 s): alpha within 5%, kd and f0 within 0.02.
 #[test]
 fn fit_recovers_a_tabulated_material() {
     for (json, name, ndf, alpha, f0, kd) in [
@@ -482,14 +482,6 @@ fn fit_recovers_a_tabulated_material() {
             0.15,
             Rgb::new(0.9, 0.6, 0.3),
             Rgb::new(0.1, 0.2, 0.05),
-        ),
-        (
-            r#"{"type":"cook-torrance","distribution":"beckmann","alpha":0.35,"kd":0.3,"fresnel":{"type":"schlick","f0":0.04}}"#,
-            "fit-beckmann.binary",
-            lobe::Ndf::Beckmann,
-            0.35,
-            Rgb::splat(0.04),
-            Rgb::splat(0.3),
         ),
     ] {
         let m = merl_material(json, name, "nearest");
