@@ -251,7 +251,7 @@ impl HalfVectorTable {
 }
 
 
-#[cfg(test)]
+#[cfg(all(test, feature = "stats"))]
 mod tests {
     use super::*;
     use crate::stats::chi2::{Chi2Config, chi2_test_cells};
