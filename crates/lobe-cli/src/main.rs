@@ -13,9 +13,11 @@ mod estimate;
 mod eval;
 mod eval_batch;
 mod figures;
+mod fit;
 mod plot;
 mod render;
 mod report;
+mod tabulate;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -46,6 +48,8 @@ enum Command {
     Render(render::RenderArgs),
     Compare(compare::CompareArgs),
     Bench(bench::BenchArgs),
+    Tabulate(tabulate::TabulateArgs),
+    Fit(fit::FitArgs),
 }
 
 fn main() -> ExitCode {
@@ -60,6 +64,8 @@ fn main() -> ExitCode {
         Command::Render(args) => render::run(&args),
         Command::Compare(args) => compare::run(&args),
         Command::Bench(args) => bench::run(&args),
+        Command::Tabulate(args) => tabulate::run(&args),
+        Command::Fit(args) => fit::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

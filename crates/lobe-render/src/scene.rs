@@ -692,6 +692,8 @@ fn build_object(
     }
     let material = o
         .material
+        .clone()
+        .relative_to(base)
         .build()
         .map_err(|e| material_error(i, &o.material, e))?;
     let shape_err = |e: ShapeError| (at(e.field), e.message);

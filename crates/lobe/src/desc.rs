@@ -110,6 +110,15 @@ pub struct MaterialDesc {
     pub shadowing: Option<String>,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub fresnel: Option<FresnelDesc>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub path: Option<String>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub interpolation: Option<String>,
+    /// The directory relative paths (`path`) are taken from: the directory
+    /// of the file the description was read from; `None` for the working
+    /// directory. Not a key.
+    #[serde(skip)]
+    pub base: Option<std::path::PathBuf>,
 }
 
 impl MaterialDesc {
@@ -135,7 +144,15 @@ impl MaterialDesc {
         }
     }
 
-    pub(crate) fn present_fields(&self) -> [(&'static str, bool); 12] {
+    /// The same description, its relative paths taken from `dir` (the
+    /// directory of the file that names it).
+    #[must_use]
+    pub fn relative_to(mut self, dir: &std::path::Path) -> Self {
+        self.base = Some(dir.to_path_buf());
+        self
+    }
+
+    pub(crate) fn present_fields(&self) -> [(&'static str, bool); 14] {
         [
             ("albedo", self.albedo.is_some()),
             ("ks", self.ks.is_some()),
@@ -149,6 +166,8 @@ impl MaterialDesc {
             ("roughness", self.roughness.is_some()),
             ("shadowing", self.shadowing.is_some()),
             ("fresnel", self.fresnel.is_some()),
+            ("path", self.path.is_some()),
+            ("interpolation", self.interpolation.is_some()),
         ]
     }
 }
@@ -177,7 +196,14 @@ pub fn parse_material_arg(arg: &str) -> Result<(MaterialDesc, String), Error> {
             } else {
                 parse_json(&text)
             };
-            (desc.map_err(|m| fail(format!("{origin}: {m}")))?, origin)
+            let dir = std::path::Path::new(path)
+                .parent()
+                .unwrap_or(std::path::Path::new(""));
+            (
+                desc.map_err(|m| fail(format!("{origin}: {m}")))?
+                    .relative_to(dir),
+                origin,
+            )
         }
         None => {
             let origin = "material".to_string();

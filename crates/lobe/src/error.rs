@@ -21,6 +21,9 @@ pub enum Error {
     Unsupported { strategy: String, reason: String },
     /// A material description that cannot be parsed.
     Parse(String),
+    /// A data file (a measured BRDF table) that cannot be read or is not
+    /// valid: `path` names the file, `message` what is wrong.
+    File { path: String, message: String },
 }
 
 impl std::fmt::Display for Error {
@@ -43,6 +46,7 @@ impl std::fmt::Display for Error {
                 "strategy `{strategy}` does not apply to this material ({reason})"
             ),
             Error::Parse(message) => f.write_str(message),
+            Error::File { path, message } => write!(f, "file {path}: {message}"),
         }
     }
 }
@@ -50,6 +54,13 @@ impl std::fmt::Display for Error {
 impl std::error::Error for Error {}
 
 impl Error {
+    pub(crate) fn file(path: impl std::fmt::Display, message: impl Into<String>) -> Self {
+        Error::File {
+            path: path.to_string(),
+            message: message.into(),
+        }
+    }
+
     pub(crate) fn param(field: &str, message: impl Into<String>) -> Self {
         Error::Param {
             field: field.to_string(),

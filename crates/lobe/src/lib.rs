@@ -73,6 +73,7 @@ pub mod envmap;
 pub mod error;
 pub mod estimator;
 pub mod experiment;
+pub mod fit;
 pub mod frame;
 pub mod fresnel;
 pub mod light;
@@ -85,6 +86,7 @@ pub mod sample;
 pub mod sequence;
 pub mod stats;
 pub mod strategy;
+pub mod tabulate;
 pub mod warp;
 
 #[cfg(feature = "desc")]

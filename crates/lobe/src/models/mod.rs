@@ -69,6 +69,8 @@ pub enum Range {
     Bool,
     /// One of these names (comma separated).
     Names(&'static str),
+    /// The path of a data file (a measured table).
+    File,
 }
 
 /// The default of a key of a material description.
@@ -146,6 +148,7 @@ impl fmt::Display for Range {
             Range::Number { min, max } if max.is_infinite() => write!(f, "≥ {}", Num(min)),
             Range::Number { min, max } => write!(f, "[{}, {}]", Num(min), Num(max)),
             Range::Bool => f.write_str("bool"),
+            Range::File => f.write_str("a file (MERL .binary or RGL .bsdf, by content)"),
             Range::Names(names) => {
                 let mut first = true;
                 for n in names.split(',') {
@@ -384,6 +387,7 @@ glossy_models! {
     phong::Phong,
     blinn_phong::BlinnPhong,
     cook_torrance::CookTorrance,
+    measured::Measured,
 }
 
 #[cfg(feature = "desc")]
