@@ -347,3 +347,66 @@ pub(crate) fn sincos_slice(level: SimdLevel, t: &[f32], s: &mut [f32], c: &mut [
         Backend::Avx512(l) => unsafe { avx512(l, t, s, c) },
     }
 }
+
+/// A function of [`super::math`], for the accuracy tests.
+#[cfg(test)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum MathFn {
+    Exp,
+    Log,
+    Log1p,
+    /// `(erfc x, e^(−x²))`.
+    ErfcExp,
+    ErfinvU,
+}
+
+/// `f` over slices at `level` (the second output only for `ErfcExp`).
+#[cfg(test)]
+pub(crate) fn math_slice(level: SimdLevel, f: MathFn, x: &[f32], a: &mut [f32], b: &mut [f32]) {
+    #[inline(always)]
+    fn one<L: Lanes>(l: L, f: MathFn, x: L::F) -> (L::F, L::F) {
+        use super::math;
+        let z = l.splat(0.0);
+        match f {
+            MathFn::Exp => (math::exp(l, x), z),
+            MathFn::Log => (math::log(l, x), z),
+            MathFn::Log1p => (math::log1p(l, x), z),
+            MathFn::ErfcExp => math::erfc_exp(l, x),
+            MathFn::ErfinvU => (math::erfinv_u(l, x), z),
+        }
+    }
+    #[inline(always)]
+    fn run<L: Lanes>(l: L, f: MathFn, x: &[f32], a: &mut [f32], b: &mut [f32]) {
+        let mut k = 0;
+        while k + L::N <= x.len() {
+            let (u, v) = one(l, f, l.load(&x[k..]));
+            l.store(u, &mut a[k..]);
+            l.store(v, &mut b[k..]);
+            k += L::N;
+        }
+        for k in k..x.len() {
+            let (u, v) = one(Scalar, f, x[k]);
+            a[k] = u;
+            b[k] = v;
+        }
+    }
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma")]
+    fn avx2(l: Avx2, f: MathFn, x: &[f32], a: &mut [f32], b: &mut [f32]) {
+        run(l, f, x, a, b);
+    }
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx512f,avx512dq,avx512bw,avx512vl,avx2,fma")]
+    fn avx512(l: Avx512, f: MathFn, x: &[f32], a: &mut [f32], b: &mut [f32]) {
+        run(l, f, x, a, b);
+    }
+    match Backend::new(level).expect("level available") {
+        Backend::Scalar(l) => run(l, f, x, a, b),
+        // SAFETY: the token proves AVX2 and FMA.
+        #[cfg(target_arch = "x86_64")]
+        Backend::Avx2(l) => unsafe { avx2(l, f, x, a, b) },
+        // SAFETY: the token proves AVX-512F/DQ/BW/VL and FMA.
+        #[cfg(target_arch = "x86_64")]
+        Backend::Avx512(l) => unsafe { avx512(l, f, x, a, b) },
+    }
+}
