@@ -87,8 +87,8 @@ mod tests;
 
 use crate::models::{Bxdf, CookTorrance, Glossy};
 use crate::{BsdfStrategy, Fresnel, Material, Ndf, Rgb, Shadowing};
-use dispatch::Backend;
-use kernel::GgxParams;
+use dispatch::{Backend, Kernel};
+use kernel::{CtParams, FresnelP, Shadow};
 
 /// A dispatch level.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -376,7 +376,7 @@ impl EvalPdfBuffers {
 /// A material and strategy prepared for the batch kernels at one level.
 #[derive(Debug, Clone, Copy)]
 pub struct BatchSampler {
-    params: GgxParams,
+    kernel: Kernel,
     strategy: BsdfStrategy,
     backend: Backend,
 }
@@ -396,11 +396,11 @@ impl BatchSampler {
         strategy: BsdfStrategy,
         level: SimdLevel,
     ) -> Result<Self, BatchError> {
-        let params = ggx_params(material, strategy)?;
+        let kernel = kernel_for(material, strategy)?;
         level.check()?;
         let backend = Backend::new(level).expect("checked");
         Ok(BatchSampler {
-            params,
+            kernel,
             strategy,
             backend,
         })
@@ -466,13 +466,7 @@ impl BatchSampler {
             out.weight.g,
             out.weight.b,
         ];
-        dispatch::sample(
-            self.backend,
-            self.strategy == BsdfStrategy::Vndf,
-            &self.params,
-            inp,
-            (&mut o, out.valid),
-        );
+        dispatch::sample(self.backend, &self.kernel, inp, (&mut o, out.valid));
         Ok(())
     }
 
@@ -486,31 +480,43 @@ impl BatchSampler {
         wi: Dirs<'_>,
         out: EvalPdfOutput<'_>,
     ) -> Result<(), BatchError> {
-        let n = wo.x.len();
-        for (slice, found) in [
-            ("wo.y", wo.y.len()),
-            ("wo.z", wo.z.len()),
-            ("wi.x", wi.x.len()),
-            ("wi.y", wi.y.len()),
-            ("wi.z", wi.z.len()),
-            ("f.r", out.f.r.len()),
-            ("f.g", out.f.g.len()),
-            ("f.b", out.f.b.len()),
-            ("pdf", out.pdf.len()),
-        ] {
-            if found != n {
-                return Err(BatchError::Length {
-                    slice,
-                    expected: n,
-                    found,
-                });
-            }
-        }
+        check_pairs(wo, wi, &[("f.r", out.f.r.len()), ("f.g", out.f.g.len()), ("f.b", out.f.b.len()), ("pdf", out.pdf.len())])?;
         let mut o = [out.f.r, out.f.g, out.f.b, out.pdf];
         dispatch::eval_pdf(
             self.backend,
-            self.strategy == BsdfStrategy::Vndf,
-            &self.params,
+            &self.kernel,
+            dispatch::BOTH,
+            [wo.x, wo.y, wo.z, wi.x, wi.y, wi.z],
+            &mut o,
+        );
+        Ok(())
+    }
+
+    /// `f(wo[i], wi[i])` without the cosine, zero below the horizon: the
+    /// `f` of [`BatchSampler::eval_pdf`] (the same bits) without its pdf.
+    pub fn eval(&self, wo: Dirs<'_>, wi: Dirs<'_>, f: RgbMut<'_>) -> Result<(), BatchError> {
+        check_pairs(wo, wi, &[("f.r", f.r.len()), ("f.g", f.g.len()), ("f.b", f.b.len())])?;
+        let mut o: [&mut [f32]; 4] = [f.r, f.g, f.b, &mut []];
+        dispatch::eval_pdf(
+            self.backend,
+            &self.kernel,
+            dispatch::F_ONLY,
+            [wo.x, wo.y, wo.z, wi.x, wi.y, wi.z],
+            &mut o,
+        );
+        Ok(())
+    }
+
+    /// The pdf (solid angle) of this sampler's strategy at `(wo[i], wi[i])`,
+    /// zero below the horizon: the pdf of [`BatchSampler::eval_pdf`] (the
+    /// same bits) without `f`.
+    pub fn pdf(&self, wo: Dirs<'_>, wi: Dirs<'_>, pdf: &mut [f32]) -> Result<(), BatchError> {
+        check_pairs(wo, wi, &[("pdf", pdf.len())])?;
+        let mut o: [&mut [f32]; 4] = [&mut [], &mut [], &mut [], pdf];
+        dispatch::eval_pdf(
+            self.backend,
+            &self.kernel,
+            dispatch::PDF_ONLY,
             [wo.x, wo.y, wo.z, wi.x, wi.y, wi.z],
             &mut o,
         );
@@ -518,62 +524,116 @@ impl BatchSampler {
     }
 }
 
-/// The f32 parameters of a material the GGX kernels cover, or why not.
-fn ggx_params(m: &Material, strategy: BsdfStrategy) -> Result<GgxParams, BatchError> {
+/// Every input slice and each of `outputs` has the length of `wo.x`.
+fn check_pairs(wo: Dirs<'_>, wi: Dirs<'_>, outputs: &[(&'static str, usize)]) -> Result<(), BatchError> {
+    let n = wo.x.len();
+    for &(slice, found) in [
+        ("wo.y", wo.y.len()),
+        ("wo.z", wo.z.len()),
+        ("wi.x", wi.x.len()),
+        ("wi.y", wi.y.len()),
+        ("wi.z", wi.z.len()),
+    ]
+    .iter()
+    .chain(outputs)
+    {
+        if found != n {
+            return Err(BatchError::Length {
+                slice,
+                expected: n,
+                found,
+            });
+        }
+    }
+    Ok(())
+}
+
+/// The kernel and its f32 parameters for a material and strategy, or why
+/// the batch path does not have them.
+fn kernel_for(m: &Material, strategy: BsdfStrategy) -> Result<Kernel, BatchError> {
     let unsupported = |reason: String| Err(BatchError::Unsupported { reason });
     if let Err(e) = m.check(strategy) {
         return unsupported(e.to_string());
     }
-    if !matches!(strategy, BsdfStrategy::Vndf | BsdfStrategy::Brdf) {
-        return unsupported(format!(
-            "strategy `{strategy}` (batched so far: vndf, brdf)"
-        ));
-    }
-    let Glossy::CookTorrance(CookTorrance {
+    let lobe = match m.glossy {
+        Glossy::CookTorrance(lobe) => lobe,
+        #[allow(unreachable_patterns)]
+        _ => {
+            return unsupported(format!(
+                "model `{}` (batched so far: cook-torrance)",
+                m.model_name()
+            ));
+        }
+    };
+    let CookTorrance {
         ks,
         microfacet,
         shadowing,
         fresnel,
-    }) = m.glossy
-    else {
-        return unsupported(format!(
-            "model `{}` (batched so far: cook-torrance with ggx)",
-            m.model_name()
-        ));
-    };
+    } = lobe;
     if m.diffuse.albedo != Rgb::ZERO {
         return unsupported("a diffuse term kd > 0 (batched so far: a single glossy lobe)".into());
     }
-    if microfacet.ndf() != Ndf::Ggx {
-        return unsupported(format!(
-            "distribution `{}` (batched so far: ggx)",
-            microfacet.ndf().name()
-        ));
-    }
-    if shadowing != Shadowing::SmithCorrelated {
-        return unsupported(format!(
-            "shadowing `{}` (batched so far: smith-correlated)",
-            shadowing.name()
-        ));
-    }
-    let f0 = match fresnel {
-        Fresnel::None => Rgb::ONE,
-        Fresnel::Schlick { f0 } => f0,
-        _ => {
-            return unsupported("this Fresnel term (batched so far: none, schlick)".into());
+    let ndf = match microfacet.ndf() {
+        Ndf::Ggx => kernel::GGX,
+        Ndf::Beckmann => kernel::BECKMANN,
+        other => {
+            return unsupported(format!(
+                "distribution `{}` (batched so far: ggx, beckmann)",
+                other.name()
+            ));
+        }
+    };
+    let strat = match strategy {
+        BsdfStrategy::Vndf => kernel::VNDF,
+        BsdfStrategy::Brdf => kernel::BRDF,
+        BsdfStrategy::Uniform => kernel::UNIFORM,
+        BsdfStrategy::Cosine => kernel::COSINE,
+        other => {
+            return unsupported(format!(
+                "strategy `{other}` (batched so far: vndf, brdf, uniform, cosine)"
+            ));
         }
     };
     // Defensive: `check` accepted the strategy, so the lobe supports it.
     debug_assert!(m.glossy.supports(strategy).is_ok());
     let (ax, ay) = microfacet.alpha();
     let c3 = |c: Rgb| [c.x as f32, c.y as f32, c.z as f32];
-    Ok(GgxParams {
-        ax: ax as f32,
-        ay: ay as f32,
-        inv_ax: (1.0 / ax) as f32,
-        inv_ay: (1.0 / ay) as f32,
-        inv_pi_axay: (crate::math::INV_PI / (ax * ay)) as f32,
-        ks_f0: c3(ks * f0),
-        ks_1mf0: c3(ks * (Rgb::ONE - f0)),
+    let fresnel = match fresnel {
+        Fresnel::None => FresnelP::Schlick {
+            ks_f0: c3(ks),
+            ks_1mf0: [0.0; 3],
+        },
+        Fresnel::Schlick { f0 } => FresnelP::Schlick {
+            ks_f0: c3(ks * f0),
+            ks_1mf0: c3(ks * (Rgb::ONE - f0)),
+        },
+        Fresnel::Dielectric { eta } => FresnelP::Dielectric {
+            ks: c3(ks),
+            eta: c3(eta),
+        },
+        Fresnel::Conductor { eta, k } => FresnelP::Conductor {
+            ks: c3(ks),
+            eta: c3(eta),
+            k: c3(k),
+        },
+    };
+    let shadow = match shadowing {
+        Shadowing::SmithCorrelated => Shadow::Correlated,
+        Shadowing::SmithSeparable => Shadow::Separable,
+        Shadowing::VCavity => Shadow::VCavity,
+    };
+    Ok(Kernel::CookTorrance {
+        ndf,
+        strat,
+        p: CtParams {
+            ax: ax as f32,
+            ay: ay as f32,
+            inv_ax: (1.0 / ax) as f32,
+            inv_ay: (1.0 / ay) as f32,
+            inv_pi_axay: (crate::math::INV_PI / (ax * ay)) as f32,
+            fresnel,
+            shadow,
+        },
     })
 }

@@ -37,7 +37,7 @@ fn ggx(ax: f64, ay: f64, fresnel: Fresnel, ks: Rgb) -> Material {
 }
 
 /// The levels to test, and a note of the skipped ones.
-fn levels(test: &str) -> Vec<SimdLevel> {
+pub(super) fn levels(test: &str) -> Vec<SimdLevel> {
     SimdLevel::ALL
         .into_iter()
         .filter(|l| {
@@ -51,13 +51,13 @@ fn levels(test: &str) -> Vec<SimdLevel> {
 }
 
 /// A uniform f32 in [0, 1), 24 random bits.
-fn uniform(rng: &mut impl Rng) -> f32 {
+pub(super) fn uniform(rng: &mut impl Rng) -> f32 {
     (rng.next_u32() >> 8) as f32 * (1.0 / (1u32 << 24) as f32)
 }
 
 /// A view direction: 10% at cos θ = 1e-7, 10% with cos θ log-uniform in
 /// [1e-7, 1e-2], 1% at the normal, the rest uniform over the hemisphere.
-fn random_wo(rng: &mut impl Rng) -> [f32; 3] {
+pub(super) fn random_wo(rng: &mut impl Rng) -> [f32; 3] {
     let k: f64 = rng.random();
     let z: f64 = if k < 0.1 {
         1e-7
@@ -73,7 +73,7 @@ fn random_wo(rng: &mut impl Rng) -> [f32; 3] {
     [(s * phi.cos()) as f32, (s * phi.sin()) as f32, z as f32]
 }
 
-fn d3(v: [f32; 3]) -> DVec3 {
+pub(super) fn d3(v: [f32; 3]) -> DVec3 {
     DVec3::new(v[0].into(), v[1].into(), v[2].into())
 }
 
@@ -120,13 +120,13 @@ fn materials(rng: &mut impl Rng) -> Vec<Material> {
 
 /// Inputs of one material: `n` view directions and uniforms (1% at the
 /// ends 0 and 1 − 2⁻²⁴).
-struct Inputs {
+pub(super) struct Inputs {
     wo: [Vec<f32>; 3],
     u1: Vec<f32>,
     u2: Vec<f32>,
 }
 
-fn inputs(rng: &mut impl Rng, n: usize) -> Inputs {
+pub(super) fn inputs(rng: &mut impl Rng, n: usize) -> Inputs {
     let mut wo = [vec![], vec![], vec![]];
     let (mut u1, mut u2) = (vec![], vec![]);
     for _ in 0..n {
@@ -149,7 +149,7 @@ fn inputs(rng: &mut impl Rng, n: usize) -> Inputs {
 }
 
 impl Inputs {
-    fn input(&self) -> SampleInput<'_> {
+    pub(super) fn input(&self) -> SampleInput<'_> {
         SampleInput {
             wo: self.wo(),
             u1: &self.u1,
@@ -157,7 +157,7 @@ impl Inputs {
             uc: None,
         }
     }
-    fn wo(&self) -> Dirs<'_> {
+    pub(super) fn wo(&self) -> Dirs<'_> {
         Dirs {
             x: &self.wo[0],
             y: &self.wo[1],
@@ -171,13 +171,13 @@ impl Inputs {
 
 /// `|a − b| / (|b| + floor)` with the relative tolerance's floor, 0 when
 /// both are tiny.
-fn rel_err(a: f64, b: f64) -> f64 {
+pub(super) fn rel_err(a: f64, b: f64) -> f64 {
     let d = (a - b).abs();
     if d <= FLOOR { 0.0 } else { d / b.abs() }
 }
 
 #[derive(Default, Debug)]
-struct Worst {
+pub(super) struct Worst {
     mask_exempt: usize,
     mask_bad: Vec<String>,
     wi_abs: f64,
@@ -221,7 +221,7 @@ fn explained_change(m: &Material, s: BsdfStrategy, wo: DVec3, wi: DVec3, delta: 
     worst
 }
 
-fn compare_samples(
+pub(super) fn compare_samples(
     m: &Material,
     s: BsdfStrategy,
     inp: &Inputs,
@@ -465,7 +465,7 @@ fn batch_eval_pdf_matches_scalar() {
     }
 }
 
-fn dirs(v: &[Vec<f32>; 3]) -> Dirs<'_> {
+pub(super) fn dirs(v: &[Vec<f32>; 3]) -> Dirs<'_> {
     Dirs {
         x: &v[0],
         y: &v[1],
@@ -473,7 +473,7 @@ fn dirs(v: &[Vec<f32>; 3]) -> Dirs<'_> {
     }
 }
 
-fn bits(b: &SampleBuffers) -> Vec<u32> {
+pub(super) fn bits(b: &SampleBuffers) -> Vec<u32> {
     let mut v: Vec<u32> = Vec::new();
     for a in b.wi.iter().chain(&b.f).chain([&b.pdf]).chain(&b.weight) {
         v.extend(a.iter().map(|x| x.to_bits()));
@@ -841,3 +841,7 @@ fn batch_chi2() {
     }
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
+
+/// The whole model × strategy × Fresnel × shadowing grid.
+#[path = "tests_grid.rs"]
+mod grid;
