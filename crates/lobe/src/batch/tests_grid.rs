@@ -210,7 +210,9 @@ fn grid_eval_pdf_matches_scalar() {
                         continue;
                     }
                     if (pdf == 0.0) != (pb == 0.0) {
-                        if o.z.min(i.z) < HORIZON {
+                        // Under f32's range (D of a sharp Beckmann lobe far
+                        // from its peak, 1e-200 in f64), or at the horizon.
+                        if o.z.min(i.z) < HORIZON || pdf.max(f64::from(pb)) < FLOOR {
                             exempt += 1;
                         } else {
                             failures.push(format!("{level} {m:?} {s} {o} {i}: pdf {pdf} vs {pb}"));
