@@ -86,6 +86,39 @@ pub(crate) struct CtParams {
     pub inv_pi_axay: f32,
     pub fresnel: FresnelP,
     pub shadow: Shadow,
+    /// Beckmann vndf: the starting points of the slope inversion
+    /// ([`beckmann_guess_table`]); empty otherwise.
+    pub guess: &'static [f32],
+}
+
+/// Cells of the guess table along `cos θ` and along the normal-incidence
+/// slope `g = erf⁻¹(2u1 − 1) ∈ [−G_MAX, G_MAX]`.
+pub(crate) const GUESS_NC: usize = 32;
+pub(crate) const GUESS_NG: usize = 64;
+const G_MAX: f32 = 4.0;
+
+/// The exact (f64, the scalar path's) visible slope `x(cos θ, g)` at the
+/// `(GUESS_NC + 1) × (GUESS_NG + 1)` nodes, row by row in `cos θ`, built
+/// once: bilinear interpolation in it starts the Newton iteration of
+/// [`beckmann_vndf_normal`] within about 1e-3 of the root, so that a vector
+/// needs a few steps instead of the ~9 from `g` alone.
+pub(crate) fn beckmann_guess_table() -> &'static [f32] {
+    static TABLE: std::sync::OnceLock<Vec<f32>> = std::sync::OnceLock::new();
+    TABLE.get_or_init(|| {
+        let mut t = Vec::with_capacity((GUESS_NC + 1) * (GUESS_NG + 1));
+        for i in 0..=GUESS_NC {
+            // Keep off the exact horizon (cot θ = 0).
+            let c = (i as f64 / GUESS_NC as f64).max(1e-4);
+            for j in 0..=GUESS_NG {
+                let g = f64::from(G_MAX) * (2.0 * j as f64 / GUESS_NG as f64 - 1.0);
+                let u = 0.5 * libm::erfc(-g);
+                let (x, _) =
+                    crate::microfacet::beckmann_visible_slope_11(c, glam::DVec2::new(u, 0.5));
+                t.push(x as f32);
+            }
+        }
+        t
+    })
 }
 
 type V3<L> = [<L as Lanes>::F; 3];
@@ -409,6 +442,14 @@ fn ggx_vndf_normal<L: Lanes>(
 /// its step falls under 4e-7 relative; measured: at most 9 in the tests).
 const BECKMANN_MAX_STEPS: usize = 24;
 
+#[cfg(test)]
+thread_local! {
+    /// Newton steps and calls (vectors) of the Beckmann inversion on this
+    /// thread, for the tests' report.
+    pub(crate) static STEPS: std::cell::Cell<u64> = const { std::cell::Cell::new(0) };
+    pub(crate) static STEPS_CALLS: std::cell::Cell<u64> = const { std::cell::Cell::new(0) };
+}
+
 /// Heitz and d'Eon 2014's visible Beckmann normal for `wo`, as the scalar
 /// `Microfacet::sample_visible` draws it: the slope along the stretched
 /// view azimuth inverts its CDF `(erfc(−x) + tanθ e^(−x²)/√π) / (erfc(−cotθ)
@@ -449,7 +490,31 @@ fn beckmann_vndf_normal<L: Lanes>(l: L, p: &CtParams, wo: V3<L>, u1: L::F, u2: L
     let one_m_u1 = one - u1;
     let mut lo = l.splat(-8.0);
     let mut hi = l.min(cot_t, l.splat(9.0));
-    let mut x = l.min(l.max(erfinv_u(l, u1), lo), hi);
+    // The start: bilinear in the table at (cos θ, g = erf⁻¹(2u1 − 1)).
+    let g = erfinv_u(l, u1);
+    let fc = cos_t * l.splat(GUESS_NC as f32);
+    let ic = l.min(l.floor(fc), l.splat(GUESS_NC as f32 - 1.0));
+    let tc = fc - ic;
+    let fg = l.mul_add(
+        l.min(l.max(g, l.splat(-G_MAX)), l.splat(G_MAX)),
+        l.splat(GUESS_NG as f32 / (2.0 * G_MAX)),
+        l.splat(GUESS_NG as f32 / 2.0),
+    );
+    let ig = l.min(l.floor(fg), l.splat(GUESS_NG as f32 - 1.0));
+    let tg = fg - ig;
+    let row = l.splat((GUESS_NG + 1) as f32);
+    let i00 = l.mul_add(ic, row, ig);
+    let t = p.guess;
+    let x00 = l.gather(t, i00);
+    let x01 = l.gather(t, i00 + one);
+    let x10 = l.gather(t, i00 + row);
+    let x11 = l.gather(t, i00 + row + one);
+    let x0 = l.mul_add(tg, x01 - x00, x00);
+    let x1 = l.mul_add(tg, x11 - x10, x10);
+    let table_x = l.mul_add(tc, x1 - x0, x0);
+    // Beyond the table's g (the tails), g itself.
+    let in_table = l.lt(l.abs(g), l.splat(G_MAX));
+    let mut x = l.min(l.max(l.select(in_table, table_x, g), lo), hi);
     let mut done = l.lt(one, zero);
     let deriv_k = norm * l.splat(TWO_INV_SQRT_PI);
     for _ in 0..BECKMANN_MAX_STEPS {
@@ -470,16 +535,23 @@ fn beckmann_vndf_normal<L: Lanes>(l: L, p: &CtParams, wo: V3<L>, u1: L::F, u2: L
         // Inclusive: a converged step lands on the bracket's end it set.
         let inside = !(l.lt(next, lo) | l.gt(next, hi)) & l.is_finite(next);
         let xn = l.select(inside, next, l.splat(0.5) * (lo + hi));
+        // Converged when the step is under 3e-7 of max(|x|, 1): slopes are
+        // of order 1 (in units of alpha), and near x = 0 the f32 residual's
+        // rounding alone makes steps of ~1e-7.
         let small = !l.gt(
             l.abs(xn - x),
-            l.mul_add(l.abs(x), l.splat(4e-7), l.splat(1e-9)),
+            l.mul_add(l.max(l.abs(x), one), l.splat(3e-7), l.splat(0.0)),
         );
         x = l.select(active, xn, x);
         done = done | small | l.eq(value, zero);
+        #[cfg(test)]
+        STEPS.with(|s| s.set(s.get() + 1));
         if !l.any(!done) {
             break;
         }
     }
+    #[cfg(test)]
+    STEPS_CALLS.with(|s| s.set(s.get() + 1));
     let sx = x;
     // Rotate back to the view azimuth, then stretch.
     let mx = l.mul_add(cphi, sx, -(sphi * sy));

@@ -59,6 +59,9 @@ pub(crate) trait Lanes: Copy {
     fn abs(self, a: Self::F) -> Self::F;
     /// Whether any lane of the mask is set.
     fn any(self, m: Self::M) -> bool;
+    /// `table[i]` lane by lane for integral `i` in `[0, table.len())`
+    /// (clamped into it, so never out of bounds).
+    fn gather(self, table: &[f32], i: Self::F) -> Self::F;
     /// `2ⁿ` for integral `n` in `[−126, 127]` (built from the exponent bits;
     /// other `n` give garbage the callers never use).
     fn exp2i(self, n: Self::F) -> Self::F;
@@ -149,6 +152,10 @@ impl Lanes for Scalar {
     #[inline(always)]
     fn any(self, m: bool) -> bool {
         m
+    }
+    #[inline(always)]
+    fn gather(self, table: &[f32], i: f32) -> f32 {
+        table[(i.max(0.0) as usize).min(table.len() - 1)]
     }
     #[inline(always)]
     fn exp2i(self, n: f32) -> f32 {
@@ -324,6 +331,17 @@ mod x86 {
         fn any(self, m: M8) -> bool {
             // SAFETY: the token proves AVX2.
             unsafe { _mm256_movemask_ps(m.0) != 0 }
+        }
+        #[inline(always)]
+        fn gather(self, table: &[f32], i: F8) -> F8 {
+            assert!(!table.is_empty() && table.len() <= i32::MAX as usize);
+            let top = (table.len() - 1) as f32;
+            // SAFETY: the token proves AVX2; the indices are clamped into
+            // [0, len − 1], so every lane reads inside `table`.
+            F8(unsafe {
+                let c = _mm256_min_ps(_mm256_max_ps(i.0, _mm256_setzero_ps()), _mm256_set1_ps(top));
+                _mm256_i32gather_ps::<4>(table.as_ptr(), _mm256_cvttps_epi32(c))
+            })
         }
         #[inline(always)]
         fn exp2i(self, n: F8) -> F8 {
@@ -507,6 +525,17 @@ mod x86 {
         #[inline(always)]
         fn any(self, m: M16) -> bool {
             m.0 != 0
+        }
+        #[inline(always)]
+        fn gather(self, table: &[f32], i: F16) -> F16 {
+            assert!(!table.is_empty() && table.len() <= i32::MAX as usize);
+            let top = (table.len() - 1) as f32;
+            // SAFETY: the token proves AVX-512F; the indices are clamped
+            // into [0, len − 1], so every lane reads inside `table`.
+            F16(unsafe {
+                let c = _mm512_min_ps(_mm512_max_ps(i.0, _mm512_setzero_ps()), _mm512_set1_ps(top));
+                _mm512_i32gather_ps::<4>(_mm512_cvttps_epi32(c), table.as_ptr())
+            })
         }
         #[inline(always)]
         fn exp2i(self, n: F16) -> F16 {

@@ -634,6 +634,11 @@ fn kernel_for(m: &Material, strategy: BsdfStrategy) -> Result<Kernel, BatchError
             inv_pi_axay: (crate::math::INV_PI / (ax * ay)) as f32,
             fresnel,
             shadow,
+            guess: if ndf == kernel::BECKMANN && strat == kernel::VNDF {
+                kernel::beckmann_guess_table()
+            } else {
+                &[]
+            },
         },
     })
 }
