@@ -307,24 +307,41 @@ fn grid_chi2_batch_pdf() {
     let views = [0.0, 60.0, 89.0];
     let alphas = [(0.3, 0.3), (0.1, 0.5)];
     let cases = batched();
-    let alpha = sidak(0.01, cases.len() * alphas.len() * views.len());
     // The harness's stream: uc, u.x, u.y per sample, rounded down into f32.
     let mut rng = Pcg64::seed_from_u64(cfg.seed);
     let down = |v: f64| {
         let r = v as f32;
         if f64::from(r) > v { r.next_down() } else { r }
     };
-    let (mut u1, mut u2) = (Vec::new(), Vec::new());
+    let (mut u1, mut u2, mut uc) = (Vec::new(), Vec::new(), Vec::new());
     for _ in 0..cfg.samples {
-        let _uc: f64 = rng.random();
+        uc.push(down(rng.random()));
         u1.push(down(rng.random()));
         u2.push(down(rng.random()));
     }
     let n = cfg.samples;
     let mut failures = Vec::new();
+    // Every Cook-Torrance pair at two alphas, two-lobe mixtures and the
+    // Lambertian material.
+    let mut mats: Vec<(String, Material, BsdfStrategy)> = Vec::new();
     for (ndf, s) in cases {
         for &(ax, ay) in &alphas {
             let m = ct(ndf, ax, ay, Shadowing::SmithCorrelated, Fresnel::None, Rgb::ONE);
+            mats.push((format!("{} α=({ax}, {ay})", ndf.name()), m, s));
+        }
+    }
+    for (ndf, s) in [(Ndf::Ggx, BsdfStrategy::Vndf), (Ndf::Beckmann, BsdfStrategy::Brdf)] {
+        let mut m = ct(ndf, 0.2, 0.4, Shadowing::SmithCorrelated, Fresnel::Schlick { f0: Rgb::splat(0.5) }, Rgb::ONE);
+        m.diffuse = crate::models::Lambert::new(Rgb::new(0.5, 0.3, 0.2)).unwrap();
+        mats.push((format!("{} + lambert", ndf.name()), m, s));
+    }
+    for s in [BsdfStrategy::Uniform, BsdfStrategy::Cosine, BsdfStrategy::Brdf] {
+        mats.push(("lambert".into(), Material::lambert(Rgb::ONE).unwrap(), s));
+    }
+    let alpha = sidak(0.01, mats.len() * views.len());
+    let _ = alphas;
+    for (name, m, s) in mats {
+        {
             let b = BatchSampler::with_level(&m, s, level).unwrap();
             for &theta in &views {
                 let wo = crate::frame::wo_from_theta(theta, 0.3f64.to_degrees());
@@ -335,7 +352,7 @@ fn grid_chi2_batch_pdf() {
                     wo: Dirs { x: &wox, y: &woy, z: &woz },
                     u1: &u1,
                     u2: &u2,
-                    uc: None,
+                    uc: Some(&uc),
                 };
                 b.sample(input, out.output()).unwrap();
                 let next = Cell::new(0usize);
@@ -355,14 +372,12 @@ fn grid_chi2_batch_pdf() {
                 };
                 let r = chi2_test(&cfg, sample, pdf);
                 eprintln!(
-                    "grid_chi2_batch_pdf {} {s} α=({ax}, {ay}) θ={theta}: p = {:.3e}",
-                    ndf.name(),
+                    "grid_chi2_batch_pdf {name} {s} θ={theta}: p = {:.3e}",
                     r.p_value
                 );
                 if !r.passes(alpha) {
                     failures.push(format!(
-                        "{} {s} α=({ax}, {ay}) θ={theta}: χ²={:.1} dof={} p={:.3e} {}",
-                        ndf.name(),
+                        "{name} {s} θ={theta}: χ²={:.1} dof={} p={:.3e} {}",
                         r.statistic,
                         r.dof,
                         r.p_value,
