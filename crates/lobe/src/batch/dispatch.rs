@@ -149,6 +149,14 @@ fn sample_block<L: Lanes, const NDF: u8, const STRAT: u8>(
     (out, valid): SampleOut<'_, '_>,
 ) {
     let n = inp[0].len();
+    // Equal lengths, stated once: the bounds checks in the loop fold away.
+    for s in &inp {
+        assert_eq!(s.len(), n);
+    }
+    for o in out.iter() {
+        assert_eq!(o.len(), n);
+    }
+    assert_eq!(valid.len(), n);
     let mut k = 0;
     while k + L::N <= n {
         let s = run_sample::<L, NDF, STRAT>(
@@ -202,6 +210,13 @@ fn eval_pdf_block<L: Lanes, const NDF: u8, const STRAT: u8, const MODE: u8>(
     out: EvalOut<'_, '_>,
 ) {
     let n = inp[0].len();
+    for s in &inp {
+        assert_eq!(s.len(), n);
+    }
+    for (i, o) in out.iter().enumerate() {
+        let written = if i == 3 { MODE != F_ONLY } else { MODE != PDF_ONLY };
+        assert!(!written || o.len() == n);
+    }
     let mut k = 0;
     while k + L::N <= n {
         let x = [
