@@ -47,8 +47,8 @@ pub(crate) const UNIFORM: u8 = 2;
 /// `STRAT`: cosine-weighted hemisphere.
 pub(crate) const COSINE: u8 = 3;
 
-const INV_SQRT_PI: f32 = 0.564_189_6;
-const TWO_INV_SQRT_PI: f32 = 1.128_379_2;
+const INV_SQRT_PI: f32 = 0.5 * std::f32::consts::FRAC_2_SQRT_PI;
+const TWO_INV_SQRT_PI: f32 = std::f32::consts::FRAC_2_SQRT_PI;
 const INV_PI: f32 = std::f32::consts::FRAC_1_PI;
 const INV_TWO_PI: f32 = 0.159_154_94;
 

@@ -11,6 +11,9 @@
 //! The polynomial coefficients are discrete minimax fits made by
 //! `fit_math.py` (and `fit_sincos.py`) beside this file.
 
+// The coefficients keep the fit's f64 digits (rounded to f32 by the compiler).
+#![allow(clippy::excessive_precision)]
+
 use super::lanes::Lanes;
 
 // Minimax coefficients on [−π/4, π/4] (Cephes-style reduction), fitted by
@@ -268,7 +271,7 @@ pub(crate) fn erfinv_u_refined<L: Lanes>(l: L, u: L::F) -> L::F {
             l.mul_add(-two, u, c),
             l.mul_add(two, one - u, -c),
         );
-        let step = g / (l.splat(1.128_379_2) * e);
+        let step = g / (l.splat(std::f32::consts::FRAC_2_SQRT_PI) * e);
         x = l.select(l.is_finite(step), x - step, x);
     }
     x

@@ -112,7 +112,6 @@ fn grid_sample_matches_scalar() {
     let n = 2_053;
     let mut summary = Vec::new();
     for (name, mats, s) in groups(&mut rng, 16) {
-        let ndf = if name == "beckmann" { Ndf::Beckmann } else { Ndf::Ggx };
         let mut sets: Vec<Inputs> = mats.iter().map(|_| inputs(&mut rng, n)).collect();
         if name == "beckmann" && s == BsdfStrategy::Vndf {
             // u1 = 0 is clamped to 1e-12 by both paths, deep in the tail of
