@@ -11,7 +11,16 @@ use std::hint::black_box;
 use std::sync::Barrier;
 use std::time::{Duration, Instant};
 
-const DEFAULT_MATERIAL: &str = r#"{"type":"cook-torrance","distribution":"ggx","alpha":0.2}"#;
+const GGX_02: &str = r#"{"type":"cook-torrance","distribution":"ggx","alpha":0.2}"#;
+const BECKMANN_02: &str = r#"{"type":"cook-torrance","distribution":"beckmann","alpha":0.2}"#;
+
+/// The table of the README (no `--material`): the three rows issue 9 sets
+/// goals for, against Mitsuba 3's figures.
+const DEFAULT_TABLE: [(&str, BsdfStrategy); 3] = [
+    (GGX_02, BsdfStrategy::Vndf),
+    (GGX_02, BsdfStrategy::Brdf),
+    (BECKMANN_02, BsdfStrategy::Vndf),
+];
 
 /// Samples per call of the batch API: the outputs stay in the L1/L2 caches.
 const BLOCK: usize = 4096;
@@ -33,17 +42,18 @@ const BLOCK: usize = 4096;
     after_help = "Examples:\n  \
                   lobe bench\n  \
                   lobe bench --threads 2 --json\n  \
+                  lobe bench --material '{\"type\":\"cook-torrance\",\"distribution\":\"beckmann\",\"alpha\":0.2}' --strategy vndf,brdf\n  \
                   LOBE_SIMD=avx2 lobe bench --material '{\"type\":\"cook-torrance\",\"alpha_u\":0.1,\"alpha_v\":0.4}' --strategy vndf"
 )]
 pub struct BenchArgs {
-    /// Material: JSON text, @file.json or @file.toml; default GGX alpha = 0.2.
-    /// The batch path has Cook-Torrance GGX, smith-correlated, Fresnel none or
-    /// schlick, kd = 0
+    /// Material: JSON text, @file.json or @file.toml. Without it, the table
+    /// of the README: GGX alpha 0.2 vndf and brdf, Beckmann alpha 0.2 vndf
     #[arg(long)]
     pub material: Option<String>,
-    /// Comma-separated strategies (batched: vndf, brdf)
-    #[arg(long, default_value = "vndf,brdf")]
-    pub strategy: String,
+    /// Comma-separated strategies (default: every strategy the material
+    /// has; without --material, for GGX alpha 0.2)
+    #[arg(long)]
+    pub strategy: Option<String>,
     /// Worker threads, each on its own part of the inputs
     #[arg(long, default_value_t = 1)]
     pub threads: usize,
@@ -63,6 +73,7 @@ struct Inputs {
     wo: [Vec<f32>; 3],
     u1: Vec<f32>,
     u2: Vec<f32>,
+    uc: Vec<f32>,
 }
 
 impl Inputs {
@@ -72,6 +83,7 @@ impl Inputs {
             wo: [vec![], vec![], vec![]],
             u1: Vec::with_capacity(n),
             u2: Vec::with_capacity(n),
+            uc: Vec::with_capacity(n),
         };
         for _ in 0..n {
             let cos_t: f64 = 1.0 - rng.random::<f64>();
@@ -84,6 +96,7 @@ impl Inputs {
             // 24 random bits: uniform f32 in [0, 1).
             v.u1.push((rng.random::<u32>() >> 8) as f32 / (1u32 << 24) as f32);
             v.u2.push((rng.random::<u32>() >> 8) as f32 / (1u32 << 24) as f32);
+            v.uc.push((rng.random::<u32>() >> 8) as f32 / (1u32 << 24) as f32);
         }
         v
     }
@@ -96,8 +109,8 @@ impl Inputs {
                 z: &self.wo[2][r.clone()],
             },
             u1: &self.u1[r.clone()],
-            u2: &self.u2[r],
-            uc: None,
+            u2: &self.u2[r.clone()],
+            uc: Some(&self.uc[r]),
         }
     }
 
@@ -150,7 +163,7 @@ fn work(
                 inputs.wo[2][i].into(),
             );
             let u = DVec2::new(inputs.u1[i].into(), inputs.u2[i].into());
-            if let Some(s) = m.sample(strategy, wo, 0.5, u) {
+            if let Some(s) = m.sample(strategy, wo, inputs.uc[i].into(), u) {
                 let wi = black_box(s.wi);
                 total += s.weight.x + m.eval(wo, wi).x + m.pdf(strategy, wo, wi);
             }
@@ -263,6 +276,13 @@ fn cpu_model() -> String {
         .unwrap_or_else(|| "unknown".into())
 }
 
+fn parse_strategies(list: &str) -> Result<Vec<BsdfStrategy>> {
+    list.split(',')
+        .map(|s| s.trim().parse::<BsdfStrategy>())
+        .collect::<Result<_, _>>()
+        .context("--strategy")
+}
+
 pub fn run(args: &BenchArgs) -> Result<()> {
     if args.threads == 0 {
         bail!("--threads must be at least 1");
@@ -270,35 +290,51 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     if args.samples == 0 || args.reps == 0 {
         bail!("--samples and --reps must be at least 1");
     }
-    let material = args.material.as_deref().unwrap_or(DEFAULT_MATERIAL);
-    let m = Material::load(material).context("--material")?;
-    let strategies: Vec<BsdfStrategy> = args
-        .strategy
-        .split(',')
-        .map(|s| s.trim().parse::<BsdfStrategy>())
-        .collect::<Result<_, _>>()
-        .context("--strategy")?;
-    let samplers: Vec<BatchSampler> = strategies
+    // (material text, material, strategy) rows.
+    let mut rows: Vec<(String, Material, BsdfStrategy)> = Vec::new();
+    match &args.material {
+        None if args.strategy.is_none() => {
+            for (text, s) in DEFAULT_TABLE {
+                rows.push((text.to_string(), Material::load(text).context("default table")?, s));
+            }
+        }
+        None => {
+            let m = Material::load(GGX_02).context("default material")?;
+            for s in parse_strategies(args.strategy.as_deref().unwrap_or_default())? {
+                rows.push((GGX_02.to_string(), m, s));
+            }
+        }
+        Some(text) => {
+            let m = Material::load(text).context("--material")?;
+            let strategies = match &args.strategy {
+                Some(list) => parse_strategies(list)?,
+                None => m.strategies(),
+            };
+            for s in strategies {
+                rows.push((text.clone(), m, s));
+            }
+        }
+    }
+    let samplers: Vec<BatchSampler> = rows
         .iter()
-        .map(|&s| BatchSampler::new(&m, s))
-        .collect::<Result<_, _>>()
-        .with_context(|| format!("--material {material}"))?;
+        .map(|(text, m, s)| BatchSampler::new(m, *s).with_context(|| format!("--material {text} --strategy {s}")))
+        .collect::<Result<_>>()?;
     let level = samplers.first().map(BatchSampler::level);
     let inputs = Inputs::new(args.samples);
     let msps = |d: Duration| args.samples as f64 / d.as_secs_f64() / 1e6;
     let mut results = Vec::new();
-    for (&s, b) in strategies.iter().zip(&samplers) {
+    for ((text, m, s), b) in rows.iter().zip(&samplers) {
         let job = |mode| Job {
             mode,
-            m: &m,
-            strategy: s,
+            m,
+            strategy: *s,
             b,
             inputs: &inputs,
         };
         let full = time(job(Mode::SampleEvalPdf), args.threads, args.reps);
         let sample = time(job(Mode::Sample), args.threads, args.reps);
         let scalar = time(job(Mode::Scalar), args.threads, args.reps);
-        results.push((s, msps(full), msps(sample), msps(scalar)));
+        results.push((text.as_str(), *s, msps(full), msps(sample), msps(scalar)));
     }
     let level = level.map_or("none", |l| l.name());
     let cpu = cpu_model();
@@ -310,8 +346,8 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             "samples": args.samples,
             "reps": args.reps,
             "block": BLOCK,
-            "material": material,
-            "results": results.iter().map(|&(s, x, y, z)| serde_json::json!({
+            "results": results.iter().map(|&(text, s, x, y, z)| serde_json::json!({
+                "material": text,
                 "strategy": s.name(),
                 "msps": x,
                 "sample_msps": y,
@@ -320,18 +356,17 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         });
         println!("{}", serde_json::to_string_pretty(&v)?);
     } else {
-        println!("material {material}");
         println!(
             "cpu {cpu}; simd {level}; {} threads; {} samples, median of {} reps; M samples/s",
             args.threads, args.samples, args.reps
         );
         println!(
-            "{:<10} {:>18} {:>12} {:>18} {:>8}",
-            "strategy", "sample+eval+pdf", "sample", "scalar f64 s+e+p", "speedup"
+            "{:<58} {:<15} {:>16} {:>8} {:>17} {:>8}",
+            "material", "strategy", "sample+eval+pdf", "sample", "scalar f64 s+e+p", "speedup"
         );
-        for (s, x, y, z) in results {
+        for (text, s, x, y, z) in results {
             println!(
-                "{:<10} {x:>18.1} {y:>12.1} {z:>18.1} {:>7.1}x",
+                "{text:<58} {:<15} {x:>16.1} {y:>8.1} {z:>17.1} {:>7.1}x",
                 s.name(),
                 x / z
             );

@@ -483,7 +483,7 @@ fn slope_to_normal(x: f64, y: f64) -> DVec3 {
 /// `(1 + b + tanθ e^{−x̃²}/√π) / (1 + erf(cotθ) + tanθ e^{−cot²θ}/√π)`,
 /// with derivative ∝ `1 − x̃ tanθ`. It is inverted by Newton's method kept
 /// inside a bisection bracket. The slope `ỹ` is an independent Gaussian.
-fn beckmann_visible_slope_11(cos_theta: f64, u: DVec2) -> (f64, f64) {
+pub(crate) fn beckmann_visible_slope_11(cos_theta: f64, u: DVec2) -> (f64, f64) {
     let u1 = u.x.clamp(1e-12, 1.0 - 1e-12);
     let u2 = u.y.clamp(1e-12, 1.0 - 1e-12);
     let sy = erf_inv(2.0 * u2 - 1.0);

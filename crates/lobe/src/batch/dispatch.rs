@@ -8,13 +8,27 @@
 //! the block size, on where the block was cut, or on the thread.
 
 use super::SimdLevel;
-use super::kernel::{self, GgxParams, Sampled};
+use super::kernel::{self, BECKMANN, BRDF, COSINE, CtParams, GGX, Sampled, UNIFORM, VNDF};
 #[cfg(target_arch = "x86_64")]
 use super::lanes::{Avx2, Avx512};
 use super::lanes::{Lanes, Scalar};
 
 /// The widest level's lane count: the size of the tail buffers.
 const MAX_LANES: usize = 16;
+
+/// What a [`super::BatchSampler`] runs: the model's parameters and the
+/// instance of its kernel, chosen once in `BatchSampler::new`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum Kernel {
+    /// Cook-Torrance with distribution `ndf` and strategy `strat` (the
+    /// kernel's const parameters).
+    CookTorrance { ndf: u8, strat: u8, p: CtParams },
+}
+
+/// Which outputs `eval_pdf_block` writes: `f` and the pdf, `f` only, the pdf only.
+pub(crate) const BOTH: u8 = 0;
+pub(crate) const F_ONLY: u8 = 1;
+pub(crate) const PDF_ONLY: u8 = 2;
 
 /// A level with its token.
 #[derive(Debug, Clone, Copy)]
@@ -51,13 +65,15 @@ impl Backend {
     }
 }
 
-/// Inputs of `sample`: `wo.x, wo.y, wo.z, u1, u2`, all of one length.
-pub(crate) type SampleIn<'a> = [&'a [f32]; 5];
+/// Inputs of `sample`: `wo.x, wo.y, wo.z, u1, u2, uc`, all of one length
+/// (`uc` is read only where it chooses a lobe).
+pub(crate) type SampleIn<'a> = [&'a [f32]; 6];
 /// Outputs of `sample`: `wi.xyz, f.rgb, pdf, weight.rgb`, and the mask.
 pub(crate) type SampleOut<'a, 'b> = (&'b mut [&'a mut [f32]; 10], &'b mut [u8]);
 /// Inputs of `eval_pdf`: `wo.xyz, wi.xyz`.
 pub(crate) type EvalIn<'a> = [&'a [f32]; 6];
-/// Outputs of `eval_pdf`: `f.rgb, pdf`.
+/// Outputs of `eval_pdf`: `f.rgb, pdf` (the ones the mode does not write
+/// may be empty).
 pub(crate) type EvalOut<'a, 'b> = &'b mut [&'a mut [f32]; 4];
 
 #[inline(always)]
@@ -88,45 +104,62 @@ fn store_sampled<L: Lanes>(
 
 /// One vector of samples from the first `L::N` values of each input.
 #[inline(always)]
-fn run_sample<L: Lanes, const VNDF: bool>(l: L, p: &GgxParams, x: [&[f32]; 5]) -> Sampled<L> {
-    kernel::sample::<L, VNDF>(
+fn run_sample<L: Lanes, const NDF: u8, const STRAT: u8>(
+    l: L,
+    p: &CtParams,
+    x: [&[f32]; 6],
+) -> Sampled<L> {
+    kernel::sample::<L, NDF, STRAT>(
         l,
         p,
         [l.load(x[0]), l.load(x[1]), l.load(x[2])],
         l.load(x[3]),
         l.load(x[4]),
+        if p.two_lobes { l.load(x[5]) } else { l.splat(0.5) },
     )
 }
 
 /// One vector of `eval_pdf`, stored at `k`.
 #[inline(always)]
-fn run_eval_pdf<L: Lanes, const VNDF: bool>(
+fn run_eval_pdf<L: Lanes, const NDF: u8, const STRAT: u8, const MODE: u8>(
     l: L,
-    p: &GgxParams,
+    p: &CtParams,
     x: [&[f32]; 6],
     out: &mut [&mut [f32]; 4],
     k: usize,
 ) {
     let wo = [l.load(x[0]), l.load(x[1]), l.load(x[2])];
     let wi = [l.load(x[3]), l.load(x[4]), l.load(x[5])];
-    let (f, pdf) = kernel::eval_pdf::<L, VNDF>(l, p, wo, wi);
-    l.store(f[0], &mut out[0][k..]);
-    l.store(f[1], &mut out[1][k..]);
-    l.store(f[2], &mut out[2][k..]);
-    l.store(pdf, &mut out[3][k..]);
+    let (f, pdf) = kernel::eval_pdf::<L, NDF, STRAT>(l, p, wo, wi);
+    if MODE != PDF_ONLY {
+        l.store(f[0], &mut out[0][k..]);
+        l.store(f[1], &mut out[1][k..]);
+        l.store(f[2], &mut out[2][k..]);
+    }
+    if MODE != F_ONLY {
+        l.store(pdf, &mut out[3][k..]);
+    }
 }
 
 #[inline(always)]
-fn sample_block<L: Lanes, const VNDF: bool>(
+fn sample_block<L: Lanes, const NDF: u8, const STRAT: u8>(
     l: L,
-    p: &GgxParams,
+    p: &CtParams,
     inp: SampleIn<'_>,
     (out, valid): SampleOut<'_, '_>,
 ) {
     let n = inp[0].len();
+    // Equal lengths, stated once: the bounds checks in the loop fold away.
+    for s in &inp {
+        assert_eq!(s.len(), n);
+    }
+    for o in out.iter() {
+        assert_eq!(o.len(), n);
+    }
+    assert_eq!(valid.len(), n);
     let mut k = 0;
     while k + L::N <= n {
-        let s = run_sample::<L, VNDF>(
+        let s = run_sample::<L, NDF, STRAT>(
             l,
             p,
             [
@@ -135,6 +168,7 @@ fn sample_block<L: Lanes, const VNDF: bool>(
                 &inp[2][k..],
                 &inp[3][k..],
                 &inp[4][k..],
+                &inp[5][k..],
             ],
         );
         store_sampled(l, &s, out, valid, k);
@@ -142,18 +176,19 @@ fn sample_block<L: Lanes, const VNDF: bool>(
     }
     if k < n {
         let rem = n - k;
-        // Padding: wo = +z, u = 1/2 (a valid, harmless sample).
+        // Padding: wo = +z, u = uc = 1/2 (a valid, harmless sample).
         let mut ib = [
             [0.0f32; MAX_LANES],
             [0.0; MAX_LANES],
             [1.0; MAX_LANES],
             [0.5; MAX_LANES],
             [0.5; MAX_LANES],
+            [0.5; MAX_LANES],
         ];
         for (b, s) in ib.iter_mut().zip(inp) {
             b[..rem].copy_from_slice(&s[k..]);
         }
-        let s = run_sample::<L, VNDF>(l, p, [&ib[0], &ib[1], &ib[2], &ib[3], &ib[4]]);
+        let s = run_sample::<L, NDF, STRAT>(l, p, [&ib[0], &ib[1], &ib[2], &ib[3], &ib[4], &ib[5]]);
         let mut ob = [[0.0f32; MAX_LANES]; 10];
         let mut vb = [0u8; MAX_LANES];
         {
@@ -168,13 +203,20 @@ fn sample_block<L: Lanes, const VNDF: bool>(
 }
 
 #[inline(always)]
-fn eval_pdf_block<L: Lanes, const VNDF: bool>(
+fn eval_pdf_block<L: Lanes, const NDF: u8, const STRAT: u8, const MODE: u8>(
     l: L,
-    p: &GgxParams,
+    p: &CtParams,
     inp: EvalIn<'_>,
     out: EvalOut<'_, '_>,
 ) {
     let n = inp[0].len();
+    for s in &inp {
+        assert_eq!(s.len(), n);
+    }
+    for (i, o) in out.iter().enumerate() {
+        let written = if i == 3 { MODE != F_ONLY } else { MODE != PDF_ONLY };
+        assert!(!written || o.len() == n);
+    }
     let mut k = 0;
     while k + L::N <= n {
         let x = [
@@ -185,7 +227,7 @@ fn eval_pdf_block<L: Lanes, const VNDF: bool>(
             &inp[4][k..],
             &inp[5][k..],
         ];
-        run_eval_pdf::<L, VNDF>(l, p, x, out, k);
+        run_eval_pdf::<L, NDF, STRAT, MODE>(l, p, x, out, k);
         k += L::N;
     }
     if k < n {
@@ -207,105 +249,99 @@ fn eval_pdf_block<L: Lanes, const VNDF: bool>(
                 &ib[4][..],
                 &ib[5][..],
             ];
-            run_eval_pdf::<L, VNDF>(l, p, x, &mut refs, 0);
+            run_eval_pdf::<L, NDF, STRAT, BOTH>(l, p, x, &mut refs, 0);
         }
-        for (o, b) in out.iter_mut().zip(&ob) {
-            o[k..].copy_from_slice(&b[..rem]);
+        for (i, (o, b)) in out.iter_mut().zip(&ob).enumerate() {
+            let wanted = if i == 3 { MODE != F_ONLY } else { MODE != PDF_ONLY };
+            if wanted {
+                o[k..].copy_from_slice(&b[..rem]);
+            }
         }
     }
 }
 
-/// Both strategies of one level: `vndf` picks the instance once per block.
-#[inline(always)]
-fn sample_level<L: Lanes>(
-    l: L,
-    vndf: bool,
-    p: &GgxParams,
-    inp: SampleIn<'_>,
-    out: SampleOut<'_, '_>,
-) {
-    if vndf {
-        sample_block::<L, true>(l, p, inp, out);
-    } else {
-        sample_block::<L, false>(l, p, inp, out);
-    }
+/// Every kernel instance of one level: the match picks it once per block.
+macro_rules! instances {
+    ($k:expr, $block:ident, $l:ident, $inp:ident, $out:ident, $($extra:tt)*) => {
+        match $k {
+            Kernel::CookTorrance { ndf, strat, p } => match (*ndf, *strat) {
+                (GGX, VNDF) => $block::<L, GGX, VNDF $($extra)*>($l, p, $inp, $out),
+                (GGX, BRDF) => $block::<L, GGX, BRDF $($extra)*>($l, p, $inp, $out),
+                (GGX, UNIFORM) => $block::<L, GGX, UNIFORM $($extra)*>($l, p, $inp, $out),
+                (GGX, COSINE) => $block::<L, GGX, COSINE $($extra)*>($l, p, $inp, $out),
+                (BECKMANN, VNDF) => $block::<L, BECKMANN, VNDF $($extra)*>($l, p, $inp, $out),
+                (BECKMANN, BRDF) => $block::<L, BECKMANN, BRDF $($extra)*>($l, p, $inp, $out),
+                (BECKMANN, UNIFORM) => $block::<L, BECKMANN, UNIFORM $($extra)*>($l, p, $inp, $out),
+                (BECKMANN, COSINE) => $block::<L, BECKMANN, COSINE $($extra)*>($l, p, $inp, $out),
+                _ => unreachable!("BatchSampler::new builds only these"),
+            },
+        }
+    };
 }
 
 #[inline(always)]
-fn eval_pdf_level<L: Lanes>(
-    l: L,
-    vndf: bool,
-    p: &GgxParams,
-    inp: EvalIn<'_>,
-    out: EvalOut<'_, '_>,
-) {
-    if vndf {
-        eval_pdf_block::<L, true>(l, p, inp, out);
-    } else {
-        eval_pdf_block::<L, false>(l, p, inp, out);
+fn sample_level<L: Lanes>(l: L, k: &Kernel, inp: SampleIn<'_>, out: SampleOut<'_, '_>) {
+    instances!(k, sample_block, l, inp, out,)
+}
+
+#[inline(always)]
+fn eval_pdf_level<L: Lanes>(l: L, k: &Kernel, mode: u8, inp: EvalIn<'_>, out: EvalOut<'_, '_>) {
+    match mode {
+        F_ONLY => instances!(k, eval_pdf_block, l, inp, out, , F_ONLY),
+        PDF_ONLY => instances!(k, eval_pdf_block, l, inp, out, , PDF_ONLY),
+        _ => instances!(k, eval_pdf_block, l, inp, out, , BOTH),
     }
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
-fn sample_avx2(l: Avx2, vndf: bool, p: &GgxParams, inp: SampleIn<'_>, out: SampleOut<'_, '_>) {
-    sample_level(l, vndf, p, inp, out);
+fn sample_avx2(l: Avx2, k: &Kernel, inp: SampleIn<'_>, out: SampleOut<'_, '_>) {
+    sample_level(l, k, inp, out);
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,avx512dq,avx512bw,avx512vl,avx2,fma")]
-fn sample_avx512(l: Avx512, vndf: bool, p: &GgxParams, inp: SampleIn<'_>, out: SampleOut<'_, '_>) {
-    sample_level(l, vndf, p, inp, out);
+fn sample_avx512(l: Avx512, k: &Kernel, inp: SampleIn<'_>, out: SampleOut<'_, '_>) {
+    sample_level(l, k, inp, out);
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
-fn eval_pdf_avx2(l: Avx2, vndf: bool, p: &GgxParams, inp: EvalIn<'_>, out: EvalOut<'_, '_>) {
-    eval_pdf_level(l, vndf, p, inp, out);
+fn eval_pdf_avx2(l: Avx2, k: &Kernel, mode: u8, inp: EvalIn<'_>, out: EvalOut<'_, '_>) {
+    eval_pdf_level(l, k, mode, inp, out);
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,avx512dq,avx512bw,avx512vl,avx2,fma")]
-fn eval_pdf_avx512(l: Avx512, vndf: bool, p: &GgxParams, inp: EvalIn<'_>, out: EvalOut<'_, '_>) {
-    eval_pdf_level(l, vndf, p, inp, out);
+fn eval_pdf_avx512(l: Avx512, k: &Kernel, mode: u8, inp: EvalIn<'_>, out: EvalOut<'_, '_>) {
+    eval_pdf_level(l, k, mode, inp, out);
 }
 
 /// Run `sample` over a block (lengths already checked equal).
-pub(crate) fn sample(
-    b: Backend,
-    vndf: bool,
-    p: &GgxParams,
-    inp: SampleIn<'_>,
-    out: SampleOut<'_, '_>,
-) {
+pub(crate) fn sample(b: Backend, k: &Kernel, inp: SampleIn<'_>, out: SampleOut<'_, '_>) {
     match b {
-        Backend::Scalar(l) => sample_level(l, vndf, p, inp, out),
+        Backend::Scalar(l) => sample_level(l, k, inp, out),
         // SAFETY: an `Avx2` token exists only if the CPU has AVX2 and FMA.
         #[cfg(target_arch = "x86_64")]
-        Backend::Avx2(l) => unsafe { sample_avx2(l, vndf, p, inp, out) },
+        Backend::Avx2(l) => unsafe { sample_avx2(l, k, inp, out) },
         // SAFETY: an `Avx512` token exists only if the CPU has AVX-512F/DQ/BW/VL and FMA
         // (AVX2 is implied by AVX-512F).
         #[cfg(target_arch = "x86_64")]
-        Backend::Avx512(l) => unsafe { sample_avx512(l, vndf, p, inp, out) },
+        Backend::Avx512(l) => unsafe { sample_avx512(l, k, inp, out) },
     }
 }
 
-/// Run `eval_pdf` over a block (lengths already checked equal).
-pub(crate) fn eval_pdf(
-    b: Backend,
-    vndf: bool,
-    p: &GgxParams,
-    inp: EvalIn<'_>,
-    out: EvalOut<'_, '_>,
-) {
+/// Run `eval_pdf` over a block (lengths already checked equal), writing
+/// the outputs `mode` names ([`BOTH`], [`F_ONLY`], [`PDF_ONLY`]).
+pub(crate) fn eval_pdf(b: Backend, k: &Kernel, mode: u8, inp: EvalIn<'_>, out: EvalOut<'_, '_>) {
     match b {
-        Backend::Scalar(l) => eval_pdf_level(l, vndf, p, inp, out),
+        Backend::Scalar(l) => eval_pdf_level(l, k, mode, inp, out),
         // SAFETY: an `Avx2` token exists only if the CPU has AVX2 and FMA.
         #[cfg(target_arch = "x86_64")]
-        Backend::Avx2(l) => unsafe { eval_pdf_avx2(l, vndf, p, inp, out) },
+        Backend::Avx2(l) => unsafe { eval_pdf_avx2(l, k, mode, inp, out) },
         // SAFETY: an `Avx512` token exists only if the CPU has AVX-512F/DQ/BW/VL and FMA.
         #[cfg(target_arch = "x86_64")]
-        Backend::Avx512(l) => unsafe { eval_pdf_avx512(l, vndf, p, inp, out) },
+        Backend::Avx512(l) => unsafe { eval_pdf_avx512(l, k, mode, inp, out) },
     }
 }
 
@@ -345,5 +381,70 @@ pub(crate) fn sincos_slice(level: SimdLevel, t: &[f32], s: &mut [f32], c: &mut [
         // SAFETY: the token proves AVX-512F/DQ/BW/VL and FMA.
         #[cfg(target_arch = "x86_64")]
         Backend::Avx512(l) => unsafe { avx512(l, t, s, c) },
+    }
+}
+
+/// A function of [`super::math`], for the accuracy tests.
+#[cfg(test)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum MathFn {
+    Exp,
+    Log,
+    Log1p,
+    /// `(erfc x, e^(−x²))`.
+    ErfcExp,
+    ErfinvU,
+    ErfinvURefined,
+}
+
+/// `f` over slices at `level` (the second output only for `ErfcExp`).
+#[cfg(test)]
+pub(crate) fn math_slice(level: SimdLevel, f: MathFn, x: &[f32], a: &mut [f32], b: &mut [f32]) {
+    #[inline(always)]
+    fn one<L: Lanes>(l: L, f: MathFn, x: L::F) -> (L::F, L::F) {
+        use super::math;
+        let z = l.splat(0.0);
+        match f {
+            MathFn::Exp => (math::exp(l, x), z),
+            MathFn::Log => (math::log(l, x), z),
+            MathFn::Log1p => (math::log1p(l, x), z),
+            MathFn::ErfcExp => math::erfc_exp(l, x),
+            MathFn::ErfinvU => (math::erfinv_u(l, x), z),
+            MathFn::ErfinvURefined => (math::erfinv_u_refined(l, x), z),
+        }
+    }
+    #[inline(always)]
+    fn run<L: Lanes>(l: L, f: MathFn, x: &[f32], a: &mut [f32], b: &mut [f32]) {
+        let mut k = 0;
+        while k + L::N <= x.len() {
+            let (u, v) = one(l, f, l.load(&x[k..]));
+            l.store(u, &mut a[k..]);
+            l.store(v, &mut b[k..]);
+            k += L::N;
+        }
+        for k in k..x.len() {
+            let (u, v) = one(Scalar, f, x[k]);
+            a[k] = u;
+            b[k] = v;
+        }
+    }
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma")]
+    fn avx2(l: Avx2, f: MathFn, x: &[f32], a: &mut [f32], b: &mut [f32]) {
+        run(l, f, x, a, b);
+    }
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx512f,avx512dq,avx512bw,avx512vl,avx2,fma")]
+    fn avx512(l: Avx512, f: MathFn, x: &[f32], a: &mut [f32], b: &mut [f32]) {
+        run(l, f, x, a, b);
+    }
+    match Backend::new(level).expect("level available") {
+        Backend::Scalar(l) => run(l, f, x, a, b),
+        // SAFETY: the token proves AVX2 and FMA.
+        #[cfg(target_arch = "x86_64")]
+        Backend::Avx2(l) => unsafe { avx2(l, f, x, a, b) },
+        // SAFETY: the token proves AVX-512F/DQ/BW/VL and FMA.
+        #[cfg(target_arch = "x86_64")]
+        Backend::Avx512(l) => unsafe { avx512(l, f, x, a, b) },
     }
 }

@@ -1,45 +1,133 @@
-//! The Cook-Torrance GGX kernels (height-correlated Smith, Fresnel none or
-//! Schlick), written once over [`Lanes`] and instantiated per level in
-//! [`super::dispatch`].
+//! The Cook-Torrance kernels, written once over [`Lanes`] and instantiated
+//! per level in [`super::dispatch`]: one instance per distribution (`NDF`:
+//! GGX, Beckmann) and strategy (`STRAT`: vndf, brdf, uniform, cosine),
+//! chosen once per block; the shadowing and Fresnel terms are block
+//! constants read by a branch that every vector takes the same way.
 //!
 //! The algebra is the scalar path's, rearranged for f32. With
 //! `Lo = ‖(αx wo.x, αy wo.y, wo.z)‖`, `Li` the same for `wi`, and `h = wo + wi`
-//! unnormalized:
-//! * `D(h) = 1/(π αx αy) · (|h|² / s)²`, `s = (hx/αx)² + (hy/αy)² + hz²`
-//!   (no normalization of `h`);
-//! * `1 + Λ(wo) = (wo.z + Lo) / (2 wo.z)` and
-//!   `G2 = 1/(1 + Λo + Λi) = 2 wo.z wi.z / (wi.z Lo + wo.z Li)`, sums of
-//!   positive terms with no cancellation, finite up to the horizon;
-//! * `f = ks F D G2 / (4 wo.z wi.z) = ks F D / (2 (wi.z Lo + wo.z Li))`;
-//! * vndf: `pdf = D / (4 wo.z (1 + Λo)) = D / (2 (wo.z + Lo))`,
-//!   `weight = ks F wi.z (wo.z + Lo) / (wi.z Lo + wo.z Li)`;
-//! * brdf: `pdf = D hz / (4 wo·h)`,
-//!   `weight = ks F 2 wi.z (wo·h) / (hz (wi.z Lo + wo.z Li))`.
+//! unnormalized (or the drawn unit normal):
+//! * GGX `D(h) = 1/(π αx αy) · (|h|² / s)²`, `s = (hx/αx)² + (hy/αy)² + hz²`;
+//!   Beckmann `D(h) = 1/(π αx αy) · e^(−t) (|h|²/hz²)²`,
+//!   `t = ((hx/αx)² + (hy/αy)²)/hz²` (both scale-invariant in `h`);
+//! * GGX `1 + Λ(w) = (w.z + L)/(2 w.z)`; Beckmann
+//!   `Λ(w) = (e^(−a²)/(a√π) − erfc a)/2`, `a = w.z/‖(αx w.x, αy w.y)‖`;
+//! * GGX with height-correlated Smith (the fast path):
+//!   `G2 = 2 wo.z wi.z / (wi.z Lo + wo.z Li)`, `f = ks F D / (2 (wi.z Lo + wo.z Li))`,
+//!   vndf `pdf = D / (2 (wo.z + Lo))`; sums of positive terms, finite up to
+//!   the horizon;
+//! * otherwise `f = ks F D G / (4 wo.z wi.z)` with `G = 1/(1 + Λo + Λi)`,
+//!   `1/((1 + Λo)(1 + Λi))` or the V-cavity `min(1, 2 hz wo.z/(wo·h),
+//!   2 hz wi.z/(wi·h))`; vndf `pdf = D / (4 wo.z (1 + Λo))`;
+//! * brdf `pdf = D hz / (4 wo·h)`; uniform `1/(2π)`; cosine `wi.z/π`;
+//!   `weight = f wi.z / pdf`.
 //!
 //! No closures and no `array::map` here: everything must inline into the
 //! `#[target_feature]` entry points for the intrinsics to inline (a closure
 //! is a function of its own, compiled without the level's features).
 //!
 //! `sample` evaluates `f`, `pdf` and `weight` with the microfacet normal it
-//! drew as the half vector (`|h| = 1`, `wo·h = wo·m`), as the scalar path
-//! does; `eval_pdf` with `h = wo + wi`.
+//! drew as the half vector (`|h| = 1`, `wo·h = wi·h = wo·m`), as the scalar
+//! path does; `eval_pdf`, and `sample` for uniform and cosine, with
+//! `h = wo + wi`.
 
 use super::lanes::Lanes;
-use super::math::sincos_turns;
+use super::math::{erfc_abs, erfc_exp, erfinv_u, erfinv_u_refined, exp, log, log1p, sincos_turns};
 
-/// The material, in f32, as the kernels read it.
+/// `NDF`: GGX.
+pub(crate) const GGX: u8 = 0;
+/// `NDF`: Beckmann.
+pub(crate) const BECKMANN: u8 = 1;
+/// `STRAT`: visible normals.
+pub(crate) const VNDF: u8 = 0;
+/// `STRAT`: `D(m) cos θm`.
+pub(crate) const BRDF: u8 = 1;
+/// `STRAT`: uniform hemisphere.
+pub(crate) const UNIFORM: u8 = 2;
+/// `STRAT`: cosine-weighted hemisphere.
+pub(crate) const COSINE: u8 = 3;
+
+const INV_SQRT_PI: f32 = 0.5 * std::f32::consts::FRAC_2_SQRT_PI;
+const TWO_INV_SQRT_PI: f32 = std::f32::consts::FRAC_2_SQRT_PI;
+const INV_PI: f32 = std::f32::consts::FRAC_1_PI;
+const INV_TWO_PI: f32 = 0.159_154_94;
+
+/// The shadowing term, a block constant.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Shadow {
+    Correlated,
+    Separable,
+    VCavity,
+}
+
+/// The Fresnel term times `ks`, per channel, a block constant.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) struct GgxParams {
+pub(crate) enum FresnelP {
+    /// Schlick (`F0 = 1` for no Fresnel): `ks F = ks F0 + ks (1 − F0)(1 − c)⁵`.
+    Schlick { ks_f0: [f32; 3], ks_1mf0: [f32; 3] },
+    /// Exact dielectric with relative index `eta`.
+    Dielectric { ks: [f32; 3], eta: [f32; 3] },
+    /// Exact conductor `eta + i k`.
+    Conductor {
+        ks: [f32; 3],
+        eta: [f32; 3],
+        k: [f32; 3],
+    },
+}
+
+/// A Cook-Torrance lobe in f32, as the kernels read it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct CtParams {
     pub ax: f32,
     pub ay: f32,
     pub inv_ax: f32,
     pub inv_ay: f32,
     /// `1/(π αx αy)`.
     pub inv_pi_axay: f32,
-    /// `ks · F0` per channel (Schlick; `ks` without Fresnel).
-    pub ks_f0: [f32; 3],
-    /// `ks · (1 − F0)` per channel (0 without Fresnel).
-    pub ks_1mf0: [f32; 3],
+    pub fresnel: FresnelP,
+    pub shadow: Shadow,
+    /// Beckmann vndf: the starting points of the slope inversion
+    /// ([`beckmann_guess_table`]); empty otherwise.
+    pub guess: &'static [f32],
+    /// Whether there is a glossy lobe (false: a Lambertian material).
+    pub has_glossy: bool,
+    /// `kd/π` per channel, the Lambertian term (0 for none).
+    pub kd_pi: [f32; 3],
+    /// `luminance(kd)`, the diffuse lobe's weight in the lobe choice.
+    pub kd_lum: f32,
+    /// Whether `uc` chooses between the glossy and the diffuse lobe (both
+    /// present, strategy vndf or brdf).
+    pub two_lobes: bool,
+}
+
+/// Cells of the guess table along `cos θ` and along the normal-incidence
+/// slope `g = erf⁻¹(2u1 − 1) ∈ [−G_MAX, G_MAX]`.
+pub(crate) const GUESS_NC: usize = 64;
+pub(crate) const GUESS_NG: usize = 128;
+const G_MAX: f32 = 4.0;
+
+/// The exact (f64, the scalar path's) visible slope `x(cos θ, g)` at the
+/// `(GUESS_NC + 1) × (GUESS_NG + 1)` nodes, row by row in `cos θ`, built
+/// once: bilinear interpolation in it starts the Newton iteration of
+/// [`beckmann_vndf_normal`] within about 1e-3 of the root, so that a vector
+/// needs a few steps instead of the ~9 from `g` alone.
+pub(crate) fn beckmann_guess_table() -> &'static [f32] {
+    static TABLE: std::sync::OnceLock<Vec<f32>> = std::sync::OnceLock::new();
+    TABLE.get_or_init(|| {
+        let mut t = Vec::with_capacity((GUESS_NC + 1) * (GUESS_NG + 1));
+        for i in 0..=GUESS_NC {
+            // Keep off the exact horizon (cot θ = 0).
+            let c = (i as f64 / GUESS_NC as f64).max(1e-4);
+            for j in 0..=GUESS_NG {
+                let g = f64::from(G_MAX) * (2.0 * j as f64 / GUESS_NG as f64 - 1.0);
+                let u = 0.5 * libm::erfc(-g);
+                let (x, _) =
+                    crate::microfacet::beckmann_visible_slope_11(c, glam::DVec2::new(u, 0.5));
+                t.push(x as f32);
+            }
+        }
+        t
+    })
 }
 
 type V3<L> = [<L as Lanes>::F; 3];
@@ -61,10 +149,93 @@ fn select3<L: Lanes>(l: L, m: L::M, v: V3<L>, zero: L::F) -> V3<L> {
 
 /// `‖(αx w.x, αy w.y, w.z)‖`.
 #[inline(always)]
-fn stretched_len<L: Lanes>(l: L, p: &GgxParams, w: V3<L>) -> L::F {
+fn stretched_len<L: Lanes>(l: L, p: &CtParams, w: V3<L>) -> L::F {
     let x = w[0] * l.splat(p.ax);
     let y = w[1] * l.splat(p.ay);
     l.sqrt(l.mul_add(x, x, l.mul_add(y, y, w[2] * w[2])))
+}
+
+/// `1 + Λ(w)` of Beckmann (and the Blinn-Phong NDF's Smith term), `+∞` at
+/// the horizon, 1 at the normal.
+#[inline(always)]
+fn beckmann_lambda1<L: Lanes>(l: L, p: &CtParams, w: V3<L>) -> L::F {
+    let x = w[0] * l.splat(p.ax);
+    let y = w[1] * l.splat(p.ay);
+    let r = l.sqrt(l.mul_add(x, x, y * y));
+    let a = w[2] / r;
+    let inv_a = r / w[2];
+    let (erfc_a, e) = erfc_exp(l, a);
+    let lam = l.splat(0.5) * l.mul_add(e * inv_a, l.splat(INV_SQRT_PI), -erfc_a);
+    l.max(lam, l.splat(0.0)) + l.splat(1.0)
+}
+
+/// `ks F(c)` per channel.
+#[inline(always)]
+fn ks_fresnel<L: Lanes>(l: L, f: &FresnelP, c: L::F) -> V3<L> {
+    let one = l.splat(1.0);
+    match *f {
+        FresnelP::Schlick { ks_f0, ks_1mf0 } => {
+            let m = one - c;
+            let m2 = m * m;
+            let m5 = m2 * m2 * m;
+            [
+                l.mul_add(l.splat(ks_1mf0[0]), m5, l.splat(ks_f0[0])),
+                l.mul_add(l.splat(ks_1mf0[1]), m5, l.splat(ks_f0[1])),
+                l.mul_add(l.splat(ks_1mf0[2]), m5, l.splat(ks_f0[2])),
+            ]
+        }
+        FresnelP::Dielectric { ks, eta } => [
+            l.splat(ks[0]) * fr_dielectric(l, c, eta[0]),
+            l.splat(ks[1]) * fr_dielectric(l, c, eta[1]),
+            l.splat(ks[2]) * fr_dielectric(l, c, eta[2]),
+        ],
+        FresnelP::Conductor { ks, eta, k } => [
+            l.splat(ks[0]) * fr_conductor(l, c, eta[0], k[0]),
+            l.splat(ks[1]) * fr_conductor(l, c, eta[1], k[1]),
+            l.splat(ks[2]) * fr_conductor(l, c, eta[2], k[2]),
+        ],
+    }
+}
+
+/// Unpolarized dielectric reflectance, `c ∈ [0, 1]` (1 under total
+/// internal reflection), as `crate::fresnel::fr_dielectric`.
+#[inline(always)]
+fn fr_dielectric<L: Lanes>(l: L, c: L::F, eta: f32) -> L::F {
+    let one = l.splat(1.0);
+    let e = l.splat(eta);
+    let sin2_t = (one - c * c) * l.splat(1.0 / (eta * eta));
+    let tir = l.gt(sin2_t, l.splat(1.0)) | l.eq(sin2_t, one);
+    let ct = l.sqrt(l.max(one - sin2_t, l.splat(0.0)));
+    let ec = e * c;
+    let r_parl = (ec - ct) / (ec + ct);
+    let ect = e * ct;
+    let r_perp = (c - ect) / (c + ect);
+    let r = l.splat(0.5) * l.mul_add(r_parl, r_parl, r_perp * r_perp);
+    l.select(tir, one, r)
+}
+
+/// Unpolarized conductor reflectance for the index `eta + i k`, `c ∈ [0,
+/// 1]`, clamped to `[0, 1]` (1 where not finite), as
+/// `crate::fresnel::fr_conductor`; in the closed real form: with
+/// `s² = 1 − c²`, `t = η² − k² − s²`, `A = √(t² + 4η²k²)`, `a = √((A + t)/2)`,
+/// `Rs = (A + c² − 2ac)/(A + c² + 2ac)`,
+/// `Rp = Rs (A c² + s⁴ − 2 a c s²)/(A c² + s⁴ + 2 a c s²)`, `R = (Rs + Rp)/2`.
+#[inline(always)]
+fn fr_conductor<L: Lanes>(l: L, c: L::F, eta: f32, k: f32) -> L::F {
+    let one = l.splat(1.0);
+    let c2 = c * c;
+    let s2 = one - c2;
+    let t = l.splat(eta * eta - k * k) - s2;
+    let a2 = l.sqrt(l.mul_add(t, t, l.splat(4.0 * eta * eta * k * k)));
+    let a = l.sqrt(l.max(l.splat(0.5) * (a2 + t), l.splat(0.0)));
+    let two_ac = l.splat(2.0) * a * c;
+    let rs = (a2 + c2 - two_ac) / (a2 + c2 + two_ac);
+    let u = l.mul_add(a2, c2, s2 * s2);
+    let v = two_ac * s2;
+    let rp = rs * (u - v) / (u + v);
+    let r = l.splat(0.5) * (rs + rp);
+    let r = l.min(l.max(r, l.splat(0.0)), one);
+    l.select(l.is_finite(r), r, one)
 }
 
 /// `f`, `pdf` and `weight` at `(wo, wi)`, and where they are meaningful
@@ -78,31 +249,107 @@ pub(crate) struct Eval<L: Lanes> {
 
 /// [`eval_at`] with the half vector `h = wo + wi` (not normalized).
 #[inline(always)]
-pub(crate) fn eval<L: Lanes, const VNDF: bool>(
+pub(crate) fn eval<L: Lanes, const NDF: u8, const STRAT: u8>(
     l: L,
-    p: &GgxParams,
+    p: &CtParams,
     wo: V3<L>,
     wi: V3<L>,
 ) -> Eval<L> {
     let h = [wo[0] + wi[0], wo[1] + wi[1], wo[2] + wi[2]];
     let hh = dot(l, h, h);
     let oh = dot(l, wo, h);
-    eval_at::<L, VNDF>(l, p, wo, wi, h, hh, oh)
+    let ih = if p.shadow == Shadow::VCavity {
+        dot(l, wi, h)
+    } else {
+        oh
+    };
+    eval_h::<L, NDF, STRAT>(l, p, wo, wi, h, hh, oh, ih)
 }
 
-/// `f`, `pdf`, `weight` given a half vector `h` of any length (`hh = |h|²`,
-/// `oh = wo·h`). The sampler passes the unit normal it drew: where `wi` is
-/// nearly `−wo` (grazing retro-reflection) `wo + wi` in f32 is mostly the
-/// rounding of `wi`, and the drawn normal is the accurate half vector.
+/// [`eval`] given the half vector (as [`eval_at`]), with the diffuse term
+/// and the lobe-choice mixture where the material has them.
 #[inline(always)]
-fn eval_at<L: Lanes, const VNDF: bool>(
+#[allow(clippy::too_many_arguments)]
+fn eval_h<L: Lanes, const NDF: u8, const STRAT: u8>(
     l: L,
-    p: &GgxParams,
+    p: &CtParams,
     wo: V3<L>,
     wi: V3<L>,
     h: V3<L>,
     hh: L::F,
     oh: L::F,
+    ih: L::F,
+) -> Eval<L> {
+    if p.has_glossy && p.kd_lum == 0.0 && p.kd_pi == [0.0; 3] {
+        return eval_at::<L, NDF, STRAT>(l, p, wo, wi, h, hh, oh, ih);
+    }
+    // A diffuse term: f = glossy + kd/π; for vndf and brdf the pdf is the
+    // mixture P p_g + (1 − P) cos θi/π of the lobe choice, as
+    // `Material::pdf` has it.
+    let zero = l.splat(0.0);
+    let above = l.gt(wo[2], zero) & l.gt(wi[2], zero);
+    let (fg, pg) = if p.has_glossy {
+        let e = eval_at::<L, NDF, STRAT>(l, p, wo, wi, h, hh, oh, ih);
+        (select3(l, e.ok, e.f, zero), l.select(e.ok, e.pdf, zero))
+    } else {
+        ([zero; 3], zero)
+    };
+    let pd = wi[2] * l.splat(INV_PI);
+    let pdf = match STRAT {
+        UNIFORM => l.splat(INV_TWO_PI),
+        COSINE => pd,
+        _ if !p.has_glossy => pd,
+        _ => {
+            let pr = glossy_probability(l, p, wo);
+            l.mul_add(pr, pg - pd, pd)
+        }
+    };
+    let f = [
+        fg[0] + l.select(above, l.splat(p.kd_pi[0]), zero),
+        fg[1] + l.select(above, l.splat(p.kd_pi[1]), zero),
+        fg[2] + l.select(above, l.splat(p.kd_pi[2]), zero),
+    ];
+    let ws = wi[2] / pdf;
+    Eval {
+        ok: above,
+        f,
+        pdf,
+        weight: [f[0] * ws, f[1] * ws, f[2] * ws],
+    }
+}
+
+/// The probability of choosing the glossy lobe, as
+/// `Material::glossy_probability`: `g/(g + d)`, `g = luminance(ks F(cos θo))`,
+/// `d = luminance(kd)`; 1/2 where both are 0.
+#[inline(always)]
+fn glossy_probability<L: Lanes>(l: L, p: &CtParams, wo: V3<L>) -> L::F {
+    let c = l.min(l.max(wo[2], l.splat(0.0)), l.splat(1.0));
+    let ksf = ks_fresnel(l, &p.fresnel, c);
+    let g = l.mul_add(
+        l.splat(0.2126),
+        ksf[0],
+        l.mul_add(l.splat(0.7152), ksf[1], l.splat(0.0722) * ksf[2]),
+    );
+    let s = g + l.splat(p.kd_lum);
+    l.select(l.gt(s, l.splat(0.0)), g / s, l.splat(0.5))
+}
+
+/// `f`, `pdf`, `weight` given a half vector `h` of any length (`hh = |h|²`,
+/// `oh = wo·h`, `ih = wi·h`, read by the V-cavity term only). The sampler
+/// passes the unit normal it drew: where `wi` is nearly `−wo` (grazing
+/// retro-reflection) `wo + wi` in f32 is mostly the rounding of `wi`, and
+/// the drawn normal is the accurate half vector.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn eval_at<L: Lanes, const NDF: u8, const STRAT: u8>(
+    l: L,
+    p: &CtParams,
+    wo: V3<L>,
+    wi: V3<L>,
+    h: V3<L>,
+    hh: L::F,
+    oh: L::F,
+    ih: L::F,
 ) -> Eval<L> {
     let zero = l.splat(0.0);
     let one = l.splat(1.0);
@@ -111,35 +358,80 @@ fn eval_at<L: Lanes, const VNDF: bool>(
     // D, scale-invariant in h.
     let sx = h[0] * l.splat(p.inv_ax);
     let sy = h[1] * l.splat(p.inv_ay);
-    let s = l.mul_add(sx, sx, l.mul_add(sy, sy, h[2] * h[2]));
-    let q = hh / s;
-    let d = l.splat(p.inv_pi_axay) * q * q;
-    // Height-correlated Smith.
-    let lo = stretched_len(l, p, wo);
-    let li = stretched_len(l, p, wi);
-    let rden = one / l.mul_add(wi[2], lo, wo[2] * li);
-    let dg = l.splat(0.5) * d * rden;
-    // Schlick (F0 = 1 for no Fresnel): ks F = ks F0 + ks (1 − F0) (1 − c)⁵.
-    let m = one - cos_oh;
-    let m2 = m * m;
-    let m5 = m2 * m2 * m;
-    let ksf = [
-        l.mul_add(l.splat(p.ks_1mf0[0]), m5, l.splat(p.ks_f0[0])),
-        l.mul_add(l.splat(p.ks_1mf0[1]), m5, l.splat(p.ks_f0[1])),
-        l.mul_add(l.splat(p.ks_1mf0[2]), m5, l.splat(p.ks_f0[2])),
-    ];
-    let (pdf, wscale) = if VNDF {
-        let pdf = l.splat(0.5) * d / (wo[2] + lo);
-        (pdf, wi[2] * (wo[2] + lo) * rden)
+    let sxy = l.mul_add(sx, sx, sy * sy);
+    let hz2 = h[2] * h[2];
+    let d = if NDF == GGX {
+        let q = hh / (sxy + hz2);
+        l.splat(p.inv_pi_axay) * q * q
     } else {
-        let pdf = l.splat(0.25) * d * h[2] / oh;
-        (pdf, l.splat(2.0) * wi[2] * oh * rden / h[2])
+        let inv_z2 = one / hz2;
+        let q = hh * inv_z2;
+        l.splat(p.inv_pi_axay) * exp(l, -(sxy * inv_z2)) * (q * q)
     };
+    let ksf = ks_fresnel(l, &p.fresnel, cos_oh);
+    if NDF == GGX && p.shadow == Shadow::Correlated && (STRAT == VNDF || STRAT == BRDF) {
+        // The fast path: height-correlated Smith without cancellation.
+        let lo = stretched_len(l, p, wo);
+        let li = stretched_len(l, p, wi);
+        let rden = one / l.mul_add(wi[2], lo, wo[2] * li);
+        let dg = l.splat(0.5) * d * rden;
+        let (pdf, wscale) = if STRAT == VNDF {
+            let pdf = l.splat(0.5) * d / (wo[2] + lo);
+            (pdf, wi[2] * (wo[2] + lo) * rden)
+        } else {
+            let pdf = l.splat(0.25) * d * h[2] / oh;
+            (pdf, l.splat(2.0) * wi[2] * oh * rden / h[2])
+        };
+        return Eval {
+            ok,
+            f: [ksf[0] * dg, ksf[1] * dg, ksf[2] * dg],
+            pdf,
+            weight: [ksf[0] * wscale, ksf[1] * wscale, ksf[2] * wscale],
+        };
+    }
+    // General: 1 + Λo (also the vndf pdf's), 1 + Λi, G.
+    let (lam1o, lo) = if NDF == GGX {
+        let lo = stretched_len(l, p, wo);
+        (l.splat(0.5) * (wo[2] + lo) / wo[2], lo)
+    } else {
+        (beckmann_lambda1(l, p, wo), zero)
+    };
+    let g = match p.shadow {
+        Shadow::VCavity => {
+            let two_hz = h[2] + h[2];
+            let go = two_hz * wo[2] / oh;
+            let gi = two_hz * wi[2] / ih;
+            l.max(l.min(l.min(one, go), gi), zero)
+        }
+        shadow => {
+            let lam1i = if NDF == GGX {
+                let li = stretched_len(l, p, wi);
+                l.splat(0.5) * (wi[2] + li) / wi[2]
+            } else {
+                beckmann_lambda1(l, p, wi)
+            };
+            if shadow == Shadow::Correlated {
+                one / (lam1o + lam1i - one)
+            } else {
+                one / (lam1o * lam1i)
+            }
+        }
+    };
+    let dg = d * g * (l.splat(0.25) / (wo[2] * wi[2]));
+    let pdf = match STRAT {
+        VNDF if NDF == GGX => l.splat(0.5) * d / (wo[2] + lo),
+        VNDF => l.splat(0.25) * d / (wo[2] * lam1o),
+        BRDF => l.splat(0.25) * d * h[2] / oh,
+        UNIFORM => l.splat(INV_TWO_PI),
+        _ => wi[2] * l.splat(INV_PI),
+    };
+    let f = [ksf[0] * dg, ksf[1] * dg, ksf[2] * dg];
+    let ws = wi[2] / pdf;
     Eval {
         ok,
-        f: [ksf[0] * dg, ksf[1] * dg, ksf[2] * dg],
+        f,
         pdf,
-        weight: [ksf[0] * wscale, ksf[1] * wscale, ksf[2] * wscale],
+        weight: [f[0] * ws, f[1] * ws, f[2] * ws],
     }
 }
 
@@ -152,120 +444,384 @@ pub(crate) struct Sampled<L: Lanes> {
     pub weight: V3<L>,
 }
 
+/// Heitz 2018's visible GGX normal for `wo`, with `(sin, cos)` of `2π u2`.
 #[inline(always)]
-pub(crate) fn sample<L: Lanes, const VNDF: bool>(
+fn ggx_vndf_normal<L: Lanes>(
     l: L,
-    p: &GgxParams,
+    p: &CtParams,
+    wo: V3<L>,
+    u1: L::F,
+    sin: L::F,
+    cos: L::F,
+) -> V3<L> {
+    let zero = l.splat(0.0);
+    let one = l.splat(1.0);
+    let (ax, ay) = (l.splat(p.ax), l.splat(p.ay));
+    // The stretched view direction and a basis around it.
+    let w = [wo[0] * ax, wo[1] * ay, wo[2]];
+    let inv = one / l.sqrt(dot(l, w, w));
+    let wh = [w[0] * inv, w[1] * inv, w[2] * inv];
+    let len2 = l.mul_add(wh[0], wh[0], wh[1] * wh[1]);
+    let has = l.gt(len2, zero);
+    let il = one / l.sqrt(len2);
+    let t1 = [
+        l.select(has, -wh[1] * il, one),
+        l.select(has, wh[0] * il, zero),
+    ];
+    // t2 = wh × (t1x, t1y, 0); its z is √len2 (0 at the pole).
+    let tl = l.sqrt(len2);
+    let t2 = [-wh[2] * t1[1], wh[2] * t1[0], tl];
+    // A point of the unit disk (p1, p2), its lower half squeezed onto
+    // the visible part: p2 ← (1 − h) a + h p2 with a = √(1 − p1²) and
+    // h = (1 + wh.z)/2. Written so that nothing cancels where the f32
+    // result would be all rounding (the rim of the disk, u1 → 1, and
+    // the rim of the visible part, grazing views): with rs = r sin,
+    // (a − rs)(a + rs) = 1 − u1 exactly.
+    let r = l.sqrt(u1);
+    let p1 = r * cos;
+    let one_m_u = one - u1;
+    let a = l.sqrt(l.mul_add(u1, sin * sin, one_m_u));
+    let rs = r * sin;
+    // One of a ± rs is a + |rs|; the other is (1 − u1) over it.
+    let big = a + l.abs(rs);
+    let small = one_m_u / big;
+    let rs_pos = l.gt(rs, zero);
+    let a_minus = l.select(rs_pos, small, big);
+    let a_plus = l.select(rs_pos, big, small);
+    // 1 − h = len2 / (2 (1 + wh.z)).
+    let omh = l.splat(0.5) * len2 / (one + wh[2]);
+    let hv = one - omh;
+    // p2 = (1 − h) a + h rs = h (a + rs) − wh.z a: small terms where
+    // p2 is small at grazing views, where nh.z needs it to full precision.
+    let p2 = l.mul_add(hv, a_plus, -(wh[2] * a));
+    // pz² = a² − p2² = (a − p2)(a + p2) = h (a − rs) (2(1 − h) a + h (a + rs)).
+    let pz = l.sqrt(hv * a_minus * l.mul_add(omh + omh, a, hv * a_plus));
+    // nh.z = p2 tl + pz wh.z; for p2 < 0 through
+    // (pz wh.z)² − (p2 tl)² = (a wh.z − p2) h (a + rs).
+    let nz_pos = l.mul_add(p2, tl, pz * wh[2]);
+    let nz_neg = (l.mul_add(a, wh[2], -p2) * hv * a_plus) / l.mul_add(pz, wh[2], -(p2 * tl));
+    let nh = [
+        l.mul_add(p1, t1[0], l.mul_add(p2, t2[0], pz * wh[0])),
+        l.mul_add(p1, t1[1], l.mul_add(p2, t2[1], pz * wh[1])),
+        l.select(l.lt(p2, zero), nz_neg, nz_pos),
+    ];
+    // Unstretch into the microfacet normal.
+    let n = [
+        ax * nh[0],
+        ay * nh[1],
+        l.max(nh[2], l.splat(f32::MIN_POSITIVE)),
+    ];
+    let inv = one / l.sqrt(dot(l, n, n));
+    [n[0] * inv, n[1] * inv, n[2] * inv]
+}
+
+/// Most Newton steps of the Beckmann slope inversion (each lane stops when
+/// its step falls under 4e-7 relative; measured: at most 9 in the tests).
+const BECKMANN_MAX_STEPS: usize = 24;
+
+#[cfg(test)]
+thread_local! {
+    /// Newton steps and calls (vectors) of the Beckmann inversion on this
+    /// thread, for the tests' report.
+    pub(crate) static STEPS: std::cell::Cell<u64> = const { std::cell::Cell::new(0) };
+    pub(crate) static STEPS_CALLS: std::cell::Cell<u64> = const { std::cell::Cell::new(0) };
+}
+
+/// Heitz and d'Eon 2014's visible Beckmann normal for `wo`, as the scalar
+/// `Microfacet::sample_visible` draws it: the slope along the stretched
+/// view azimuth inverts its CDF `(erfc(−x) + tanθ e^(−x²)/√π) / (erfc(−cotθ)
+/// + tanθ e^(−cot²θ)/√π)` (written with `erfc`, relative to itself in the
+/// lower tail) by Newton's method inside a bisection bracket, each lane
+/// frozen once converged (so a lane's result does not depend on its
+/// neighbours); the other slope is `erf⁻¹(2u2 − 1)`.
+#[inline(always)]
+fn beckmann_vndf_normal<L: Lanes>(l: L, p: &CtParams, wo: V3<L>, u1: L::F, u2: L::F) -> V3<L> {
+    let zero = l.splat(0.0);
+    let one = l.splat(1.0);
+    let (ax, ay) = (l.splat(p.ax), l.splat(p.ay));
+    let w = [wo[0] * ax, wo[1] * ay, wo[2]];
+    let len2 = l.mul_add(w[0], w[0], w[1] * w[1]);
+    let sl = l.sqrt(len2);
+    let inv = one / l.sqrt(len2 + w[2] * w[2]);
+    // sin θ from the tangent part: accurate near the normal.
+    let (sin_t, cos_t) = (sl * inv, w[2] * inv);
+    let has = l.gt(len2, zero);
+    let il = one / sl;
+    let cphi = l.select(has, l.min(w[0] * il, one), one);
+    let sphi = l.select(has, l.max(l.min(w[1] * il, one), -one), zero);
+    let cphi = l.max(cphi, -one);
+    let lo_u = l.splat(1e-12);
+    let hi_u = l.splat(1.0 - f32::EPSILON / 2.0);
+    let u1 = l.min(l.max(u1, lo_u), hi_u);
+    let u2 = l.min(l.max(u2, lo_u), hi_u);
+    // Giles' erf⁻¹ is good to 2.6e-7 where w = −ln(4u(1 − u)) < 16; the
+    // refined one (three logarithms, two Newton steps) only for the vectors
+    // with a lane beyond (u2 within 3e-8 of 0 or 1: in practice u2 = 0).
+    // Lane by lane the same value either way.
+    let sy = {
+        let w = -log(l, l.splat(4.0) * u2 * (one - u2));
+        let plain = erfinv_u(l, u2);
+        let tail = !l.lt(w, l.splat(16.0));
+        if l.any(tail) {
+            l.select(tail, erfinv_u_refined(l, u2), plain)
+        } else {
+            plain
+        }
+    };
+    let tan_t = sin_t / cos_t;
+    let cot_t = cos_t / sin_t;
+    let k = tan_t * l.splat(INV_SQRT_PI);
+    // erfc(cot θ), and the normalization with 1 + erf(cot θ) = 2 − erfc(cot θ).
+    let (erfc_cot, e_top) = erfc_abs(l, cot_t);
+    let norm = one / l.mul_add(k, e_top, l.splat(2.0) - erfc_cot);
+    // Above u1 = 1/2 the residual is written with 1 − CDF (relative to
+    // itself where u1 → 1): 1 − CDF = norm ((erfc x − erfc cot θ) + k (e^(−cot²θ) − e^(−x²))).
+    let upper = l.gt(u1, l.splat(0.5));
+    let one_m_u1 = one - u1;
+    let mut lo = l.splat(-8.0);
+    let mut hi = l.min(cot_t, l.splat(9.0));
+    // The start: bilinear in the table at (cos θ, g = erf⁻¹(2u1 − 1)).
+    let g = erfinv_u(l, u1);
+    let fc = cos_t * l.splat(GUESS_NC as f32);
+    let ic = l.min(l.floor(fc), l.splat(GUESS_NC as f32 - 1.0));
+    let tc = fc - ic;
+    let fg = l.mul_add(
+        l.min(l.max(g, l.splat(-G_MAX)), l.splat(G_MAX)),
+        l.splat(GUESS_NG as f32 / (2.0 * G_MAX)),
+        l.splat(GUESS_NG as f32 / 2.0),
+    );
+    let ig = l.min(l.floor(fg), l.splat(GUESS_NG as f32 - 1.0));
+    let tg = fg - ig;
+    let row = l.splat((GUESS_NG + 1) as f32);
+    let i00 = l.mul_add(ic, row, ig);
+    let t = p.guess;
+    let x00 = l.gather(t, i00);
+    let x01 = l.gather(t, i00 + one);
+    let x10 = l.gather(t, i00 + row);
+    let x11 = l.gather(t, i00 + row + one);
+    let x0 = l.mul_add(tg, x01 - x00, x00);
+    let x1 = l.mul_add(tg, x11 - x10, x10);
+    let table_x = l.mul_add(tc, x1 - x0, x0);
+    // Beyond the table's g (the tails), g itself.
+    let in_table = l.lt(l.abs(g), l.splat(G_MAX));
+    let mut x = l.min(l.max(l.select(in_table, table_x, g), lo), hi);
+    let mut done = l.lt(one, zero);
+    let deriv_k = norm * l.splat(TWO_INV_SQRT_PI);
+    for _ in 0..BECKMANN_MAX_STEPS {
+        let (ez, e) = erfc_abs(l, l.abs(x));
+        let two_m = l.splat(2.0) - ez;
+        let xneg = l.lt(x, zero);
+        let erfc_negx = l.select(xneg, ez, two_m);
+        let erfc_x = l.select(xneg, two_m, ez);
+        let v_lo = l.mul_add(norm, l.mul_add(k, e, erfc_negx), -u1);
+        let v_hi = one_m_u1 - norm * l.mul_add(k, e_top - e, erfc_x - erfc_cot);
+        let value = l.select(upper, v_hi, v_lo);
+        let active = !done;
+        let pos = l.gt(value, zero);
+        hi = l.select(pos & active, x, hi);
+        lo = l.select(!pos & active, x, lo);
+        let deriv = deriv_k * e * l.mul_add(-x, tan_t, one);
+        let next = x - value / deriv;
+        // Inclusive: a converged step lands on the bracket's end it set.
+        let inside = !(l.lt(next, lo) | l.gt(next, hi)) & l.is_finite(next);
+        let xn = l.select(inside, next, l.splat(0.5) * (lo + hi));
+        // Converged when the Newton step is under 1e-4 of max(|x|, 1)
+        // (slopes are of order 1 in units of alpha): Newton's error after a
+        // step s is about s² F''/(2F'), under 1e-7 here (the tests measure
+        // the result against the scalar path's, converged to 1e-14).
+        let small = inside
+            & !l.gt(
+                l.abs(xn - x),
+                l.mul_add(l.max(l.abs(x), one), l.splat(1e-4), l.splat(0.0)),
+            );
+        x = l.select(active, xn, x);
+        done = done | small | l.eq(value, zero);
+        #[cfg(test)]
+        STEPS.with(|s| s.set(s.get() + 1));
+        if !l.any(!done) {
+            break;
+        }
+    }
+    #[cfg(test)]
+    STEPS_CALLS.with(|s| s.set(s.get() + 1));
+    let sx = x;
+    // Rotate back to the view azimuth, then stretch.
+    let mx = l.mul_add(cphi, sx, -(sphi * sy));
+    let my = l.mul_add(sphi, sx, cphi * sy);
+    let n = [-(ax * mx), -(ay * my), one];
+    let inv = one / l.sqrt(dot(l, n, n));
+    [n[0] * inv, n[1] * inv, inv]
+}
+
+#[inline(always)]
+pub(crate) fn sample<L: Lanes, const NDF: u8, const STRAT: u8>(
+    l: L,
+    p: &CtParams,
     wo: V3<L>,
     u1: L::F,
     u2: L::F,
+    uc: L::F,
 ) -> Sampled<L> {
     let zero = l.splat(0.0);
     let one = l.splat(1.0);
     let (ax, ay) = (l.splat(p.ax), l.splat(p.ay));
-    let (sin, cos) = sincos_turns(l, u2);
-    let m = if VNDF {
-        // Heitz 2018: the stretched view direction and a basis around it.
-        let w = [wo[0] * ax, wo[1] * ay, wo[2]];
-        let inv = one / l.sqrt(dot(l, w, w));
-        let wh = [w[0] * inv, w[1] * inv, w[2] * inv];
-        let len2 = l.mul_add(wh[0], wh[0], wh[1] * wh[1]);
-        let has = l.gt(len2, zero);
-        let il = one / l.sqrt(len2);
-        let t1 = [
-            l.select(has, -wh[1] * il, one),
-            l.select(has, wh[0] * il, zero),
+    let e;
+    let wi;
+    let mut valid = l.gt(wo[2], zero);
+    if (STRAT == VNDF || STRAT == BRDF) && !p.has_glossy {
+        // A Lambertian material: its own sampler, cosine-weighted.
+        let wi = cosine_hemisphere(l, u1, u2);
+        let e = eval::<L, NDF, STRAT>(l, p, wo, wi);
+        return finish(l, valid & l.gt(wi[2], zero), wi, e.f, e.pdf, e.weight);
+    }
+    if STRAT == VNDF || STRAT == BRDF {
+        let m = if STRAT == VNDF && NDF == GGX {
+            let (sin, cos) = sincos_turns(l, u2);
+            ggx_vndf_normal(l, p, wo, u1, sin, cos)
+        } else if STRAT == VNDF {
+            beckmann_vndf_normal(l, p, wo, u1, u2)
+        } else {
+            // D(m) cos θm: slope radius² u/(1 − u) (GGX), −ln(1 − u)
+            // (Beckmann), u below 1.
+            let (sin, cos) = sincos_turns(l, u2);
+            let u = l.min(u1, l.splat(1.0 - f32::EPSILON / 2.0));
+            let r2 = if NDF == GGX {
+                u / (one - u)
+            } else {
+                -log1p(l, -u)
+            };
+            let r = l.sqrt(r2);
+            let n = [-(ax * r * cos), -(ay * r * sin), one];
+            let inv = one / l.sqrt(dot(l, n, n));
+            [n[0] * inv, n[1] * inv, inv]
+        };
+        let om = dot(l, wo, m);
+        let two_om = om + om;
+        wi = [
+            l.mul_add(two_om, m[0], -wo[0]),
+            l.mul_add(two_om, m[1], -wo[1]),
+            l.mul_add(two_om, m[2], -wo[2]),
         ];
-        // t2 = wh × (t1x, t1y, 0); its z is √len2 (0 at the pole).
-        let tl = l.sqrt(len2);
-        let t2 = [-wh[2] * t1[1], wh[2] * t1[0], tl];
-        // A point of the unit disk (p1, p2), its lower half squeezed onto
-        // the visible part: p2 ← (1 − h) a + h p2 with a = √(1 − p1²) and
-        // h = (1 + wh.z)/2. Written so that nothing cancels where the f32
-        // result would be all rounding (the rim of the disk, u1 → 1, and
-        // the rim of the visible part, grazing views): with rs = r sin,
-        // (a − rs)(a + rs) = 1 − u1 exactly.
-        let r = l.sqrt(u1);
-        let p1 = r * cos;
-        let one_m_u = one - u1;
-        let a = l.sqrt(l.mul_add(u1, sin * sin, one_m_u));
-        let rs = r * sin;
-        // One of a ± rs is a + |rs|; the other is (1 − u1) over it.
-        let big = a + l.abs(rs);
-        let small = one_m_u / big;
-        let rs_pos = l.gt(rs, zero);
-        let a_minus = l.select(rs_pos, small, big);
-        let a_plus = l.select(rs_pos, big, small);
-        // 1 − h = len2 / (2 (1 + wh.z)).
-        let omh = l.splat(0.5) * len2 / (one + wh[2]);
-        let hv = one - omh;
-        // p2 = (1 − h) a + h rs = h (a + rs) − wh.z a: small terms where
-        // p2 is small at grazing views, where nh.z needs it to full precision.
-        let p2 = l.mul_add(hv, a_plus, -(wh[2] * a));
-        // pz² = a² − p2² = (a − p2)(a + p2) = h (a − rs) (2(1 − h) a + h (a + rs)).
-        let pz = l.sqrt(hv * a_minus * l.mul_add(omh + omh, a, hv * a_plus));
-        // nh.z = p2 tl + pz wh.z; for p2 < 0 through
-        // (pz wh.z)² − (p2 tl)² = (a wh.z − p2) h (a + rs).
-        let nz_pos = l.mul_add(p2, tl, pz * wh[2]);
-        let nz_neg = (l.mul_add(a, wh[2], -p2) * hv * a_plus) / l.mul_add(pz, wh[2], -(p2 * tl));
-        let nh = [
-            l.mul_add(p1, t1[0], l.mul_add(p2, t2[0], pz * wh[0])),
-            l.mul_add(p1, t1[1], l.mul_add(p2, t2[1], pz * wh[1])),
-            l.select(l.lt(p2, zero), nz_neg, nz_pos),
-        ];
-        // Unstretch into the microfacet normal.
-        let n = [
-            ax * nh[0],
-            ay * nh[1],
-            l.max(nh[2], l.splat(f32::MIN_POSITIVE)),
-        ];
-        let inv = one / l.sqrt(dot(l, n, n));
-        [n[0] * inv, n[1] * inv, n[2] * inv]
+        valid = valid & l.gt(om, zero);
+        if p.two_lobes {
+            // uc < P: the glossy lobe's direction, else a cosine-weighted
+            // one; then f and the mixture pdf at it, as `Material::sample`.
+            let wd = cosine_hemisphere(l, u1, u2);
+            let choose = l.lt(uc, glossy_probability(l, p, wo));
+            let wi = [
+                l.select(choose, wi[0], wd[0]),
+                l.select(choose, wi[1], wd[1]),
+                l.select(choose, wi[2], wd[2]),
+            ];
+            let valid = l.select_mask(choose, valid, l.gt(wo[2], zero)) & l.gt(wi[2], zero);
+            // The half vector: the drawn normal where the glossy lobe drew
+            // (accurate where wo + wi is mostly rounding), else wo + wi.
+            let hd = [wo[0] + wi[0], wo[1] + wi[1], wo[2] + wi[2]];
+            let h = [
+                l.select(choose, m[0], hd[0]),
+                l.select(choose, m[1], hd[1]),
+                l.select(choose, m[2], hd[2]),
+            ];
+            let hh = l.select(choose, one, dot(l, hd, hd));
+            let oh = l.select(choose, om, dot(l, wo, hd));
+            let ih = if p.shadow == Shadow::VCavity {
+                l.select(choose, om, dot(l, wi, hd))
+            } else {
+                oh
+            };
+            let e = eval_h::<L, NDF, STRAT>(l, p, wo, wi, h, hh, oh, ih);
+            return finish(l, valid, wi, e.f, e.pdf, e.weight);
+        }
+        e = eval_at::<L, NDF, STRAT>(l, p, wo, wi, m, one, om, om);
+        valid = valid & e.ok;
     } else {
-        // D(m) cos θm: slope radius² = u/(1 − u), u below 1.
-        let u = l.min(u1, l.splat(1.0 - f32::EPSILON / 2.0));
-        let r = l.sqrt(u / (one - u));
-        let n = [-(ax * r * cos), -(ay * r * sin), one];
-        let inv = one / l.sqrt(dot(l, n, n));
-        [n[0] * inv, n[1] * inv, inv]
-    };
-    let om = dot(l, wo, m);
-    let two_om = om + om;
-    let wi = [
-        l.mul_add(two_om, m[0], -wo[0]),
-        l.mul_add(two_om, m[1], -wo[1]),
-        l.mul_add(two_om, m[2], -wo[2]),
-    ];
-    let e = eval_at::<L, VNDF>(l, p, wo, wi, m, one, om);
-    let finite = l.is_finite(e.f[0])
-        & l.is_finite(e.f[1])
-        & l.is_finite(e.f[2])
-        & l.is_finite(e.weight[0])
-        & l.is_finite(e.weight[1])
-        & l.is_finite(e.weight[2])
-        & l.is_finite(e.pdf);
-    let valid = l.gt(om, zero) & e.ok & l.gt(e.pdf, zero) & finite;
+        wi = if STRAT == UNIFORM {
+            let (sin, cos) = sincos_turns(l, u2);
+            let r = l.sqrt(l.max(l.mul_add(-u1, u1, one), zero));
+            [r * cos, r * sin, u1]
+        } else {
+            cosine_hemisphere(l, u1, u2)
+        };
+        e = eval::<L, NDF, STRAT>(l, p, wo, wi);
+        // f is zero where the lobe is (wo·h ≤ 0), not a failed sample.
+        let f = select3(l, e.ok, e.f, zero);
+        let weight = select3(l, e.ok, e.weight, zero);
+        return finish(l, valid & l.gt(wi[2], zero), wi, f, e.pdf, weight);
+    }
+    finish(l, valid, wi, e.f, e.pdf, e.weight)
+}
+
+/// The sample where `valid`, its pdf positive and everything finite; zeros
+/// elsewhere.
+#[inline(always)]
+fn finish<L: Lanes>(
+    l: L,
+    valid: L::M,
+    wi: V3<L>,
+    f: V3<L>,
+    pdf: L::F,
+    weight: V3<L>,
+) -> Sampled<L> {
+    let zero = l.splat(0.0);
+    let finite = l.is_finite(f[0])
+        & l.is_finite(f[1])
+        & l.is_finite(f[2])
+        & l.is_finite(weight[0])
+        & l.is_finite(weight[1])
+        & l.is_finite(weight[2])
+        & l.is_finite(pdf);
+    let valid = valid & l.gt(pdf, zero) & finite;
     Sampled {
         valid,
         wi: select3(l, valid, wi, zero),
-        f: select3(l, valid, e.f, zero),
-        pdf: l.select(valid, e.pdf, zero),
-        weight: select3(l, valid, e.weight, zero),
+        f: select3(l, valid, f, zero),
+        pdf: l.select(valid, pdf, zero),
+        weight: select3(l, valid, weight, zero),
     }
+}
+
+/// Shirley and Chiu's concentric map of `(u1, u2)` onto the unit disk,
+/// lifted to the hemisphere, as `crate::warp::square_to_cosine_hemisphere`.
+#[inline(always)]
+fn cosine_hemisphere<L: Lanes>(l: L, u1: L::F, u2: L::F) -> V3<L> {
+    let zero = l.splat(0.0);
+    let one = l.splat(1.0);
+    let ox = l.mul_add(u1, l.splat(2.0), -one);
+    let oy = l.mul_add(u2, l.splat(2.0), -one);
+    let xbig = l.gt(l.abs(ox), l.abs(oy));
+    // θ = π/4 · oy/ox, or π/2 − π/4 · ox/oy: in turns, /8.
+    let q = l.select(xbig, oy / ox, ox / oy);
+    let t = l.select(xbig, q * l.splat(0.125), l.mul_add(q, l.splat(-0.125), l.splat(0.25)));
+    let r = l.select(xbig, ox, oy);
+    let (s, c) = sincos_turns(l, t);
+    let origin = l.eq(ox, zero) & l.eq(oy, zero);
+    let dx = l.select(origin, zero, r * c);
+    let dy = l.select(origin, zero, r * s);
+    // 1 − |d|² = (1 − |r|)(1 + |r|), exact where the disk's rim makes
+    // 1 − |d|² all rounding.
+    let ar = l.abs(r);
+    let z = l.sqrt(l.max((one - ar) * (one + ar), zero));
+    [dx, dy, z]
 }
 
 /// `(f, pdf)` of `eval_pdf`: each zero where not meaningful or not finite,
 /// as the scalar path does.
 #[inline(always)]
-pub(crate) fn eval_pdf<L: Lanes, const VNDF: bool>(
+pub(crate) fn eval_pdf<L: Lanes, const NDF: u8, const STRAT: u8>(
     l: L,
-    p: &GgxParams,
+    p: &CtParams,
     wo: V3<L>,
     wi: V3<L>,
 ) -> (V3<L>, L::F) {
     let zero = l.splat(0.0);
-    let e = eval::<L, VNDF>(l, p, wo, wi);
+    let e = eval::<L, NDF, STRAT>(l, p, wo, wi);
     let f_ok = e.ok & l.is_finite(e.f[0]) & l.is_finite(e.f[1]) & l.is_finite(e.f[2]);
-    let p_ok = e.ok & l.is_finite(e.pdf);
+    let above = l.gt(wo[2], zero) & l.gt(wi[2], zero);
+    // Uniform and cosine have a pdf wherever both are above the horizon.
+    let p_ok = if STRAT == UNIFORM || STRAT == COSINE {
+        above
+    } else {
+        e.ok
+    } & l.is_finite(e.pdf);
     (select3(l, f_ok, e.f, zero), l.select(p_ok, e.pdf, zero))
 }

@@ -57,6 +57,23 @@ pub(crate) trait Lanes: Copy {
     /// `m ? a : b` lane by lane.
     fn select(self, m: Self::M, a: Self::F, b: Self::F) -> Self::F;
     fn abs(self, a: Self::F) -> Self::F;
+    /// Whether any lane of the mask is set.
+    fn any(self, m: Self::M) -> bool;
+    /// `table[i]` lane by lane for integral `i` in `[0, table.len())`
+    /// (clamped into it, so never out of bounds).
+    fn gather(self, table: &[f32], i: Self::F) -> Self::F;
+    /// `2ⁿ` for integral `n` in `[−126, 127]` (built from the exponent bits;
+    /// other `n` give garbage the callers never use).
+    fn exp2i(self, n: Self::F) -> Self::F;
+    /// `(m, e)` with `x = m · 2ᵉ`, `m ∈ [1, 2)`, `e` integral, for a normal
+    /// positive `x` (read from the bits; exact).
+    fn frexp(self, x: Self::F) -> (Self::F, Self::F);
+
+    /// `m ? a : b` for masks.
+    #[inline(always)]
+    fn select_mask(self, m: Self::M, a: Self::M, b: Self::M) -> Self::M {
+        (m & a) | (!m & b)
+    }
 
     /// Finite (neither infinite nor NaN).
     #[inline(always)]
@@ -137,6 +154,24 @@ impl Lanes for Scalar {
     #[inline(always)]
     fn abs(self, a: f32) -> f32 {
         a.abs()
+    }
+    #[inline(always)]
+    fn any(self, m: bool) -> bool {
+        m
+    }
+    #[inline(always)]
+    fn gather(self, table: &[f32], i: f32) -> f32 {
+        table[(i.max(0.0) as usize).min(table.len() - 1)]
+    }
+    #[inline(always)]
+    fn exp2i(self, n: f32) -> f32 {
+        f32::from_bits(((n as i32).wrapping_add(127) as u32) << 23)
+    }
+    #[inline(always)]
+    fn frexp(self, x: f32) -> (f32, f32) {
+        let b = x.to_bits();
+        let e = ((b >> 23) as i32) - 127;
+        (f32::from_bits((b & 0x007f_ffff) | 0x3f80_0000), e as f32)
     }
 }
 
@@ -298,6 +333,43 @@ mod x86 {
             // SAFETY: the token proves AVX2.
             F8(unsafe { _mm256_andnot_ps(_mm256_set1_ps(-0.0), a.0) })
         }
+        #[inline(always)]
+        fn any(self, m: M8) -> bool {
+            // SAFETY: the token proves AVX2.
+            unsafe { _mm256_movemask_ps(m.0) != 0 }
+        }
+        #[inline(always)]
+        fn gather(self, table: &[f32], i: F8) -> F8 {
+            assert!(!table.is_empty() && table.len() <= i32::MAX as usize);
+            let top = (table.len() - 1) as f32;
+            // SAFETY: the token proves AVX2; the indices are clamped into
+            // [0, len − 1], so every lane reads inside `table`.
+            F8(unsafe {
+                let c = _mm256_min_ps(_mm256_max_ps(i.0, _mm256_setzero_ps()), _mm256_set1_ps(top));
+                _mm256_i32gather_ps::<4>(table.as_ptr(), _mm256_cvttps_epi32(c))
+            })
+        }
+        #[inline(always)]
+        fn exp2i(self, n: F8) -> F8 {
+            // SAFETY: the token proves AVX2.
+            F8(unsafe {
+                let i = _mm256_add_epi32(_mm256_cvtps_epi32(n.0), _mm256_set1_epi32(127));
+                _mm256_castsi256_ps(_mm256_slli_epi32::<23>(i))
+            })
+        }
+        #[inline(always)]
+        fn frexp(self, x: F8) -> (F8, F8) {
+            // SAFETY: the token proves AVX2.
+            unsafe {
+                let b = _mm256_castps_si256(x.0);
+                let e = _mm256_sub_epi32(_mm256_srli_epi32::<23>(b), _mm256_set1_epi32(127));
+                let m = _mm256_or_si256(
+                    _mm256_and_si256(b, _mm256_set1_epi32(0x007f_ffff)),
+                    _mm256_set1_epi32(0x3f80_0000),
+                );
+                (F8(_mm256_castsi256_ps(m)), F8(_mm256_cvtepi32_ps(e)))
+            }
+        }
     }
 
     // ------------------------------------------------------------ AVX-512
@@ -455,6 +527,42 @@ mod x86 {
         fn abs(self, a: F16) -> F16 {
             // SAFETY: the token proves AVX-512F.
             F16(unsafe { _mm512_abs_ps(a.0) })
+        }
+        #[inline(always)]
+        fn any(self, m: M16) -> bool {
+            m.0 != 0
+        }
+        #[inline(always)]
+        fn gather(self, table: &[f32], i: F16) -> F16 {
+            assert!(!table.is_empty() && table.len() <= i32::MAX as usize);
+            let top = (table.len() - 1) as f32;
+            // SAFETY: the token proves AVX-512F; the indices are clamped
+            // into [0, len − 1], so every lane reads inside `table`.
+            F16(unsafe {
+                let c = _mm512_min_ps(_mm512_max_ps(i.0, _mm512_setzero_ps()), _mm512_set1_ps(top));
+                _mm512_i32gather_ps::<4>(_mm512_cvttps_epi32(c), table.as_ptr())
+            })
+        }
+        #[inline(always)]
+        fn exp2i(self, n: F16) -> F16 {
+            // SAFETY: the token proves AVX-512F.
+            F16(unsafe {
+                let i = _mm512_add_epi32(_mm512_cvtps_epi32(n.0), _mm512_set1_epi32(127));
+                _mm512_castsi512_ps(_mm512_slli_epi32::<23>(i))
+            })
+        }
+        #[inline(always)]
+        fn frexp(self, x: F16) -> (F16, F16) {
+            // SAFETY: the token proves AVX-512F.
+            unsafe {
+                let b = _mm512_castps_si512(x.0);
+                let e = _mm512_sub_epi32(_mm512_srli_epi32::<23>(b), _mm512_set1_epi32(127));
+                let m = _mm512_or_si512(
+                    _mm512_and_si512(b, _mm512_set1_epi32(0x007f_ffff)),
+                    _mm512_set1_epi32(0x3f80_0000),
+                );
+                (F16(_mm512_castsi512_ps(m)), F16(_mm512_cvtepi32_ps(e)))
+            }
         }
     }
 }

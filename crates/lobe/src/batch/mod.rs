@@ -28,16 +28,34 @@
 //! # Ok::<(), lobe::Error>(())
 //! ```
 //!
-//! ## What is batched so far
+//! ## What is batched
 //!
-//! This first step of issue 9 covers **Cook-Torrance with GGX** (isotropic
-//! or anisotropic alpha), **height-correlated Smith** shadowing, **Fresnel
-//! `none` or `schlick`**, any `ks`, a **single lobe** (`kd = 0`), and the
-//! strategies **`vndf` and `brdf`**. Anything else (other models, Beckmann
-//! and the Blinn-Phong NDF, other shadowing or Fresnel terms, `kd > 0`,
-//! `uniform`, `cosine`, `spherical-caps`, `bounded-vndf`) makes
-//! [`BatchSampler::new`] return [`BatchError::Unsupported`]: the scalar
-//! path ([`crate::Material`]) still serves them.
+//! * **Cook-Torrance** with **GGX or Beckmann** (isotropic or anisotropic
+//!   alpha), **every shadowing term** (Smith height-correlated, separable,
+//!   V-cavity), **every Fresnel term** (none, Schlick, dielectric,
+//!   conductor), any `ks`, strategies **`vndf`, `brdf`, `uniform`,
+//!   `cosine`**;
+//! * the **two-lobe mixture** `kd > 0`: `uc` chooses the lobe with the
+//!   scalar path's probability (`Material::glossy_probability`), the pdf is
+//!   the mixture, `f` the sum ([`BatchSampler::chooses_lobe`]; `uc = None`
+//!   there is [`BatchError::MissingUc`]);
+//! * the **Lambertian** material (`uniform`, `cosine`, `brdf`).
+//!
+//! Not yet (the scalar path, [`crate::Material`], serves them;
+//! [`BatchSampler::new`] returns [`BatchError::Unsupported`]): the Phong
+//! and Blinn-Phong models, the Blinn-Phong NDF, `spherical-caps` and
+//! `bounded-vndf`. The test `grid_every_supported_combination_builds`
+//! walks every combination the scalar path has and checks that exactly
+//! these are refused.
+//!
+//! Beckmann's visible slopes are drawn as the scalar path draws them (Heitz
+//! and d'Eon 2014: the slope CDF inverted by Newton's method inside a
+//! bisection bracket), in f32 lanes with the CDF written with `erfc` of
+//! each tail, each lane frozen once converged (so that a lane's result does
+//! not depend on its neighbours), started from a bilinear table of exact
+//! slopes built once (65 × 129 values, by the scalar f64 inversion):
+//! measured 1.5 Newton steps per sample, 2.5 per 16-lane vector, on the
+//! tests' inputs.
 //!
 //! ## Outputs and conventions
 //!
@@ -50,17 +68,57 @@
 //! * `valid`: 1 for a sample, 0 for a failed one (the scalar path's `None`);
 //!   every other output of a failed sample is 0.
 //!
-//! `f`, `pdf` and `weight` of a sample use the microfacet normal it drew
-//! as the half vector, as the scalar path does. Measured against the scalar
-//! f64 path on 10⁶ random inputs per strategy (grazing `cos θ = 1e-7`,
-//! alpha 1e-4 to 1, anisotropy to 100; the tests in `batch::tests`): the
-//! same validity mask, `wi` within 2.6e-6 absolute, `f`, `pdf`, `weight`
-//! within 1.3e-5 relative wherever an f32 direction can carry them (where
-//! a 1e-7 change of direction moves them by less than 1e-5); `eval_pdf`
-//! within 2.1e-5 relative on the same f32 inputs. About one sample in
-//! 10⁴ (alpha ≈ 1e-4 at grazing views, where `D` changes by 1e-4 per 1e-8
-//! of direction) differs by more, up to 2e-2, all explained by the 1e-6
-//! difference of the two `wi`.
+//! `f`, `pdf` and `weight` of a single lobe's sample use the microfacet
+//! normal it drew as the half vector, as the scalar path does.
+//! [`BatchSampler::eval`] and [`BatchSampler::pdf`] give the same bits as
+//! the two halves of [`BatchSampler::eval_pdf`].
+//!
+//! ## Accuracy
+//!
+//! Measured against the scalar f64 path (the tests in `batch::tests` and
+//! `batch::tests::grid`; `--nocapture` prints every figure): 10⁶ random
+//! inputs per strategy for GGX with height-correlated Smith (grazing
+//! `cos θ = 1e-7`, alpha 1e-4 to 1, anisotropy to 100) and ~9·10⁴ per
+//! (distribution, strategy) pair over the whole grid (every shadowing ×
+//! Fresnel, iso/aniso, kd = 0 and > 0, and Lambert):
+//! * the same validity mask except within 1e-5 of the horizon;
+//! * `wi` within 2.6e-6 absolute (under 2e-7 for uniform and cosine), except
+//!   Beckmann vndf: within 4.3e-5 where the slope CDF is inverted within
+//!   6e-8 of 1 at grazing views (about 1 sample in 10⁴), and within 1.2e-4
+//!   where `u1 = 0` exactly (both paths clamp it to 1e-12, deep in the
+//!   CDF's tail);
+//! * `f`, `pdf`, `weight` within 1.4e-5 relative (GGX) and 2.2e-5
+//!   (Beckmann, uniform, cosine, mixtures) wherever an f32 direction can
+//!   carry them (where a 1e-7 change of direction moves them by less than
+//!   1e-5). About one sample in 10⁴ (alpha ≈ 1e-4 at grazing views, where
+//!   `D` changes by 1e-4 per 1e-8 of direction) differs by more, up to
+//!   2e-2, all explained by the ~1e-6 difference of the two `wi`. Where `f`
+//!   is evaluated at `h = wo + wi` (uniform, cosine, the diffuse lobe's
+//!   samples) and `wi` mirrors a grazing `wo`, the f32 sum loses bits: at
+//!   most one sample in 10⁴ exceeds 1e-4, by at most 2.2e-4 (measured);
+//! * `eval_pdf`, `eval` and `pdf` within 2.1e-5 relative on the same f32
+//!   inputs (zero where the f64 value is under f32's range, 1e-30);
+//! * chi-square of the batch samples against the batch pdf: passes for
+//!   every pair at two alphas and three views, the mixtures and Lambert;
+//! * the same bits at every level, for any block size and thread split.
+//!
+//! ## Cost per sample
+//!
+//! Counted in the kernel source, for sample + eval + pdf as `lobe bench`
+//! runs them. GGX vndf: `sample` about 95 flops (sincos 16, the disk warp
+//! and basis 45, reflection and `f`/`pdf`/`weight` 34) with 10 square
+//! roots and 10 divisions as written, three of them repeated
+//! subexpressions (`‖stretched wo‖`, `√len2`, `√|m|² = √1`) that inlining
+//! lets the compiler share; `eval_pdf` about 55 flops, 3 square roots, 4
+//! divisions. GGX brdf: `sample` about 70 flops, 6 square roots, 7
+//! divisions. Beckmann adds `exp` (20 flops) to `D`, `erfc` with `exp` (35
+//! flops, 2 divisions) to each Smith `Λ`, and to vndf sampling two `erf⁻¹`
+//! (about 40 flops each, one `log` and one square root) plus about 70
+//! flops and 2 divisions per Newton step (2.5 steps per vector). Under
+//! callgrind
+//! (`LOBE_SIMD=avx2 lobe bench --strategy vndf --samples 262144 --reps
+//! 1`): 480 instructions per vector of 8 GGX vndf samples, 70 per vector
+//! of `eval_pdf`.
 //!
 //! The portable level uses `f32::mul_add` for bit-identical results: on an
 //! x86-64 CPU without FMA that is a library call, and the portable level
@@ -87,8 +145,8 @@ mod tests;
 
 use crate::models::{Bxdf, CookTorrance, Glossy};
 use crate::{BsdfStrategy, Fresnel, Material, Ndf, Rgb, Shadowing};
-use dispatch::Backend;
-use kernel::GgxParams;
+use dispatch::{Backend, Kernel};
+use kernel::{CtParams, FresnelP, Shadow};
 
 /// A dispatch level.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -208,6 +266,9 @@ pub enum BatchError {
     Unsupported { reason: String },
     /// A `LOBE_SIMD` level that is unknown or that this CPU lacks.
     Level { level: String, reason: String },
+    /// `uc` is `None` where the material has two lobes for `uc` to choose
+    /// between.
+    MissingUc,
 }
 
 impl std::fmt::Display for BatchError {
@@ -228,6 +289,10 @@ impl std::fmt::Display for BatchError {
                 )
             }
             BatchError::Level { level, reason } => write!(f, "SIMD level `{level}`: {reason}"),
+            BatchError::MissingUc => write!(
+                f,
+                "slice `uc` is missing: it chooses between the material's glossy and diffuse lobes"
+            ),
         }
     }
 }
@@ -259,8 +324,10 @@ pub struct RgbMut<'a> {
 }
 
 /// The inputs of [`BatchSampler::sample`]: `wo` (unit, local frame) and the
-/// uniforms in `[0, 1)`. `uc` chooses the lobe; single-lobe materials do
-/// not read it (its length is still checked).
+/// uniforms in `[0, 1)`. `uc` chooses the lobe where the material has two
+/// ([`BatchSampler::chooses_lobe`]; `None` there is
+/// [`BatchError::MissingUc`]); single-lobe materials do not read it (its
+/// length is still checked).
 #[derive(Debug, Clone, Copy)]
 pub struct SampleInput<'a> {
     pub wo: Dirs<'a>,
@@ -376,7 +443,7 @@ impl EvalPdfBuffers {
 /// A material and strategy prepared for the batch kernels at one level.
 #[derive(Debug, Clone, Copy)]
 pub struct BatchSampler {
-    params: GgxParams,
+    kernel: Kernel,
     strategy: BsdfStrategy,
     backend: Backend,
 }
@@ -396,14 +463,23 @@ impl BatchSampler {
         strategy: BsdfStrategy,
         level: SimdLevel,
     ) -> Result<Self, BatchError> {
-        let params = ggx_params(material, strategy)?;
+        let kernel = kernel_for(material, strategy)?;
         level.check()?;
         let backend = Backend::new(level).expect("checked");
         Ok(BatchSampler {
-            params,
+            kernel,
             strategy,
             backend,
         })
+    }
+
+    /// Whether `sample` reads `uc` (the material has a glossy and a diffuse
+    /// lobe and the strategy samples them: `Material::chooses_lobe`).
+    #[must_use]
+    pub fn chooses_lobe(&self) -> bool {
+        match self.kernel {
+            Kernel::CookTorrance { p, .. } => p.two_lobes,
+        }
     }
 
     /// The level the kernels run at.
@@ -453,7 +529,15 @@ impl BatchSampler {
         check("weight.g", out.weight.g.len())?;
         check("weight.b", out.weight.b.len())?;
         check("valid", out.valid.len())?;
-        let inp = [input.wo.x, input.wo.y, input.wo.z, input.u1, input.u2];
+        let uc = match input.uc {
+            Some(uc) => uc,
+            None if self.chooses_lobe() => {
+                return Err(BatchError::MissingUc);
+            }
+            // Not read: a single lobe.
+            None => input.u1,
+        };
+        let inp = [input.wo.x, input.wo.y, input.wo.z, input.u1, input.u2, uc];
         let mut o = [
             out.wi.x,
             out.wi.y,
@@ -466,13 +550,7 @@ impl BatchSampler {
             out.weight.g,
             out.weight.b,
         ];
-        dispatch::sample(
-            self.backend,
-            self.strategy == BsdfStrategy::Vndf,
-            &self.params,
-            inp,
-            (&mut o, out.valid),
-        );
+        dispatch::sample(self.backend, &self.kernel, inp, (&mut o, out.valid));
         Ok(())
     }
 
@@ -486,31 +564,43 @@ impl BatchSampler {
         wi: Dirs<'_>,
         out: EvalPdfOutput<'_>,
     ) -> Result<(), BatchError> {
-        let n = wo.x.len();
-        for (slice, found) in [
-            ("wo.y", wo.y.len()),
-            ("wo.z", wo.z.len()),
-            ("wi.x", wi.x.len()),
-            ("wi.y", wi.y.len()),
-            ("wi.z", wi.z.len()),
-            ("f.r", out.f.r.len()),
-            ("f.g", out.f.g.len()),
-            ("f.b", out.f.b.len()),
-            ("pdf", out.pdf.len()),
-        ] {
-            if found != n {
-                return Err(BatchError::Length {
-                    slice,
-                    expected: n,
-                    found,
-                });
-            }
-        }
+        check_pairs(wo, wi, &[("f.r", out.f.r.len()), ("f.g", out.f.g.len()), ("f.b", out.f.b.len()), ("pdf", out.pdf.len())])?;
         let mut o = [out.f.r, out.f.g, out.f.b, out.pdf];
         dispatch::eval_pdf(
             self.backend,
-            self.strategy == BsdfStrategy::Vndf,
-            &self.params,
+            &self.kernel,
+            dispatch::BOTH,
+            [wo.x, wo.y, wo.z, wi.x, wi.y, wi.z],
+            &mut o,
+        );
+        Ok(())
+    }
+
+    /// `f(wo[i], wi[i])` without the cosine, zero below the horizon: the
+    /// `f` of [`BatchSampler::eval_pdf`] (the same bits) without its pdf.
+    pub fn eval(&self, wo: Dirs<'_>, wi: Dirs<'_>, f: RgbMut<'_>) -> Result<(), BatchError> {
+        check_pairs(wo, wi, &[("f.r", f.r.len()), ("f.g", f.g.len()), ("f.b", f.b.len())])?;
+        let mut o: [&mut [f32]; 4] = [f.r, f.g, f.b, &mut []];
+        dispatch::eval_pdf(
+            self.backend,
+            &self.kernel,
+            dispatch::F_ONLY,
+            [wo.x, wo.y, wo.z, wi.x, wi.y, wi.z],
+            &mut o,
+        );
+        Ok(())
+    }
+
+    /// The pdf (solid angle) of this sampler's strategy at `(wo[i], wi[i])`,
+    /// zero below the horizon: the pdf of [`BatchSampler::eval_pdf`] (the
+    /// same bits) without `f`.
+    pub fn pdf(&self, wo: Dirs<'_>, wi: Dirs<'_>, pdf: &mut [f32]) -> Result<(), BatchError> {
+        check_pairs(wo, wi, &[("pdf", pdf.len())])?;
+        let mut o: [&mut [f32]; 4] = [&mut [], &mut [], &mut [], pdf];
+        dispatch::eval_pdf(
+            self.backend,
+            &self.kernel,
+            dispatch::PDF_ONLY,
             [wo.x, wo.y, wo.z, wi.x, wi.y, wi.z],
             &mut o,
         );
@@ -518,62 +608,154 @@ impl BatchSampler {
     }
 }
 
-/// The f32 parameters of a material the GGX kernels cover, or why not.
-fn ggx_params(m: &Material, strategy: BsdfStrategy) -> Result<GgxParams, BatchError> {
+/// Every input slice and each of `outputs` has the length of `wo.x`.
+fn check_pairs(wo: Dirs<'_>, wi: Dirs<'_>, outputs: &[(&'static str, usize)]) -> Result<(), BatchError> {
+    let n = wo.x.len();
+    for &(slice, found) in [
+        ("wo.y", wo.y.len()),
+        ("wo.z", wo.z.len()),
+        ("wi.x", wi.x.len()),
+        ("wi.y", wi.y.len()),
+        ("wi.z", wi.z.len()),
+    ]
+    .iter()
+    .chain(outputs)
+    {
+        if found != n {
+            return Err(BatchError::Length {
+                slice,
+                expected: n,
+                found,
+            });
+        }
+    }
+    Ok(())
+}
+
+/// The kernel and its f32 parameters for a material and strategy, or why
+/// the batch path does not have them.
+fn kernel_for(m: &Material, strategy: BsdfStrategy) -> Result<Kernel, BatchError> {
     let unsupported = |reason: String| Err(BatchError::Unsupported { reason });
     if let Err(e) = m.check(strategy) {
         return unsupported(e.to_string());
     }
-    if !matches!(strategy, BsdfStrategy::Vndf | BsdfStrategy::Brdf) {
-        return unsupported(format!(
-            "strategy `{strategy}` (batched so far: vndf, brdf)"
-        ));
-    }
-    let Glossy::CookTorrance(CookTorrance {
+    let c3 = |c: Rgb| [c.x as f32, c.y as f32, c.z as f32];
+    let kd = m.diffuse.albedo;
+    let kd_pi = c3(kd * crate::math::INV_PI);
+    let kd_lum = crate::math::luminance(kd) as f32;
+    let lobe = match m.glossy {
+        Glossy::CookTorrance(lobe) => lobe,
+        Glossy::None => {
+            // A Lambertian material: cosine-weighted (uniform for uniform).
+            let strat = if strategy == BsdfStrategy::Uniform {
+                kernel::UNIFORM
+            } else {
+                kernel::COSINE
+            };
+            return Ok(Kernel::CookTorrance {
+                ndf: kernel::GGX,
+                strat,
+                p: CtParams {
+                    ax: 1.0,
+                    ay: 1.0,
+                    inv_ax: 1.0,
+                    inv_ay: 1.0,
+                    inv_pi_axay: 0.0,
+                    fresnel: FresnelP::Schlick {
+                        ks_f0: [0.0; 3],
+                        ks_1mf0: [0.0; 3],
+                    },
+                    shadow: Shadow::Correlated,
+                    guess: &[],
+                    has_glossy: false,
+                    kd_pi,
+                    kd_lum,
+                    two_lobes: false,
+                },
+            });
+        }
+        #[allow(unreachable_patterns)]
+        _ => {
+            return unsupported(format!(
+                "model `{}` (batched so far: cook-torrance, lambert)",
+                m.model_name()
+            ));
+        }
+    };
+    let CookTorrance {
         ks,
         microfacet,
         shadowing,
         fresnel,
-    }) = m.glossy
-    else {
-        return unsupported(format!(
-            "model `{}` (batched so far: cook-torrance with ggx)",
-            m.model_name()
-        ));
+    } = lobe;
+    let ndf = match microfacet.ndf() {
+        Ndf::Ggx => kernel::GGX,
+        Ndf::Beckmann => kernel::BECKMANN,
+        other => {
+            return unsupported(format!(
+                "distribution `{}` (batched so far: ggx, beckmann)",
+                other.name()
+            ));
+        }
     };
-    if m.diffuse.albedo != Rgb::ZERO {
-        return unsupported("a diffuse term kd > 0 (batched so far: a single glossy lobe)".into());
-    }
-    if microfacet.ndf() != Ndf::Ggx {
-        return unsupported(format!(
-            "distribution `{}` (batched so far: ggx)",
-            microfacet.ndf().name()
-        ));
-    }
-    if shadowing != Shadowing::SmithCorrelated {
-        return unsupported(format!(
-            "shadowing `{}` (batched so far: smith-correlated)",
-            shadowing.name()
-        ));
-    }
-    let f0 = match fresnel {
-        Fresnel::None => Rgb::ONE,
-        Fresnel::Schlick { f0 } => f0,
-        _ => {
-            return unsupported("this Fresnel term (batched so far: none, schlick)".into());
+    let strat = match strategy {
+        BsdfStrategy::Vndf => kernel::VNDF,
+        BsdfStrategy::Brdf => kernel::BRDF,
+        BsdfStrategy::Uniform => kernel::UNIFORM,
+        BsdfStrategy::Cosine => kernel::COSINE,
+        other => {
+            return unsupported(format!(
+                "strategy `{other}` (batched so far: vndf, brdf, uniform, cosine)"
+            ));
         }
     };
     // Defensive: `check` accepted the strategy, so the lobe supports it.
     debug_assert!(m.glossy.supports(strategy).is_ok());
     let (ax, ay) = microfacet.alpha();
-    let c3 = |c: Rgb| [c.x as f32, c.y as f32, c.z as f32];
-    Ok(GgxParams {
-        ax: ax as f32,
-        ay: ay as f32,
-        inv_ax: (1.0 / ax) as f32,
-        inv_ay: (1.0 / ay) as f32,
-        inv_pi_axay: (crate::math::INV_PI / (ax * ay)) as f32,
-        ks_f0: c3(ks * f0),
-        ks_1mf0: c3(ks * (Rgb::ONE - f0)),
+    let fresnel = match fresnel {
+        Fresnel::None => FresnelP::Schlick {
+            ks_f0: c3(ks),
+            ks_1mf0: [0.0; 3],
+        },
+        Fresnel::Schlick { f0 } => FresnelP::Schlick {
+            ks_f0: c3(ks * f0),
+            ks_1mf0: c3(ks * (Rgb::ONE - f0)),
+        },
+        Fresnel::Dielectric { eta } => FresnelP::Dielectric {
+            ks: c3(ks),
+            eta: c3(eta),
+        },
+        Fresnel::Conductor { eta, k } => FresnelP::Conductor {
+            ks: c3(ks),
+            eta: c3(eta),
+            k: c3(k),
+        },
+    };
+    let shadow = match shadowing {
+        Shadowing::SmithCorrelated => Shadow::Correlated,
+        Shadowing::SmithSeparable => Shadow::Separable,
+        Shadowing::VCavity => Shadow::VCavity,
+    };
+    Ok(Kernel::CookTorrance {
+        ndf,
+        strat,
+        p: CtParams {
+            ax: ax as f32,
+            ay: ay as f32,
+            inv_ax: (1.0 / ax) as f32,
+            inv_ay: (1.0 / ay) as f32,
+            inv_pi_axay: (crate::math::INV_PI / (ax * ay)) as f32,
+            fresnel,
+            shadow,
+            guess: if ndf == kernel::BECKMANN && strat == kernel::VNDF {
+                kernel::beckmann_guess_table()
+            } else {
+                &[]
+            },
+            has_glossy: true,
+            kd_pi,
+            kd_lum,
+            two_lobes: m.chooses_lobe(strategy),
+        },
     })
 }

@@ -37,7 +37,7 @@ fn ggx(ax: f64, ay: f64, fresnel: Fresnel, ks: Rgb) -> Material {
 }
 
 /// The levels to test, and a note of the skipped ones.
-fn levels(test: &str) -> Vec<SimdLevel> {
+pub(super) fn levels(test: &str) -> Vec<SimdLevel> {
     SimdLevel::ALL
         .into_iter()
         .filter(|l| {
@@ -51,13 +51,13 @@ fn levels(test: &str) -> Vec<SimdLevel> {
 }
 
 /// A uniform f32 in [0, 1), 24 random bits.
-fn uniform(rng: &mut impl Rng) -> f32 {
+pub(super) fn uniform(rng: &mut impl Rng) -> f32 {
     (rng.next_u32() >> 8) as f32 * (1.0 / (1u32 << 24) as f32)
 }
 
 /// A view direction: 10% at cos θ = 1e-7, 10% with cos θ log-uniform in
 /// [1e-7, 1e-2], 1% at the normal, the rest uniform over the hemisphere.
-fn random_wo(rng: &mut impl Rng) -> [f32; 3] {
+pub(super) fn random_wo(rng: &mut impl Rng) -> [f32; 3] {
     let k: f64 = rng.random();
     let z: f64 = if k < 0.1 {
         1e-7
@@ -73,7 +73,7 @@ fn random_wo(rng: &mut impl Rng) -> [f32; 3] {
     [(s * phi.cos()) as f32, (s * phi.sin()) as f32, z as f32]
 }
 
-fn d3(v: [f32; 3]) -> DVec3 {
+pub(super) fn d3(v: [f32; 3]) -> DVec3 {
     DVec3::new(v[0].into(), v[1].into(), v[2].into())
 }
 
@@ -120,16 +120,18 @@ fn materials(rng: &mut impl Rng) -> Vec<Material> {
 
 /// Inputs of one material: `n` view directions and uniforms (1% at the
 /// ends 0 and 1 − 2⁻²⁴).
-struct Inputs {
+pub(super) struct Inputs {
     wo: [Vec<f32>; 3],
     u1: Vec<f32>,
     u2: Vec<f32>,
+    uc: Vec<f32>,
 }
 
-fn inputs(rng: &mut impl Rng, n: usize) -> Inputs {
+pub(super) fn inputs(rng: &mut impl Rng, n: usize) -> Inputs {
     let mut wo = [vec![], vec![], vec![]];
-    let (mut u1, mut u2) = (vec![], vec![]);
+    let (mut u1, mut u2, mut uc) = (vec![], vec![], vec![]);
     for _ in 0..n {
+        uc.push(uniform(rng));
         let w = random_wo(rng);
         for c in 0..3 {
             wo[c].push(w[c]);
@@ -145,19 +147,19 @@ fn inputs(rng: &mut impl Rng, n: usize) -> Inputs {
         u1.push(u[0]);
         u2.push(u[1]);
     }
-    Inputs { wo, u1, u2 }
+    Inputs { wo, u1, u2, uc }
 }
 
 impl Inputs {
-    fn input(&self) -> SampleInput<'_> {
+    pub(super) fn input(&self) -> SampleInput<'_> {
         SampleInput {
             wo: self.wo(),
             u1: &self.u1,
             u2: &self.u2,
-            uc: None,
+            uc: Some(&self.uc),
         }
     }
-    fn wo(&self) -> Dirs<'_> {
+    pub(super) fn wo(&self) -> Dirs<'_> {
         Dirs {
             x: &self.wo[0],
             y: &self.wo[1],
@@ -171,13 +173,13 @@ impl Inputs {
 
 /// `|a − b| / (|b| + floor)` with the relative tolerance's floor, 0 when
 /// both are tiny.
-fn rel_err(a: f64, b: f64) -> f64 {
+pub(super) fn rel_err(a: f64, b: f64) -> f64 {
     let d = (a - b).abs();
     if d <= FLOOR { 0.0 } else { d / b.abs() }
 }
 
 #[derive(Default, Debug)]
-struct Worst {
+pub(super) struct Worst {
     mask_exempt: usize,
     mask_bad: Vec<String>,
     wi_abs: f64,
@@ -221,7 +223,7 @@ fn explained_change(m: &Material, s: BsdfStrategy, wo: DVec3, wi: DVec3, delta: 
     worst
 }
 
-fn compare_samples(
+pub(super) fn compare_samples(
     m: &Material,
     s: BsdfStrategy,
     inp: &Inputs,
@@ -245,7 +247,7 @@ fn compare_samples(
         w.count += 1;
         let wo = inp.wo_at(i);
         let u = DVec2::new(inp.u1[i].into(), inp.u2[i].into());
-        let scalar = sp.sample(wo, 0.5, u);
+        let scalar = sp.sample(wo, inp.uc[i].into(), u);
         let valid = out.valid[i] == 1;
         let wi_b = d3([out.wi[0][i], out.wi[1][i], out.wi[2][i]]);
         let near = |z: f64| z < HORIZON;
@@ -465,7 +467,7 @@ fn batch_eval_pdf_matches_scalar() {
     }
 }
 
-fn dirs(v: &[Vec<f32>; 3]) -> Dirs<'_> {
+pub(super) fn dirs(v: &[Vec<f32>; 3]) -> Dirs<'_> {
     Dirs {
         x: &v[0],
         y: &v[1],
@@ -473,7 +475,7 @@ fn dirs(v: &[Vec<f32>; 3]) -> Dirs<'_> {
     }
 }
 
-fn bits(b: &SampleBuffers) -> Vec<u32> {
+pub(super) fn bits(b: &SampleBuffers) -> Vec<u32> {
     let mut v: Vec<u32> = Vec::new();
     for a in b.wi.iter().chain(&b.f).chain([&b.pdf]).chain(&b.weight) {
         v.extend(a.iter().map(|x| x.to_bits()));
@@ -667,37 +669,34 @@ fn batch_errors_name_the_slice_and_the_unsupported() {
             other => panic!("{other:?}"),
         };
     assert!(unsupported(&m, BsdfStrategy::SphericalCaps).contains("spherical-caps"));
-    assert!(unsupported(&m, BsdfStrategy::Cosine).contains("cosine"));
-    let beckmann = {
-        let mf = Microfacet::new(Ndf::Beckmann, 0.2, 0.2).unwrap();
+    let blinn = {
+        let mf = Microfacet::new(Ndf::BlinnPhong, 0.2, 0.2).unwrap();
         let l = CookTorrance::new(Rgb::ONE, mf, Shadowing::SmithCorrelated, Fresnel::None).unwrap();
         Material::with_diffuse(Rgb::ZERO, Glossy::CookTorrance(l)).unwrap()
     };
-    assert!(unsupported(&beckmann, BsdfStrategy::Vndf).contains("beckmann"));
-    let separable = {
-        let mf = Microfacet::new(Ndf::Ggx, 0.2, 0.2).unwrap();
-        let l = CookTorrance::new(Rgb::ONE, mf, Shadowing::SmithSeparable, Fresnel::None).unwrap();
-        Material::with_diffuse(Rgb::ZERO, Glossy::CookTorrance(l)).unwrap()
-    };
-    assert!(unsupported(&separable, BsdfStrategy::Vndf).contains("smith-separable"));
+    assert!(unsupported(&blinn, BsdfStrategy::Brdf).contains("blinn-phong"));
     let two_lobes = Material {
         diffuse: crate::models::Lambert::new(Rgb::splat(0.3)).unwrap(),
         ..m
     };
-    assert!(unsupported(&two_lobes, BsdfStrategy::Vndf).contains("kd"));
-    let conductor = ggx(
-        0.2,
-        0.2,
-        Fresnel::Conductor {
-            eta: Rgb::ONE,
-            k: Rgb::ONE,
-        },
-        Rgb::ONE,
-    );
-    assert!(unsupported(&conductor, BsdfStrategy::Vndf).contains("Fresnel"));
-    assert!(
-        unsupported(&Material::lambert(Rgb::ONE).unwrap(), BsdfStrategy::Brdf).contains("lambert")
-    );
+    let b2 = BatchSampler::with_level(&two_lobes, BsdfStrategy::Vndf, SimdLevel::Scalar).unwrap();
+    assert!(b2.chooses_lobe());
+    let mut o8 = SampleBuffers::new(8);
+    let no_uc = SampleInput {
+        wo: Dirs { x: &v, y: &v, z: &v },
+        u1: &v,
+        u2: &v,
+        uc: None,
+    };
+    let e = b2.sample(no_uc, o8.output()).unwrap_err();
+    assert_eq!(e, BatchError::MissingUc);
+    assert!(e.to_string().contains("`uc`"), "{e}");
+    assert!(b2.sample(SampleInput { uc: Some(&v), ..no_uc }, o8.output()).is_ok());
+    let phong = Material {
+        diffuse: crate::models::Lambert::new(Rgb::ZERO).unwrap(),
+        glossy: Glossy::Phong(crate::models::Phong::new(Rgb::splat(0.5), 10.0, true).unwrap()),
+    };
+    assert!(unsupported(&phong, BsdfStrategy::Brdf).contains("phong"));
 
     // Levels by name.
     assert_eq!("avx2".parse::<SimdLevel>().unwrap(), SimdLevel::Avx2);
@@ -841,3 +840,7 @@ fn batch_chi2() {
     }
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
+
+/// The whole model × strategy × Fresnel × shadowing grid.
+#[path = "tests_grid.rs"]
+mod grid;
