@@ -295,7 +295,11 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     match &args.material {
         None if args.strategy.is_none() => {
             for (text, s) in DEFAULT_TABLE {
-                rows.push((text.to_string(), Material::load(text).context("default table")?, s));
+                rows.push((
+                    text.to_string(),
+                    Material::load(text).context("default table")?,
+                    s,
+                ));
             }
         }
         None => {
@@ -317,7 +321,9 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     }
     let samplers: Vec<BatchSampler> = rows
         .iter()
-        .map(|(text, m, s)| BatchSampler::new(m, *s).with_context(|| format!("--material {text} --strategy {s}")))
+        .map(|(text, m, s)| {
+            BatchSampler::new(m, *s).with_context(|| format!("--material {text} --strategy {s}"))
+        })
         .collect::<Result<_>>()?;
     let level = samplers.first().map(BatchSampler::level);
     let inputs = Inputs::new(args.samples);

@@ -44,7 +44,11 @@ pub fn run(args: &FitArgs) -> Result<()> {
     }
     let lobe = Measured::load(&args.file, None).context("FILE")?;
     let m = lobe::Material::with_diffuse(lobe::Rgb::ZERO, lobe::Glossy::Measured(lobe))?;
-    let ndf = if args.distribution == "beckmann" { Ndf::Beckmann } else { Ndf::Ggx };
+    let ndf = if args.distribution == "beckmann" {
+        Ndf::Beckmann
+    } else {
+        Ndf::Ggx
+    };
     let t0 = std::time::Instant::now();
     let fit = lobe::fit::fit_cook_torrance(&m, ndf)?;
     let seconds = t0.elapsed().as_secs_f64();
@@ -67,7 +71,10 @@ pub fn run(args: &FitArgs) -> Result<()> {
         let fitted = fit.material()?;
         let title = format!(
             "{} against its fit ({}, α {:.3}; E = {:.2e})",
-            args.file.file_name().map_or_else(|| args.file.display().to_string(), |n| n.to_string_lossy().into_owned()),
+            args.file.file_name().map_or_else(
+                || args.file.display().to_string(),
+                |n| n.to_string_lossy().into_owned()
+            ),
             fit.distribution.name(),
             fit.alpha,
             fit.error
@@ -80,7 +87,12 @@ pub fn run(args: &FitArgs) -> Result<()> {
 
 /// Four panels, one per view: the data and the fit, `lum(f cos θi)` over
 /// the signed `θi` of the plane of incidence.
-fn draw(path: &std::path::Path, title: &str, data: &lobe::Material, fit: &lobe::Material) -> Result<()> {
+fn draw(
+    path: &std::path::Path,
+    title: &str,
+    data: &lobe::Material,
+    fit: &lobe::Material,
+) -> Result<()> {
     use plotters::prelude::*;
     crate::figures::register_fonts()?;
     let (w, h) = (1200u32, 900u32);
@@ -95,7 +107,13 @@ fn draw(path: &std::path::Path, title: &str, data: &lobe::Material, fit: &lobe::
         for (panel, theta) in panels.iter().zip([0.0, 30.0, 60.0, 75.0]) {
             let d = lobe::fit::incidence_plane(data, theta, 360);
             let f = lobe::fit::incidence_plane(fit, theta, 360);
-            let ymax = d.iter().chain(&f).map(|p| p.1).fold(0.0f64, f64::max).max(1e-9) * 1.08;
+            let ymax = d
+                .iter()
+                .chain(&f)
+                .map(|p| p.1)
+                .fold(0.0f64, f64::max)
+                .max(1e-9)
+                * 1.08;
             let mut chart = ChartBuilder::on(panel)
                 .caption(format!("θo = {theta}°"), ("sans-serif", 20))
                 .margin(12)
@@ -119,7 +137,9 @@ fn draw(path: &std::path::Path, title: &str, data: &lobe::Material, fit: &lobe::
                 .draw_series(LineSeries::new(f, RGBColor(220, 50, 30).stroke_width(2)))
                 .map_err(|e| anyhow::anyhow!("{e}"))?
                 .label("fit")
-                .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], RGBColor(220, 50, 30).stroke_width(2)));
+                .legend(|(x, y)| {
+                    PathElement::new([(x, y), (x + 20, y)], RGBColor(220, 50, 30).stroke_width(2))
+                });
             chart
                 .configure_series_labels()
                 .border_style(BLACK)

@@ -95,7 +95,11 @@ fn target(m: &Material) -> Target {
                 }
                 let c = wi.z;
                 t.pairs.push((wo, wi));
-                t.log_f.push([(1.0 + f.x * c).ln(), (1.0 + f.y * c).ln(), (1.0 + f.z * c).ln()]);
+                t.log_f.push([
+                    (1.0 + f.x * c).ln(),
+                    (1.0 + f.y * c).ln(),
+                    (1.0 + f.z * c).ln(),
+                ]);
                 t.weight.push(c);
             }
         }
@@ -216,7 +220,10 @@ fn nelder_mead(
 
 /// Fit Cook-Torrance with `distribution` (GGX or Beckmann) and a Lambertian
 /// term to `target` (any material; a measured one in practice).
-pub fn fit_cook_torrance(target_material: &Material, distribution: Ndf) -> crate::error::Result<Fit> {
+pub fn fit_cook_torrance(
+    target_material: &Material,
+    distribution: Ndf,
+) -> crate::error::Result<Fit> {
     if distribution == Ndf::BlinnPhong {
         return Err(crate::Error::UnknownName {
             field: "distribution".into(),
@@ -282,7 +289,11 @@ pub fn incidence_plane(m: &Material, theta_o_deg: f64, steps: usize) -> Vec<(f64
             let a = -90.0 + 180.0 * i as f64 / steps.max(1) as f64;
             let r = a.to_radians();
             let wi = DVec3::new(r.sin(), 0.0, r.cos());
-            let v = if wi.z > 0.0 { crate::math::luminance(m.eval(wo, wi)) * wi.z } else { 0.0 };
+            let v = if wi.z > 0.0 {
+                crate::math::luminance(m.eval(wo, wi)) * wi.z
+            } else {
+                0.0
+            };
             (a, v)
         })
         .collect()

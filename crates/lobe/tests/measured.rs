@@ -26,7 +26,8 @@ fn analytic(json: &str) -> Material {
 
 const GGX: &str = r#"{"type":"cook-torrance","distribution":"ggx","alpha":0.3,"kd":0.2,"fresnel":{"type":"schlick","f0":0.5}}"#;
 const GLOSSY: &str = r#"{"type":"cook-torrance","distribution":"ggx","alpha":0.1,"fresnel":{"type":"schlick","f0":0.8}}"#;
-const BECKMANN: &str = r#"{"type":"cook-torrance","distribution":"beckmann","alpha":0.25,"kd":[0.3,0.2,0.1]}"#;
+const BECKMANN: &str =
+    r#"{"type":"cook-torrance","distribution":"beckmann","alpha":0.25,"kd":[0.3,0.2,0.1]}"#;
 
 /// Every 101st entry is missing.
 fn missing(i: usize) -> bool {
@@ -36,7 +37,9 @@ fn missing(i: usize) -> bool {
 /// A MERL file of `json` (with missing entries), written once per test run.
 fn merl_file(json: &str, name: &str) -> PathBuf {
     static LOCK: std::sync::Mutex<()> = std::sync::Mutex::new(());
-    let _g = LOCK.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+    let _g = LOCK
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner);
     let m = analytic(json);
     let path = dir().join(name);
     if !path.exists() {
@@ -74,7 +77,11 @@ fn beckmann_rgl() -> &'static Material {
         let path = dir().join("beckmann.bsdf");
         let bytes = Rgl::write(|wo, wi| m.eval(wo, wi), 16, 64, "beckmann");
         std::fs::write(&path, bytes).unwrap();
-        Material::load(&format!(r#"{{"type":"measured","path":"{}"}}"#, path.display())).unwrap()
+        Material::load(&format!(
+            r#"{{"type":"measured","path":"{}"}}"#,
+            path.display()
+        ))
+        .unwrap()
     })
 }
 
@@ -128,7 +135,13 @@ fn merl_linear_interpolation_is_within_the_resolution() {
     let m = merl_material(BECKMANN, "beckmann.binary", "linear");
     let a = analytic(BECKMANN);
     let mut worst: f64 = 0.0;
-    for (to, ti, p) in [(10.0, 20.0, 170.0), (30.0, 40.0, 200.0), (45.0, 45.0, 180.0), (60.0, 20.0, 90.0), (5.0, 70.0, 30.0)] {
+    for (to, ti, p) in [
+        (10.0, 20.0, 170.0),
+        (30.0, 40.0, 200.0),
+        (45.0, 45.0, 180.0),
+        (60.0, 20.0, 90.0),
+        (5.0, 70.0, 30.0),
+    ] {
         let (o, i) = (dir_of(to, 0.0), dir_of(ti, p));
         let (g, w) = (luminance(m.eval(o, i)), luminance(a.eval(o, i)));
         worst = worst.max((g - w).abs() / w);
@@ -144,7 +157,13 @@ fn rgl_values_match_the_model_within_the_resolution() {
     // At a tabulated view (θ = k·89°/15) the table is exact at its grid
     // points and bilinear between them.
     let t = 89.0 / 15.0 * 5.0;
-    for (ti, p) in [(20.0, 180.0), (30.0, 150.0), (45.0, 200.0), (10.0, 90.0), (60.0, 180.0)] {
+    for (ti, p) in [
+        (20.0, 180.0),
+        (30.0, 150.0),
+        (45.0, 200.0),
+        (10.0, 90.0),
+        (60.0, 180.0),
+    ] {
         let (o, i) = (dir_of(t, 0.0), dir_of(ti, p));
         let (g, w) = (luminance(m.eval(o, i)), luminance(a.eval(o, i)));
         worst = worst.max((g - w).abs() / w);
@@ -189,9 +208,15 @@ fn chi2_of_the_tabulated_sampler() {
                 |uc, u| m.sample(BsdfStrategy::Brdf, o, uc, u).map(|s| s.wi),
                 |wi| m.pdf(BsdfStrategy::Brdf, o, wi),
             );
-            eprintln!("{name} θo={theta}: χ² = {:.1}, dof {}, p = {:.3}", r.statistic, r.dof, r.p_value);
+            eprintln!(
+                "{name} θo={theta}: χ² = {:.1}, dof {}, p = {:.3}",
+                r.statistic, r.dof, r.p_value
+            );
             if !r.passes(alpha) {
-                failures.push(format!("{name} θo={theta}: p = {:.3e} {:?}", r.p_value, r.message));
+                failures.push(format!(
+                    "{name} θo={theta}: p = {:.3e} {:?}",
+                    r.p_value, r.message
+                ));
             }
             if (r.pdf_integral - (1.0 - r.lost_observed / cfg.samples as f64)).abs() > 2e-3 {
                 failures.push(format!(
@@ -256,7 +281,9 @@ fn estimates_are_unbiased() {
                 let acc = estimate(&m, &sp, light, &Plan::independent(s, 1 << 15, seed)).unwrap();
                 let (mean, se) = (acc.lum.mean(), acc.lum.std_error());
                 if (mean - r).abs() > 4.0 * se + 1e-5 * r {
-                    failures.push(format!("θ={theta} {light:?} {s}: {mean} ± {se}, reference {r}"));
+                    failures.push(format!(
+                        "θ={theta} {light:?} {s}: {mean} ± {se}, reference {r}"
+                    ));
                 }
             }
         }
@@ -277,7 +304,10 @@ fn tabulated_sampling_beats_cosine_on_a_glossy_table() {
             acc.lum.variance()
         };
         let (vb, vc) = (var(BsdfStrategy::Brdf), var(BsdfStrategy::Cosine));
-        eprintln!("θo={theta}: variance brdf {vb:.4e}, cosine {vc:.4e}, ratio {:.1}", vc / vb);
+        eprintln!(
+            "θo={theta}: variance brdf {vb:.4e}, cosine {vc:.4e}, ratio {:.1}",
+            vc / vb
+        );
         assert!(vc >= 4.0 * vb, "θo={theta}: brdf {vb} vs cosine {vc}");
     }
 }
@@ -290,7 +320,14 @@ fn the_table_is_shared_and_only_the_listed_strategies_apply() {
         panic!("not measured")
     };
     assert!(std::ptr::eq(x.data, y.data), "one file, one table");
-    assert_eq!(a.strategies(), vec![BsdfStrategy::Uniform, BsdfStrategy::Cosine, BsdfStrategy::Brdf]);
+    assert_eq!(
+        a.strategies(),
+        vec![
+            BsdfStrategy::Uniform,
+            BsdfStrategy::Cosine,
+            BsdfStrategy::Brdf
+        ]
+    );
     let e = a.sampler(BsdfStrategy::Vndf).unwrap_err().to_string();
     assert!(e.contains("measured table"), "{e}");
     let (table, sampler) = x.memory();
@@ -306,9 +343,17 @@ fn relative_paths_are_relative_to_the_file_that_names_them() {
     let sub = dir().join("sub");
     std::fs::create_dir_all(&sub).unwrap();
     let m = analytic(GGX);
-    std::fs::write(sub.join("t.bsdf"), Rgl::write(|o, i| m.eval(o, i), 4, 8, "t")).unwrap();
+    std::fs::write(
+        sub.join("t.bsdf"),
+        Rgl::write(|o, i| m.eval(o, i), 4, 8, "t"),
+    )
+    .unwrap();
     std::fs::write(sub.join("m.json"), r#"{"type":"measured","path":"t.bsdf"}"#).unwrap();
-    std::fs::write(sub.join("m.toml"), "type = \"measured\"\npath = \"t.bsdf\"\n").unwrap();
+    std::fs::write(
+        sub.join("m.toml"),
+        "type = \"measured\"\npath = \"t.bsdf\"\n",
+    )
+    .unwrap();
     for f in ["m.json", "m.toml"] {
         let mm = Material::load(&format!("@{}", sub.join(f).display())).unwrap();
         assert_eq!(mm.model_name(), "measured");
@@ -324,8 +369,13 @@ fn relative_paths_are_relative_to_the_file_that_names_them() {
     ))
     .unwrap_err()
     .to_string();
-    assert!(e.contains("`interpolation`: applies to MERL tables only"), "{e}");
-    let e = Material::load(r#"{"type":"measured"}"#).unwrap_err().to_string();
+    assert!(
+        e.contains("`interpolation`: applies to MERL tables only"),
+        "{e}"
+    );
+    let e = Material::load(r#"{"type":"measured"}"#)
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("`path`: missing"), "{e}");
     let e = Material::load(r#"{"type":"measured","path":"x","interpolation":"cubic"}"#)
         .unwrap_err()
@@ -360,7 +410,10 @@ fn bad_merl_files_get_clear_errors() {
     let mut dims = good.clone();
     dims[8..12].copy_from_slice(&360i32.to_le_bytes());
     let e = parse_err(&dims);
-    assert!(e.contains("dimensions 90×90×360") && e.contains("expected MERL's 90×90×180"), "{e}");
+    assert!(
+        e.contains("dimensions 90×90×360") && e.contains("expected MERL's 90×90×180"),
+        "{e}"
+    );
     let mut huge = good[..12].to_vec();
     huge[0..4].copy_from_slice(&i32::MAX.to_le_bytes());
     let e = parse_err(&huge);
@@ -374,7 +427,10 @@ fn bad_merl_files_get_clear_errors() {
         let at = 12 + 8 * (2 * merl::N + 5);
         b[at..at + 8].copy_from_slice(&bad.to_le_bytes());
         let e = parse_err(&b);
-        assert!(e.contains("entry 5 of the blue channel") && e.contains(word), "{e}");
+        assert!(
+            e.contains("entry 5 of the blue channel") && e.contains(word),
+            "{e}"
+        );
     }
     let mut none = good[..12].to_vec();
     none.extend(std::iter::repeat_n((-1.0f64).to_le_bytes(), 3 * merl::N).flatten());
@@ -391,7 +447,17 @@ fn small_rgl_bytes() -> Vec<u8> {
 fn edit_rgl(name: &str, f: impl Fn(&mut rgl::Field) -> bool) -> Vec<u8> {
     let fields = rgl::parse_tensor(&small_rgl_bytes()).unwrap();
     let mut list: Vec<(&str, rgl::Field)> = Vec::new();
-    let order = ["description", "jacobian", "theta_i", "phi_i", "ndf", "sigma", "vndf", "luminance", "rgb"];
+    let order = [
+        "description",
+        "jacobian",
+        "theta_i",
+        "phi_i",
+        "ndf",
+        "sigma",
+        "vndf",
+        "luminance",
+        "rgb",
+    ];
     for n in order {
         let mut fld = fields[n].clone();
         if n == name && !f(&mut fld) {
@@ -409,9 +475,15 @@ fn bad_rgl_files_get_clear_errors() {
     let e = parse_err(&good[..15]);
     assert!(e.contains("truncated: 15 bytes"), "{e}");
     let e = parse_err(&good[..40]);
-    assert!(e.contains("truncated: the file ends at byte 40 inside the header of field"), "{e}");
+    assert!(
+        e.contains("truncated: the file ends at byte 40 inside the header of field"),
+        "{e}"
+    );
     let e = parse_err(&good[..good.len() - 4]);
-    assert!(e.contains("field `rgb`") && e.contains("claims bytes"), "{e}");
+    assert!(
+        e.contains("field `rgb`") && e.contains("claims bytes"),
+        "{e}"
+    );
     let e = parse_err(&edit_rgl("vndf", |_| false));
     assert!(e.contains("missing field `vndf`"), "{e}");
     let e = parse_err(&edit_rgl("rgb", |_| false));
@@ -441,7 +513,10 @@ fn bad_rgl_files_get_clear_errors() {
         f.data.truncate(2 * 36 * 4);
         true
     }));
-    assert!(e.contains("field `vndf` has shape [1, 2, 6, 6], expected [1, 3,"), "{e}");
+    assert!(
+        e.contains("field `vndf` has shape [1, 2, 6, 6], expected [1, 3,"),
+        "{e}"
+    );
     let e = parse_err(&edit_rgl("theta_i", |f| {
         f.dtype = rgl::DType::F64;
         f.shape = vec![1];
@@ -455,35 +530,38 @@ fn bad_rgl_files_get_clear_errors() {
     assert!(e.contains("version 2.0"), "{e}");
     // Neither format.
     let e = parse_err(b"hello, this is not a table at all");
-    assert!(e.contains("not an RGL file") && e.contains("not a MERL file"), "{e}");
+    assert!(
+        e.contains("not an RGL file") && e.contains("not a MERL file"),
+        "{e}"
+    );
 }
 
 #[test]
 fn a_measured_material_names_its_file_in_errors() {
     let p = dir().join("garbage.binary");
     std::fs::write(&p, b"0123456789abcdef").unwrap();
-    let e = Material::load(&format!(r#"{{"type":"measured","path":"{}"}}"#, p.display()))
-        .unwrap_err()
-        .to_string();
+    let e = Material::load(&format!(
+        r#"{{"type":"measured","path":"{}"}}"#,
+        p.display()
+    ))
+    .unwrap_err()
+    .to_string();
     assert!(e.contains(&format!("file {}: ", p.display())), "{e}");
     let _ = Measured::load(&p, None).unwrap_err();
 }
-
 
 /// `lobe fit` recovers the parameters of a tabulated analytic material
 /// (GGX; about 5 s): alpha within 5%, kd and f0 within 0.02.
 #[test]
 fn fit_recovers_a_tabulated_material() {
-    for (json, name, ndf, alpha, f0, kd) in [
-        (
-            r#"{"type":"cook-torrance","distribution":"ggx","alpha":0.15,"kd":[0.1,0.2,0.05],"fresnel":{"type":"schlick","f0":[0.9,0.6,0.3]}}"#,
-            "fit-ggx.binary",
-            lobe::Ndf::Ggx,
-            0.15,
-            Rgb::new(0.9, 0.6, 0.3),
-            Rgb::new(0.1, 0.2, 0.05),
-        ),
-    ] {
+    for (json, name, ndf, alpha, f0, kd) in [(
+        r#"{"type":"cook-torrance","distribution":"ggx","alpha":0.15,"kd":[0.1,0.2,0.05],"fresnel":{"type":"schlick","f0":[0.9,0.6,0.3]}}"#,
+        "fit-ggx.binary",
+        lobe::Ndf::Ggx,
+        0.15,
+        Rgb::new(0.9, 0.6, 0.3),
+        Rgb::new(0.1, 0.2, 0.05),
+    )] {
         let m = merl_material(json, name, "nearest");
         let t0 = std::time::Instant::now();
         let fit = lobe::fit::fit_cook_torrance(&m, ndf).unwrap();
@@ -495,9 +573,21 @@ fn fit_recovers_a_tabulated_material() {
             fit.pairs,
             t0.elapsed().as_secs_f64()
         );
-        assert!((fit.alpha - alpha).abs() <= 0.05 * alpha, "{name}: alpha {}", fit.alpha);
-        assert!((fit.f0 - f0).abs().max_element() <= 0.02, "{name}: f0 {}", fit.f0);
-        assert!((fit.kd - kd).abs().max_element() <= 0.02, "{name}: kd {}", fit.kd);
+        assert!(
+            (fit.alpha - alpha).abs() <= 0.05 * alpha,
+            "{name}: alpha {}",
+            fit.alpha
+        );
+        assert!(
+            (fit.f0 - f0).abs().max_element() <= 0.02,
+            "{name}: f0 {}",
+            fit.f0
+        );
+        assert!(
+            (fit.kd - kd).abs().max_element() <= 0.02,
+            "{name}: kd {}",
+            fit.kd
+        );
         // The printed material is accepted by --material.
         assert!(Material::load(&fit.to_json()).is_ok());
     }

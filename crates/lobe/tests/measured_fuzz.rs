@@ -51,7 +51,8 @@ fn mutate(rng: &mut Pcg64, bytes: &mut Vec<u8>) {
         }
         1 => {
             let i = rng.random_range(0..len);
-            let v: u8 = [0x00, 0xff, 0x7f, 0x80, 0x7f80_0000u32.to_le_bytes()[2]][rng.random_range(0..5)];
+            let v: u8 =
+                [0x00, 0xff, 0x7f, 0x80, 0x7f80_0000u32.to_le_bytes()[2]][rng.random_range(0..5)];
             if let Some(b) = bytes.get_mut(i) {
                 *b = v;
             }
@@ -116,8 +117,16 @@ fn mutate(rng: &mut Pcg64, bytes: &mut Vec<u8>) {
         _ => {
             // Random bytes of a random length, behind a valid magic.
             let n = rng.random_range(0..256);
-            let magic: &[u8] = if rng.random::<bool>() { b"tensor_file\0\x01\x00" } else { &[90, 0, 0, 0, 90, 0, 0, 0, 180, 0, 0, 0] };
-            *bytes = magic.iter().copied().chain((0..n).map(|_| rng.random::<u8>())).collect();
+            let magic: &[u8] = if rng.random::<bool>() {
+                b"tensor_file\0\x01\x00"
+            } else {
+                &[90, 0, 0, 0, 90, 0, 0, 0, 180, 0, 0, 0]
+            };
+            *bytes = magic
+                .iter()
+                .copied()
+                .chain((0..n).map(|_| rng.random::<u8>()))
+                .collect();
         }
     }
 }
@@ -222,7 +231,10 @@ fn fuzz_for_a_long_time() {
         .unwrap_or(600);
     let t0 = std::time::Instant::now();
     let deadline = t0 + std::time::Duration::from_secs(secs);
-    let seed: u64 = std::env::var("LOBE_FUZZ_SEED").ok().and_then(|s| s.parse().ok()).unwrap_or(2);
+    let seed: u64 = std::env::var("LOBE_FUZZ_SEED")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(2);
     let (n, accepted, crashers) = fuzz(seed, usize::MAX, Some(deadline));
     eprintln!(
         "fuzzed {n} files in {:.0} s (seed {seed}): {accepted} accepted and evaluated, {} crashers",

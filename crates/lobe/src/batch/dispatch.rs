@@ -115,7 +115,11 @@ fn run_sample<L: Lanes, const NDF: u8, const STRAT: u8>(
         [l.load(x[0]), l.load(x[1]), l.load(x[2])],
         l.load(x[3]),
         l.load(x[4]),
-        if p.two_lobes { l.load(x[5]) } else { l.splat(0.5) },
+        if p.two_lobes {
+            l.load(x[5])
+        } else {
+            l.splat(0.5)
+        },
     )
 }
 
@@ -214,7 +218,11 @@ fn eval_pdf_block<L: Lanes, const NDF: u8, const STRAT: u8, const MODE: u8>(
         assert_eq!(s.len(), n);
     }
     for (i, o) in out.iter().enumerate() {
-        let written = if i == 3 { MODE != F_ONLY } else { MODE != PDF_ONLY };
+        let written = if i == 3 {
+            MODE != F_ONLY
+        } else {
+            MODE != PDF_ONLY
+        };
         assert!(!written || o.len() == n);
     }
     let mut k = 0;
@@ -252,7 +260,11 @@ fn eval_pdf_block<L: Lanes, const NDF: u8, const STRAT: u8, const MODE: u8>(
             run_eval_pdf::<L, NDF, STRAT, BOTH>(l, p, x, &mut refs, 0);
         }
         for (i, (o, b)) in out.iter_mut().zip(&ob).enumerate() {
-            let wanted = if i == 3 { MODE != F_ONLY } else { MODE != PDF_ONLY };
+            let wanted = if i == 3 {
+                MODE != F_ONLY
+            } else {
+                MODE != PDF_ONLY
+            };
             if wanted {
                 o[k..].copy_from_slice(&b[..rem]);
             }

@@ -791,7 +791,11 @@ fn cosine_hemisphere<L: Lanes>(l: L, u1: L::F, u2: L::F) -> V3<L> {
     let xbig = l.gt(l.abs(ox), l.abs(oy));
     // θ = π/4 · oy/ox, or π/2 − π/4 · ox/oy: in turns, /8.
     let q = l.select(xbig, oy / ox, ox / oy);
-    let t = l.select(xbig, q * l.splat(0.125), l.mul_add(q, l.splat(-0.125), l.splat(0.25)));
+    let t = l.select(
+        xbig,
+        q * l.splat(0.125),
+        l.mul_add(q, l.splat(-0.125), l.splat(0.25)),
+    );
     let r = l.select(xbig, ox, oy);
     let (s, c) = sincos_turns(l, t);
     let origin = l.eq(ox, zero) & l.eq(oy, zero);

@@ -257,11 +257,7 @@ pub(crate) fn erfinv_u_refined<L: Lanes>(l: L, u: L::F) -> L::F {
     let m = l.select(lower, u, one - u);
     let w = -log(l, l.splat(4.0) * u * (one - u));
     let t = -log(l, two * m);
-    let z = l.sqrt(l.mul_add(
-        l.splat(-0.5),
-        log(l, l.splat(std::f32::consts::PI) * t),
-        t,
-    ));
+    let z = l.sqrt(l.mul_add(l.splat(-0.5), log(l, l.splat(std::f32::consts::PI) * t), t));
     let tail = l.select(lower, -z, z);
     let mut x = l.select(l.lt(w, l.splat(16.0)), erfinv_u(l, u), tail);
     for _ in 0..2 {
@@ -378,8 +374,8 @@ mod tests {
 
 #[cfg(test)]
 mod accuracy {
-    use super::super::dispatch::{MathFn, math_slice};
     use super::super::SimdLevel;
+    use super::super::dispatch::{MathFn, math_slice};
     use rand::{RngExt, SeedableRng};
 
     /// Runs `f` at every level, checks the same bits, returns the outputs.
@@ -445,7 +441,11 @@ mod accuracy {
         let mut x = uniform(&mut rng, n, -87.3, 88.7);
         x.extend(uniform(&mut rng, n, -1.0, 1.0));
         let (y, _) = run(MathFn::Exp, &x);
-        let e = x.iter().zip(&y).map(|(&x, &y)| rel(y, f64::from(x).exp())).fold(0.0, f64::max);
+        let e = x
+            .iter()
+            .zip(&y)
+            .map(|(&x, &y)| rel(y, f64::from(x).exp()))
+            .fold(0.0, f64::max);
         eprintln!("math_errors exp: max rel {e:.3e}");
         assert!(e < 1e-7, "exp {e}");
         let (y, _) = run(MathFn::Exp, &[-87.4, -100.0, 89.0, f32::NEG_INFINITY]);
@@ -477,7 +477,11 @@ mod accuracy {
             if i % 2 == 0 { v } else { -v }
         }));
         let (y, _) = run(MathFn::Log1p, &x);
-        let e = x.iter().zip(&y).map(|(&x, &y)| rel(y, f64::from(x).ln_1p())).fold(0.0, f64::max);
+        let e = x
+            .iter()
+            .zip(&y)
+            .map(|(&x, &y)| rel(y, f64::from(x).ln_1p()))
+            .fold(0.0, f64::max);
         eprintln!("math_errors log1p: max rel {e:.3e}");
         assert!(e < 2.5e-7, "log1p {e}");
         // erfc and exp(-x²)

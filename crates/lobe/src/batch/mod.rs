@@ -564,7 +564,16 @@ impl BatchSampler {
         wi: Dirs<'_>,
         out: EvalPdfOutput<'_>,
     ) -> Result<(), BatchError> {
-        check_pairs(wo, wi, &[("f.r", out.f.r.len()), ("f.g", out.f.g.len()), ("f.b", out.f.b.len()), ("pdf", out.pdf.len())])?;
+        check_pairs(
+            wo,
+            wi,
+            &[
+                ("f.r", out.f.r.len()),
+                ("f.g", out.f.g.len()),
+                ("f.b", out.f.b.len()),
+                ("pdf", out.pdf.len()),
+            ],
+        )?;
         let mut o = [out.f.r, out.f.g, out.f.b, out.pdf];
         dispatch::eval_pdf(
             self.backend,
@@ -579,7 +588,11 @@ impl BatchSampler {
     /// `f(wo[i], wi[i])` without the cosine, zero below the horizon: the
     /// `f` of [`BatchSampler::eval_pdf`] (the same bits) without its pdf.
     pub fn eval(&self, wo: Dirs<'_>, wi: Dirs<'_>, f: RgbMut<'_>) -> Result<(), BatchError> {
-        check_pairs(wo, wi, &[("f.r", f.r.len()), ("f.g", f.g.len()), ("f.b", f.b.len())])?;
+        check_pairs(
+            wo,
+            wi,
+            &[("f.r", f.r.len()), ("f.g", f.g.len()), ("f.b", f.b.len())],
+        )?;
         let mut o: [&mut [f32]; 4] = [f.r, f.g, f.b, &mut []];
         dispatch::eval_pdf(
             self.backend,
@@ -609,7 +622,11 @@ impl BatchSampler {
 }
 
 /// Every input slice and each of `outputs` has the length of `wo.x`.
-fn check_pairs(wo: Dirs<'_>, wi: Dirs<'_>, outputs: &[(&'static str, usize)]) -> Result<(), BatchError> {
+fn check_pairs(
+    wo: Dirs<'_>,
+    wi: Dirs<'_>,
+    outputs: &[(&'static str, usize)],
+) -> Result<(), BatchError> {
     let n = wo.x.len();
     for &(slice, found) in [
         ("wo.y", wo.y.len()),

@@ -683,7 +683,11 @@ fn batch_errors_name_the_slice_and_the_unsupported() {
     assert!(b2.chooses_lobe());
     let mut o8 = SampleBuffers::new(8);
     let no_uc = SampleInput {
-        wo: Dirs { x: &v, y: &v, z: &v },
+        wo: Dirs {
+            x: &v,
+            y: &v,
+            z: &v,
+        },
         u1: &v,
         u2: &v,
         uc: None,
@@ -691,7 +695,16 @@ fn batch_errors_name_the_slice_and_the_unsupported() {
     let e = b2.sample(no_uc, o8.output()).unwrap_err();
     assert_eq!(e, BatchError::MissingUc);
     assert!(e.to_string().contains("`uc`"), "{e}");
-    assert!(b2.sample(SampleInput { uc: Some(&v), ..no_uc }, o8.output()).is_ok());
+    assert!(
+        b2.sample(
+            SampleInput {
+                uc: Some(&v),
+                ..no_uc
+            },
+            o8.output()
+        )
+        .is_ok()
+    );
     let phong = Material {
         diffuse: crate::models::Lambert::new(Rgb::ZERO).unwrap(),
         glossy: Glossy::Phong(crate::models::Phong::new(Rgb::splat(0.5), 10.0, true).unwrap()),

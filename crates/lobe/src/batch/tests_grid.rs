@@ -65,7 +65,14 @@ fn grid_materials(rng: &mut impl Rng, ndf: Ndf, random: usize) -> Vec<Material> 
     // Two lobes: a diffuse term beside the glossy one.
     for (i, sh) in shadowings().into_iter().enumerate() {
         let fr = fresnels()[i + 1];
-        let mut m = ct(ndf, 0.2, 0.05 + 0.3 * i as f64, sh, fr, Rgb::new(0.8, 0.9, 1.0));
+        let mut m = ct(
+            ndf,
+            0.2,
+            0.05 + 0.3 * i as f64,
+            sh,
+            fr,
+            Rgb::new(0.8, 0.9, 1.0),
+        );
         m.diffuse = crate::models::Lambert::new(Rgb::new(0.5, 0.3, 0.1)).unwrap();
         v.push(m);
     }
@@ -97,7 +104,11 @@ fn groups(rng: &mut impl Rng, random: usize) -> Vec<(String, Vec<Material>, Bsdf
         Material::lambert(Rgb::new(0.9, 0.5, 0.1)).unwrap(),
         Material::lambert(Rgb::ONE).unwrap(),
     ];
-    for s in [BsdfStrategy::Uniform, BsdfStrategy::Cosine, BsdfStrategy::Brdf] {
+    for s in [
+        BsdfStrategy::Uniform,
+        BsdfStrategy::Cosine,
+        BsdfStrategy::Brdf,
+    ] {
         v.push(("lambert".to_string(), lambert.clone(), s));
     }
     v
@@ -138,7 +149,10 @@ fn grid_sample_matches_scalar() {
             }
             match &reference {
                 None => reference = Some(all_bits),
-                Some(r) => assert!(*r == all_bits, "{name} {s}: {level} differs from the first level"),
+                Some(r) => assert!(
+                    *r == all_bits,
+                    "{name} {s}: {level} differs from the first level"
+                ),
             }
             let line = format!(
                 "{} {s} {level}: {} samples, {} valid; mask differs near the horizon: {}; max |Δwi| {:.2e}; \
@@ -181,17 +195,26 @@ fn grid_sample_matches_scalar() {
             // by more than 1e-3 relative.
             let not_finite = w.bad.iter().any(|b| b.contains("output"));
             if !w.bad.is_empty() {
-                eprintln!("  {} beyond 1e-4 + 2 × explained; first: {}", w.bad.len(), w.bad[0]);
+                eprintln!(
+                    "  {} beyond 1e-4 + 2 × explained; first: {}",
+                    w.bad.len(),
+                    w.bad[0]
+                );
             }
             let bad_ok = !not_finite
                 && w.bad.len() * 10_000 <= w.count
                 && w.bad.iter().all(|b| {
-                    b.rsplit("rel ").next().and_then(|r| r.split(',').next()).and_then(|r| r.parse::<f64>().ok()).is_some_and(|r| r < 1e-3)
+                    b.rsplit("rel ")
+                        .next()
+                        .and_then(|r| r.split(',').next())
+                        .and_then(|r| r.parse::<f64>().ok())
+                        .is_some_and(|r| r < 1e-3)
                 });
             let ok = bad_ok
                 && w.mask_bad.is_empty()
                 && wi_ok
-                && w.f_rel.max(w.pdf_rel).max(w.weight_rel) < if w.bad.is_empty() { REL } else { 1e-3 };
+                && w.f_rel.max(w.pdf_rel).max(w.weight_rel)
+                    < if w.bad.is_empty() { REL } else { 1e-3 };
             if !ok {
                 summary.push(format!(
                     "{line}\n bad: {}\n mask: {} {}\n wi: {} {}",
@@ -226,7 +249,11 @@ fn grid_eval_pdf_matches_scalar() {
                     let o = random_wo(&mut rng);
                     let i = match j % 4 {
                         0 | 1 => random_wo(&mut rng),
-                        2 => match sp.sample(d3(o), rng.random(), DVec2::new(rng.random(), rng.random())) {
+                        2 => match sp.sample(
+                            d3(o),
+                            rng.random(),
+                            DVec2::new(rng.random(), rng.random()),
+                        ) {
                             Some(x) => [x.wi.x as f32, x.wi.y as f32, x.wi.z as f32],
                             None => random_wo(&mut rng),
                         },
@@ -243,11 +270,15 @@ fn grid_eval_pdf_matches_scalar() {
                 let mut f_only = EvalPdfBuffers::new(n);
                 {
                     let [r, g, bb] = &mut f_only.f;
-                    b.eval(dirs(&wo), dirs(&wi), RgbMut { r, g, b: bb }).unwrap();
+                    b.eval(dirs(&wo), dirs(&wi), RgbMut { r, g, b: bb })
+                        .unwrap();
                 }
                 let mut p_only = vec![0.0f32; n];
                 b.pdf(dirs(&wo), dirs(&wi), &mut p_only).unwrap();
-                assert!(f_only.f == out.f && p_only == out.pdf, "eval/pdf differ from eval_pdf");
+                assert!(
+                    f_only.f == out.f && p_only == out.pdf,
+                    "eval/pdf differ from eval_pdf"
+                );
                 for j in 0..n {
                     let o = d3([wo[0][j], wo[1][j], wo[2][j]]);
                     let i = d3([wi[0][j], wi[1][j], wi[2][j]]);
@@ -278,14 +309,20 @@ fn grid_eval_pdf_matches_scalar() {
                 "grid_eval_pdf_matches_scalar {name} {s} {level}: max rel f {f_rel:.2e}, pdf {pdf_rel:.2e}; zero on one side within 1e-5 of the horizon: {exempt}"
             );
             if !(f_rel < REL && pdf_rel < REL) {
-                failures.push(format!("{name} {s} {level}: f {f_rel:.2e} pdf {pdf_rel:.2e}"));
+                failures.push(format!(
+                    "{name} {s} {level}: f {f_rel:.2e} pdf {pdf_rel:.2e}"
+                ));
             }
         }
     }
     let shown: Vec<_> = failures.iter().take(8).cloned().collect();
-    assert!(failures.is_empty(), "{} failures:\n{}", failures.len(), shown.join("\n"));
+    assert!(
+        failures.is_empty(),
+        "{} failures:\n{}",
+        failures.len(),
+        shown.join("\n")
+    );
 }
-
 
 /// Chi-square of the batch samples against the batch pdf (evaluated by
 /// `BatchSampler::pdf`, one direction at a time) over every batched
@@ -325,16 +362,39 @@ fn grid_chi2_batch_pdf() {
     let mut mats: Vec<(String, Material, BsdfStrategy)> = Vec::new();
     for (ndf, s) in cases {
         for &(ax, ay) in &alphas {
-            let m = ct(ndf, ax, ay, Shadowing::SmithCorrelated, Fresnel::None, Rgb::ONE);
+            let m = ct(
+                ndf,
+                ax,
+                ay,
+                Shadowing::SmithCorrelated,
+                Fresnel::None,
+                Rgb::ONE,
+            );
             mats.push((format!("{} α=({ax}, {ay})", ndf.name()), m, s));
         }
     }
-    for (ndf, s) in [(Ndf::Ggx, BsdfStrategy::Vndf), (Ndf::Beckmann, BsdfStrategy::Brdf)] {
-        let mut m = ct(ndf, 0.2, 0.4, Shadowing::SmithCorrelated, Fresnel::Schlick { f0: Rgb::splat(0.5) }, Rgb::ONE);
+    for (ndf, s) in [
+        (Ndf::Ggx, BsdfStrategy::Vndf),
+        (Ndf::Beckmann, BsdfStrategy::Brdf),
+    ] {
+        let mut m = ct(
+            ndf,
+            0.2,
+            0.4,
+            Shadowing::SmithCorrelated,
+            Fresnel::Schlick {
+                f0: Rgb::splat(0.5),
+            },
+            Rgb::ONE,
+        );
         m.diffuse = crate::models::Lambert::new(Rgb::new(0.5, 0.3, 0.2)).unwrap();
         mats.push((format!("{} + lambert", ndf.name()), m, s));
     }
-    for s in [BsdfStrategy::Uniform, BsdfStrategy::Cosine, BsdfStrategy::Brdf] {
+    for s in [
+        BsdfStrategy::Uniform,
+        BsdfStrategy::Cosine,
+        BsdfStrategy::Brdf,
+    ] {
         mats.push(("lambert".into(), Material::lambert(Rgb::ONE).unwrap(), s));
     }
     let alpha = sidak(0.01, mats.len() * views.len());
@@ -348,7 +408,11 @@ fn grid_chi2_batch_pdf() {
                 let (wox, woy, woz) = (vec![wo32[0]; n], vec![wo32[1]; n], vec![wo32[2]; n]);
                 let mut out = SampleBuffers::new(n);
                 let input = SampleInput {
-                    wo: Dirs { x: &wox, y: &woy, z: &woz },
+                    wo: Dirs {
+                        x: &wox,
+                        y: &woy,
+                        z: &woz,
+                    },
                     u1: &u1,
                     u2: &u2,
                     uc: Some(&uc),
@@ -359,14 +423,31 @@ fn grid_chi2_batch_pdf() {
                     let i = next.get();
                     next.set(i + 1);
                     (out.valid[i] == 1).then(|| {
-                        DVec3::new(out.wi[0][i].into(), out.wi[1][i].into(), out.wi[2][i].into())
+                        DVec3::new(
+                            out.wi[0][i].into(),
+                            out.wi[1][i].into(),
+                            out.wi[2][i].into(),
+                        )
                     })
                 };
                 let pdf = |wi: DVec3| {
                     let (x, y, z) = ([wi.x as f32], [wi.y as f32], [wi.z as f32]);
                     let mut p = [0.0f32];
-                    let o = Dirs { x: &wox[..1], y: &woy[..1], z: &woz[..1] };
-                    b.pdf(o, Dirs { x: &x, y: &y, z: &z }, &mut p).unwrap();
+                    let o = Dirs {
+                        x: &wox[..1],
+                        y: &woy[..1],
+                        z: &woz[..1],
+                    };
+                    b.pdf(
+                        o,
+                        Dirs {
+                            x: &x,
+                            y: &y,
+                            z: &z,
+                        },
+                        &mut p,
+                    )
+                    .unwrap();
                     f64::from(p[0])
                 };
                 let r = chi2_test(&cfg, sample, pdf);
@@ -403,21 +484,28 @@ fn grid_every_supported_combination_builds() {
             for fr in fresnels() {
                 for (ax, ay) in [(0.3, 0.3), (0.1, 0.6)] {
                     let mf = Microfacet::new(ndf, ax, ay).unwrap();
-                    glossies.push(Glossy::CookTorrance(CookTorrance::new(Rgb::ONE, mf, sh, fr).unwrap()));
+                    glossies.push(Glossy::CookTorrance(
+                        CookTorrance::new(Rgb::ONE, mf, sh, fr).unwrap(),
+                    ));
                 }
             }
         }
     }
     glossies.push(Glossy::None);
     for normalized in [false, true] {
-        glossies.push(Glossy::Phong(Phong::new(Rgb::splat(0.5), 20.0, normalized).unwrap()));
-        glossies.push(Glossy::BlinnPhong(BlinnPhong::new(Rgb::splat(0.5), 20.0, normalized).unwrap()));
+        glossies.push(Glossy::Phong(
+            Phong::new(Rgb::splat(0.5), 20.0, normalized).unwrap(),
+        ));
+        glossies.push(Glossy::BlinnPhong(
+            BlinnPhong::new(Rgb::splat(0.5), 20.0, normalized).unwrap(),
+        ));
     }
     let _ = Lambert::new(Rgb::ONE);
     // What the batch path does not have yet (the module doc says so).
     let not_yet = |m: &Material, s: BsdfStrategy| {
         let other_model = !matches!(m.glossy, Glossy::CookTorrance(_) | Glossy::None);
-        let ndf_bp = matches!(m.glossy, Glossy::CookTorrance(c) if c.microfacet.ndf() == Ndf::BlinnPhong);
+        let ndf_bp =
+            matches!(m.glossy, Glossy::CookTorrance(c) if c.microfacet.ndf() == Ndf::BlinnPhong);
         let caps = matches!(s, BsdfStrategy::SphericalCaps | BsdfStrategy::BoundedVndf);
         other_model || ndf_bp || caps
     };
@@ -433,11 +521,22 @@ fn grid_every_supported_combination_builds() {
                 continue;
             }
             for s in m.strategies() {
-                match (BatchSampler::with_level(&m, s, SimdLevel::Scalar), not_yet(&m, s)) {
+                match (
+                    BatchSampler::with_level(&m, s, SimdLevel::Scalar),
+                    not_yet(&m, s),
+                ) {
                     (Ok(_), false) => built += 1,
-                    (Err(e), true) => missing.push(format!("{} {s} kd {}: {e}", m.model_name(), kd.x)),
-                    (Ok(_), true) => wrong.push(format!("{} {s} kd {}: builds; update `not_yet`", m.model_name(), kd.x)),
-                    (Err(e), false) => wrong.push(format!("{} {s} kd {}: {e}", m.model_name(), kd.x)),
+                    (Err(e), true) => {
+                        missing.push(format!("{} {s} kd {}: {e}", m.model_name(), kd.x))
+                    }
+                    (Ok(_), true) => wrong.push(format!(
+                        "{} {s} kd {}: builds; update `not_yet`",
+                        m.model_name(),
+                        kd.x
+                    )),
+                    (Err(e), false) => {
+                        wrong.push(format!("{} {s} kd {}: {e}", m.model_name(), kd.x))
+                    }
                 }
             }
         }
