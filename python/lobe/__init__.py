@@ -134,8 +134,10 @@ def estimate(
     the CLI's syntax: ``constant[:V]``, ``beam[:K[:X,Y,Z[:V]]]`` (a world
     direction; ``normal``/``tangent`` give the frame, default normal +Y),
     ``sky[:ELEVATION[:AZIMUTH]]``, or an ``.hdr``/``.exr`` map.
-    ``strategies``: ``"all"`` or names (BSDF strategies, ``light``, ``mis``,
-    ``mis-power``, ``mis-one``, ``mis-power-one``). ``sequence``:
+    ``strategies``: ``"all"`` or names (BSDF strategies, ``light``, ``mis``
+    (adaptive: a pilot gives each sample's draws to BSDF sampling, the
+    balance heuristic or light sampling), ``mis-balance``, ``mis-power``,
+    ``mis-one``, ``mis-power-one``). ``sequence``:
     ``independent``, ``stratified`` or ``sobol``. Each row's ``mean`` is the
     estimate with the cosine included.
 

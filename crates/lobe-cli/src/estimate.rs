@@ -5,7 +5,7 @@ use crate::common::{Bar, LightArgs, ViewArgs};
 use anyhow::{Result, bail};
 use clap::Args;
 use glam::DVec3;
-use lobe::estimator::{Heuristic, Mis, MisForm, Strategy};
+use lobe::estimator::Strategy;
 use lobe::experiment::table::{StderrMethod, TableOptions};
 use lobe::experiment::table::{Table, TableSettings, run_table_with};
 use lobe::progress::SystemClock;
@@ -77,8 +77,9 @@ pub struct EstimateArgs {
 #[must_use]
 pub fn strategy_help() -> String {
     format!(
-        "`all` or a comma-separated list of: {} (all: every BSDF strategy that applies, light, mis, mis-balance, mis-power). mis (the default MIS) gives each sample's draws to BSDF sampling, to the balance heuristic or to light sampling, whichever a pilot of its own samples says has the least variance; mis-balance and mis-power are multi-sample MIS with those heuristics; mis-one and mis-power-one one-sample MIS",
-        Strategy::names()
+        "`all` or a comma-separated list of: {} (all: {}). mis (the default MIS) gives each sample's draws to BSDF sampling, to the balance heuristic or to light sampling, whichever a pilot of its own samples says has the least variance; mis-balance and mis-power are multi-sample MIS with those heuristics; mis-one and mis-power-one one-sample MIS",
+        Strategy::names(),
+        lobe::strategy::ALL_MEANS
     )
 }
 
@@ -94,51 +95,8 @@ pub fn parse_strategies(
     n_bsdf: u32,
     n_light: u32,
 ) -> Result<Vec<Strategy>> {
-    let mis = |h, form| {
-        Strategy::Mis(Mis {
-            bsdf: Some(mis_bsdf),
-            heuristic: h,
-            form,
-            n_bsdf,
-            n_light,
-        })
-    };
-    if spec == "all" {
-        let mut v: Vec<Strategy> = m.strategies().into_iter().map(Strategy::from).collect();
-        v.extend([
-            Strategy::Light,
-            mis(Heuristic::Balance, MisForm::Adaptive),
-            mis(Heuristic::Balance, MisForm::MultiSample),
-            mis(Heuristic::Power, MisForm::MultiSample),
-        ]);
-        return Ok(v);
-    }
-    let mut v = Vec::new();
-    for name in spec.split(',').map(str::trim) {
-        let t = match name {
-            "light" => Strategy::Light,
-            "mis" => mis(Heuristic::Balance, MisForm::Adaptive),
-            "mis-balance" => mis(Heuristic::Balance, MisForm::MultiSample),
-            "mis-power" => mis(Heuristic::Power, MisForm::MultiSample),
-            "mis-one" => mis(Heuristic::Balance, MisForm::OneSample),
-            "mis-power-one" => mis(Heuristic::Power, MisForm::OneSample),
-            _ => {
-                let s: BsdfStrategy = name.parse().map_err(|_| {
-                    anyhow::anyhow!(
-                        "--strategy: unknown strategy `{name}`, expected all or a list of: {}, {}",
-                        BsdfStrategy::names(),
-                        lobe::estimator::NON_BSDF_NAMES.join(", ")
-                    )
-                })?;
-                m.check(s).map_err(|e| anyhow::anyhow!("--strategy: {e}"))?;
-                Strategy::Bsdf(s)
-            }
-        };
-        if !v.contains(&t) {
-            v.push(t);
-        }
-    }
-    Ok(v)
+    Strategy::parse_list(spec.split(','), m, mis_bsdf, n_bsdf, n_light)
+        .map_err(|e| anyhow::anyhow!("--strategy: {e}"))
 }
 
 /// `B,L`: samples of BSDF and light sampling per MIS estimate.

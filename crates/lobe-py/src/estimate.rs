@@ -4,7 +4,7 @@
 //! in the binary crate, which a library cannot depend on).
 
 use glam::DVec3;
-use lobe::estimator::{Heuristic, Mis, MisForm, ShadingPoint, Strategy};
+use lobe::estimator::{ShadingPoint, Strategy};
 use lobe::experiment::table::{TableOptions, TableSettings, run_table_with};
 use lobe::progress::SystemClock;
 use lobe::sequence::Sequence;
@@ -134,57 +134,22 @@ pub fn parse_light(spec: &str, frame: &Frame) -> Result<Light, String> {
     }
 }
 
-/// The techniques: `all` (every BSDF strategy that applies, `light`, `mis`,
-/// `mis-power`) or names, each checked against the material.
+/// The techniques: `all` ([`lobe::strategy::ALL_MEANS`]) or names, each
+/// checked against the material ([`Strategy::parse_list`]).
 pub fn parse_strategies(
     names: &[String],
     m: &Material,
     mis_bsdf: BsdfStrategy,
     (n_bsdf, n_light): (u32, u32),
 ) -> Result<Vec<Strategy>, String> {
-    let mis = |h, form| {
-        Strategy::Mis(Mis {
-            bsdf: Some(mis_bsdf),
-            heuristic: h,
-            form,
-            n_bsdf,
-            n_light,
-        })
-    };
-    let mut v = Vec::new();
-    for name in names {
-        let t = match name.as_str() {
-            "all" => {
-                for s in m.strategies() {
-                    v.push(Strategy::from(s));
-                }
-                v.extend([
-                    Strategy::Light,
-                    mis(Heuristic::Balance, MisForm::MultiSample),
-                    mis(Heuristic::Power, MisForm::MultiSample),
-                ]);
-                continue;
-            }
-            "light" => Strategy::Light,
-            "mis" => mis(Heuristic::Balance, MisForm::MultiSample),
-            "mis-power" => mis(Heuristic::Power, MisForm::MultiSample),
-            "mis-one" => mis(Heuristic::Balance, MisForm::OneSample),
-            "mis-power-one" => mis(Heuristic::Power, MisForm::OneSample),
-            _ => {
-                let s: BsdfStrategy = name.parse().map_err(|_| {
-                    format!(
-                        "strategies: unknown strategy `{name}`, expected all or a list of: {}, light, mis, mis-power, mis-one, mis-power-one",
-                        BsdfStrategy::names()
-                    )
-                })?;
-                m.check(s).map_err(|e| format!("strategies: {e}"))?;
-                Strategy::Bsdf(s)
-            }
-        };
-        if !v.contains(&t) {
-            v.push(t);
-        }
-    }
+    let v = Strategy::parse_list(
+        names.iter().map(String::as_str),
+        m,
+        mis_bsdf,
+        n_bsdf,
+        n_light,
+    )
+    .map_err(|e| format!("strategies: {e}"))?;
     if v.is_empty() {
         return Err("strategies: the list is empty".into());
     }

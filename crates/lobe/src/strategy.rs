@@ -277,3 +277,74 @@ impl std::str::FromStr for Strategy {
             })
     }
 }
+
+/// The techniques `all` stands for: every BSDF strategy that applies to the
+/// material, `light`, `mis`, `mis-balance`, `mis-power`.
+pub const ALL_MEANS: &str = "every BSDF strategy that applies, light, mis, mis-balance, mis-power";
+
+impl Strategy {
+    /// A list of technique names for material `m`, in order, without
+    /// repeats: each name is a BSDF strategy (checked against `m`), `light`,
+    /// or an MIS name of [`NON_BSDF_NAMES`], whose MIS combines light
+    /// sampling with `mis_bsdf` at `n_bsdf` and `n_light` draws; `all` is
+    /// [`ALL_MEANS`]. The one parser of `lobe estimate --strategy`, the
+    /// experiments and the Python `lobe.estimate`.
+    pub fn parse_list<'a>(
+        names: impl IntoIterator<Item = &'a str>,
+        m: &Material,
+        mis_bsdf: BsdfStrategy,
+        n_bsdf: u32,
+        n_light: u32,
+    ) -> Result<Vec<Strategy>, Error> {
+        let mis = |heuristic, form| {
+            Strategy::Mis(Mis {
+                bsdf: Some(mis_bsdf),
+                heuristic,
+                form,
+                n_bsdf,
+                n_light,
+            })
+        };
+        let mut v: Vec<Strategy> = Vec::new();
+        let push = |t: Strategy, v: &mut Vec<Strategy>| {
+            if !v.contains(&t) {
+                v.push(t);
+            }
+        };
+        for name in names {
+            let name = name.trim();
+            let t = match name {
+                "all" => {
+                    for s in m.strategies() {
+                        push(Strategy::Bsdf(s), &mut v);
+                    }
+                    for t in [
+                        Strategy::Light,
+                        mis(Heuristic::Balance, MisForm::Adaptive),
+                        mis(Heuristic::Balance, MisForm::MultiSample),
+                        mis(Heuristic::Power, MisForm::MultiSample),
+                    ] {
+                        push(t, &mut v);
+                    }
+                    continue;
+                }
+                "light" => Strategy::Light,
+                "mis" => mis(Heuristic::Balance, MisForm::Adaptive),
+                "mis-balance" => mis(Heuristic::Balance, MisForm::MultiSample),
+                "mis-power" => mis(Heuristic::Power, MisForm::MultiSample),
+                "mis-one" => mis(Heuristic::Balance, MisForm::OneSample),
+                "mis-power-one" => mis(Heuristic::Power, MisForm::OneSample),
+                _ => {
+                    let s: BsdfStrategy = name.parse().map_err(|_| Error::UnknownStrategy {
+                        value: name.into(),
+                        expected: format!("all, {}", Strategy::names()),
+                    })?;
+                    m.check(s)?;
+                    Strategy::Bsdf(s)
+                }
+            };
+            push(t, &mut v);
+        }
+        Ok(v)
+    }
+}
