@@ -297,11 +297,11 @@ fn showcase_scene(width: u32, height: u32) -> Result<(Scene, Vec<Label>)> {
 fn showcase_caption(s: &CompareSettings) -> Vec<String> {
     vec![
         format!(
-            "Rows: the reference (mis, {} spp), then each strategy at {} spp, its error map on the right; paths of up to {} bounces.",
+            "Rows: the reference (mis-balance, {} spp), then each strategy at {} spp, its error map on the right; paths of up to {} bounces.",
             s.reference_spp, s.spp, s.max_depth
         ),
         "brdf samples the BSDF only: it rarely finds the small sun, so the ground shows the blue sky with sun fireflies.".to_string(),
-        "light samples the sky and sun only: clean on the diffuse ground, noisy on glossy lobes, worst on sharp gold; mis weights both (balance heuristic).".to_string(),
+        "light samples the sky and sun only: clean on the diffuse ground, noisy on glossy lobes, worst on sharp gold; mis gives each pixel's draws to BSDF sampling, the balance heuristic or the light, as its pilot finds best.".to_string(),
     ]
 }
 
