@@ -109,6 +109,18 @@ pub fn process_batch<R: BufRead, W: Write>(
     let mut line = String::with_capacity(256);
     let mut n = 0usize;
     loop {
+        if places.len() == BLOCK {
+            run_block(
+                material,
+                &strategies,
+                &keys,
+                &mut samplers,
+                &mut evals,
+                &mut samples,
+                &mut places,
+                out,
+            )?;
+        }
         line.clear();
         n += 1;
         let read = input.read_line(&mut line);
@@ -127,18 +139,6 @@ pub fn process_batch<R: BufRead, W: Write>(
                         evals.line.push(n);
                         push3(&mut evals.a, wo);
                         push3(&mut evals.b, wi);
-                        if places.len() == BLOCK {
-                            run_block(
-                                material,
-                                &strategies,
-                                &keys,
-                                &mut samplers,
-                                &mut evals,
-                                &mut samples,
-                                &mut places,
-                                out,
-                            )?;
-                        }
                         continue;
                     }
                     Ok(Request::Sample {
@@ -159,18 +159,6 @@ pub fn process_batch<R: BufRead, W: Write>(
                         c.u1.push(unit_f32(u.x));
                         c.u2.push(unit_f32(u.y));
                         c.uc.push(unit_f32(uc));
-                        if places.len() == BLOCK {
-                            run_block(
-                                material,
-                                &strategies,
-                                &keys,
-                                &mut samplers,
-                                &mut evals,
-                                &mut samples,
-                                &mut places,
-                                out,
-                            )?;
-                        }
                         continue;
                     }
                 }
