@@ -76,11 +76,6 @@ fn push3(cols: &mut [Vec<f32>; 3], v: glam::DVec3) {
     cols[2].push(v.z as f32);
 }
 
-/// A number of [0, 1) in f32, still below 1 (rounding to f32 may reach 1).
-fn unit_f32(x: f64) -> f32 {
-    unit_interval_f32(x)
-}
-
 /// Where each line of a block went.
 #[derive(Clone, Copy)]
 enum Place {
@@ -156,9 +151,9 @@ pub fn process_batch<R: BufRead, W: Write>(
                         c.slot.push(places.len() - 1);
                         c.line.push(n);
                         push3(&mut c.a, wo);
-                        c.u1.push(unit_f32(u.x));
-                        c.u2.push(unit_f32(u.y));
-                        c.uc.push(unit_f32(uc));
+                        c.u1.push(unit_interval_f32(u.x));
+                        c.u2.push(unit_interval_f32(u.y));
+                        c.uc.push(unit_interval_f32(uc));
                         continue;
                     }
                 }
