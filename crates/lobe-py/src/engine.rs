@@ -240,6 +240,100 @@ fn load_1<'a, T: Real>(
     buf
 }
 
+/// [`stream_copy`] of `src & mask` (bit by bit; `None`: all ones), for the
+/// f32 outputs of `eval_pdf`.
+fn stream_copy_masked(dst: &mut [f32], src: &[f32], mask: Option<&[u32]>) {
+    let Some(mask) = mask else {
+        return stream_copy(dst, src);
+    };
+    assert!(dst.len() == src.len() && mask.len() == src.len());
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::x86_64::{
+            __m128i, _mm_and_si128, _mm_loadu_si128, _mm_sfence, _mm_stream_si128,
+        };
+        let n = dst.len();
+        let head = dst.as_ptr().align_offset(16).min(n);
+        let body = (n - head) / 4;
+        let apply = |i: usize| f32::from_bits(src[i].to_bits() & mask[i]);
+        for i in 0..head {
+            dst[i] = apply(i);
+        }
+        let base = dst.as_mut_ptr();
+        // SAFETY: every access is within the three slices (`head + 4 body ≤
+        // n`); the streaming stores are to 16-byte-aligned addresses; SSE2
+        // is part of the x86-64 baseline.
+        unsafe {
+            for k in 0..body {
+                let o = head + 4 * k;
+                let v = _mm_loadu_si128(src.as_ptr().add(o).cast::<__m128i>());
+                let m = _mm_loadu_si128(mask.as_ptr().add(o).cast::<__m128i>());
+                _mm_stream_si128(base.add(o).cast::<__m128i>(), _mm_and_si128(v, m));
+            }
+            _mm_sfence();
+        }
+        for i in head + 4 * body..n {
+            dst[i] = apply(i);
+        }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    for ((d, &s), &m) in dst.iter_mut().zip(src).zip(mask) {
+        *d = f32::from_bits(s.to_bits() & m);
+    }
+}
+
+/// Runs `f` compiled for AVX2 + FMA where the CPU has them, so that the
+/// checks and copies around the kernels (loops the compiler vectorizes)
+/// run 8 lanes wide instead of the x86-64 baseline's 4; the same values at
+/// either width (comparisons and IEEE arithmetic only).
+#[inline(always)]
+fn wide<R>(f: impl FnOnce() -> R) -> R {
+    #[cfg(target_arch = "x86_64")]
+    {
+        #[target_feature(enable = "avx2,fma")]
+        fn avx2<R>(f: impl FnOnce() -> R) -> R {
+            f()
+        }
+        if is_x86_feature_detected!("avx2") && is_x86_feature_detected!("fma") {
+            // SAFETY: the CPU has AVX2 and FMA (checked just above).
+            return unsafe { avx2(f) };
+        }
+    }
+    f()
+}
+
+/// Whether every `(x, y, z)` is unit within `tol` (or, with `zero_ok`,
+/// zero), and whether any is zero: one branch-free pass.
+#[inline(always)]
+fn unit_or_zero<T: Real>(
+    x: &[T],
+    y: &[T],
+    z: &[T],
+    tol: T,
+    one: T,
+    zero: T,
+    zero_ok: bool,
+) -> (bool, bool) {
+    x.iter()
+        .zip(y)
+        .zip(z)
+        .fold((true, false), |(ok, zs), ((&a, &b), &c)| {
+            let n2 = T::mul_add3(a, b, c);
+            let d = n2 - one;
+            let is_zero = zero_ok & (n2 == zero);
+            (
+                ok & (((d <= tol) & (d >= T::neg(tol))) | is_zero),
+                zs | is_zero,
+            )
+        })
+}
+
+/// Whether every value is in `[0, 1)`: one branch-free pass.
+#[inline(always)]
+fn in_unit_interval<T: Real>(v: &[T], zero: T, one: T) -> bool {
+    v.iter().fold(true, |ok, &x| ok & (x >= zero) & (x < one))
+}
+
 /// Checks a block of directions (rows from `start`): finite and unit.
 fn check_dirs<T: Real>(
     name: &str,
@@ -249,15 +343,14 @@ fn check_dirs<T: Real>(
     start: usize,
     zero_ok: bool,
 ) -> Result<bool, BadInput> {
-    // The common case first, in one branch-free (vectorizable) pass.
+    // The common case first, in one branch-free (vectorizable) pass: every
+    // direction unit, or (where allowed) the zero vector of a failed sample.
     let tol = T::from_f64(UNIT_TOLERANCE);
     let one = T::from_f64(1.0);
-    let all_unit = x.iter().zip(y).zip(z).fold(true, |ok, ((&a, &b), &c)| {
-        let d = T::mul_add3(a, b, c) - one;
-        ok & (d <= tol) & (d >= T::neg(tol))
-    });
-    if all_unit {
-        return Ok(false);
+    let zero = T::from_f64(0.0);
+    let (all_ok, any_zero) = wide(|| unit_or_zero(x, y, z, tol, one, zero, zero_ok));
+    if all_ok {
+        return Ok(any_zero);
     }
     let mut zeros = false;
     for i in 0..x.len() {
@@ -316,7 +409,7 @@ fn check_uniform<'a, T: Real>(
     buf: &'a mut Vec<T>,
 ) -> Result<&'a [T], BadInput> {
     let (zero, one) = (T::from_f64(0.0), T::from_f64(1.0));
-    if v.iter().fold(true, |ok, &x| ok & (x >= zero) & (x < one)) {
+    if wide(|| in_unit_interval(v, zero, one)) {
         return Ok(v);
     }
     let mut has_one = false;
@@ -485,6 +578,12 @@ struct Scratch32 {
     fix: [Vec<f32>; 3],
     f: [Vec<f32>; 3],
     pdf: Vec<f32>,
+    /// The kernels' outputs, streamed from here into the caller's arrays.
+    out_wi: [Vec<f32>; 3],
+    out_w: [Vec<f32>; 3],
+    out_valid: Vec<u8>,
+    /// All ones where an eval input `wi` is not the zero vector, else 0.
+    keep: Vec<u32>,
 }
 
 impl Scratch32 {
@@ -498,8 +597,55 @@ impl Scratch32 {
             fix: [v(), v(), v()],
             f: [z(), z(), z()],
             pdf: z(),
+            out_wi: [z(), z(), z()],
+            out_w: [z(), z(), z()],
+            out_valid: vec![0; BLOCK],
+            keep: Vec::with_capacity(BLOCK),
         }
     }
+}
+
+/// `dst.copy_from_slice(src)`, with non-temporal (streaming) stores on
+/// x86-64 for the 16-byte-aligned middle: the outputs are far larger than
+/// the caches and are not read again soon, and a streaming store writes a
+/// line without reading it first, a third less memory traffic than a plain
+/// store. The block's kernel output is in the cache, so the copy is cheap.
+fn stream_copy<T: Copy>(dst: &mut [T], src: &[T]) {
+    assert_eq!(dst.len(), src.len());
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::x86_64::{__m128i, _mm_loadu_si128, _mm_sfence, _mm_stream_si128};
+        let size = std::mem::size_of_val(dst);
+        let base = dst.as_mut_ptr().cast::<u8>();
+        let head = base.align_offset(16).min(size);
+        let body = (size - head) / 16;
+        if body < 4 {
+            dst.copy_from_slice(src);
+            return;
+        }
+        let sb = src.as_ptr().cast::<u8>();
+        // SAFETY: `dst` and `src` are `size` bytes each and do not overlap
+        // (`&mut` and `&`); every access below is within them; `T: Copy`
+        // has no drop glue and any byte copy of it is a valid `T` (both
+        // slices hold `T`s at the same offsets); the streaming stores are
+        // to 16-byte-aligned addresses (`head` is the alignment offset);
+        // SSE2 is part of the x86-64 baseline.
+        unsafe {
+            std::ptr::copy_nonoverlapping(sb, base, head);
+            for k in 0..body {
+                let o = head + 16 * k;
+                let v = _mm_loadu_si128(sb.add(o).cast::<__m128i>());
+                _mm_stream_si128(base.add(o).cast::<__m128i>(), v);
+            }
+            let done = head + 16 * body;
+            std::ptr::copy_nonoverlapping(sb.add(done), base.add(done), size - done);
+            // Order the streaming stores before anything this thread does
+            // next (rayon's join then publishes them to the caller).
+            _mm_sfence();
+        }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    dst.copy_from_slice(src);
 }
 
 /// One block of sample outputs.
@@ -602,6 +748,10 @@ pub fn sample32_into(
                 u: ub,
                 fix,
                 f,
+                pdf: sp,
+                out_wi,
+                out_w,
+                out_valid,
                 ..
             } = s;
             let [b0, b1, b2] = wb;
@@ -610,51 +760,73 @@ pub fn sample32_into(
                 load_col::<f32>(wo, 1, r.clone(), b1),
                 load_col::<f32>(wo, 2, r.clone(), b2),
             );
-            check_dirs("wo", x, y, z, start, false)?;
             let [ub0, ub1, ub2] = ub;
+            let u1raw = load_col::<f32>(u, 0, r.clone(), ub0);
+            let u2raw = load_col::<f32>(u, 1, r.clone(), ub1);
+            let ucraw = uc.map(|c| load_1::<f32>(c, r.clone(), ub2));
+            let [fr, fg, fb] = f;
+            let [sx, sy, sz] = out_wi;
+            let [sr, sg, sb] = out_w;
+            let mut run = |u1: &[f32], u2: &[f32], uc: Option<&[f32]>| {
+                b.sample(
+                    SampleInput {
+                        wo: Dirs { x, y, z },
+                        u1,
+                        u2,
+                        uc,
+                    },
+                    SampleOutput {
+                        wi: DirsMut {
+                            x: &mut sx[..len],
+                            y: &mut sy[..len],
+                            z: &mut sz[..len],
+                        },
+                        f: RgbMut {
+                            r: &mut fr[..len],
+                            g: &mut fg[..len],
+                            b: &mut fb[..len],
+                        },
+                        pdf: &mut sp[..len],
+                        weight: RgbMut {
+                            r: &mut sr[..len],
+                            g: &mut sg[..len],
+                            b: &mut sb[..len],
+                        },
+                        valid: &mut out_valid[..len],
+                    },
+                )
+                .expect("every block slice has the block's length");
+            };
+            // The kernel first, on the inputs as given: it reads them from
+            // memory interleaved with its arithmetic, which hides the
+            // latency; the checks then read them from the cache. The
+            // kernels are plain arithmetic on any f32 (no panic on bad
+            // values), and nothing is written out unless the checks pass.
+            run(u1raw, u2raw, ucraw);
+            check_dirs("wo", x, y, z, start, false)?;
             let [f0, f1, f2] = fix;
-            let u1 = check_uniform("u", load_col::<f32>(u, 0, r.clone(), ub0), start, f0)?;
-            let u2 = check_uniform("u", load_col::<f32>(u, 1, r.clone(), ub1), start, f1)?;
-            let ucs = match uc {
-                Some(c) => Some(check_uniform(
-                    "uc",
-                    load_1::<f32>(c, r.clone(), ub2),
-                    start,
-                    f2,
-                )?),
+            let u1 = check_uniform("u", u1raw, start, f0)?;
+            let u2 = check_uniform("u", u2raw, start, f1)?;
+            let ucs = match ucraw {
+                Some(c) => Some(check_uniform("uc", c, start, f2)?),
                 None => None,
             };
-            let [wx, wy, wz] = wi;
-            let [wr, wg, wb] = w;
-            let [fr, fg, fb] = f;
-            b.sample(
-                SampleInput {
-                    wo: Dirs { x, y, z },
-                    u1,
-                    u2,
-                    uc: ucs,
-                },
-                SampleOutput {
-                    wi: DirsMut {
-                        x: wx,
-                        y: wy,
-                        z: wz,
-                    },
-                    f: RgbMut {
-                        r: &mut fr[..len],
-                        g: &mut fg[..len],
-                        b: &mut fb[..len],
-                    },
-                    pdf,
-                    weight: RgbMut {
-                        r: wr,
-                        g: wg,
-                        b: wb,
-                    },
-                    valid,
-                },
-            )
-            .expect("every block slice has the block's length");
+            // A 1 moved below one (see `check_uniform`): again, on the fixed values.
+            let moved = |a: &[f32], b: &[f32]| !std::ptr::eq(a.as_ptr(), b.as_ptr());
+            if moved(u1, u1raw)
+                || moved(u2, u2raw)
+                || ucs.zip(ucraw).is_some_and(|(a, b)| moved(a, b))
+            {
+                run(u1, u2, ucs);
+            }
+            for (d, s) in wi.into_iter().zip(out_wi.iter()) {
+                stream_copy(d, &s[..len]);
+            }
+            for (d, s) in w.into_iter().zip(out_w.iter()) {
+                stream_copy(d, &s[..len]);
+            }
+            stream_copy(pdf, &sp[..len]);
+            stream_copy(valid, &out_valid[..len]);
             Ok(())
         })
         .collect();
@@ -833,6 +1005,7 @@ pub fn eval_pdf32_into(
                 wi: ib,
                 f: sf,
                 pdf: sp,
+                keep,
                 ..
             } = s;
             let [b0, b1, b2] = wb;
@@ -841,23 +1014,15 @@ pub fn eval_pdf32_into(
                 y: load_col::<f32>(wo, 1, r.clone(), b1),
                 z: load_col::<f32>(wo, 2, r.clone(), b2),
             };
-            check_dirs("wo", wo3.x, wo3.y, wo3.z, start, false)?;
             let [i0, i1, i2] = ib;
             let wi3 = Dirs {
                 x: load_col::<f32>(wi, 0, r.clone(), i0),
                 y: load_col::<f32>(wi, 1, r.clone(), i1),
                 z: load_col::<f32>(wi, 2, r.clone(), i2),
             };
-            let zeros = check_dirs("wi", wi3.x, wi3.y, wi3.z, start, true)?;
             let [sr, sg, sb] = sf;
-            let [fr, fg, fb] = match f {
-                Some(f) => f,
-                None => [&mut sr[..len], &mut sg[..len], &mut sb[..len]],
-            };
-            let pdf = match p {
-                Some(p) => p,
-                None => &mut sp[..len],
-            };
+            let (fr, fg, fb) = (&mut sr[..len], &mut sg[..len], &mut sb[..len]);
+            let pdf = &mut sp[..len];
             b.eval_pdf(
                 wo3,
                 wi3,
@@ -871,16 +1036,30 @@ pub fn eval_pdf32_into(
                 },
             )
             .expect("every block slice has the block's length");
-            if zeros {
-                // A failed sample's wi (the zero vector): no direction, zero.
-                for i in 0..len {
-                    if wi3.x[i] == 0.0 && wi3.y[i] == 0.0 && wi3.z[i] == 0.0 {
-                        fr[i] = 0.0;
-                        fg[i] = 0.0;
-                        fb[i] = 0.0;
-                        pdf[i] = 0.0;
-                    }
-                }
+            // The checks after the kernel (as in `sample32_into`: the inputs
+            // are in the cache now); nothing is written out unless they pass.
+            check_dirs("wo", wo3.x, wo3.y, wo3.z, start, false)?;
+            let zeros = check_dirs("wi", wi3.x, wi3.y, wi3.z, start, true)?;
+            // A failed sample's wi (the zero vector): no direction, zero;
+            // applied as a bit mask while streaming the outputs out.
+            let mask = if zeros {
+                keep.clear();
+                wide(|| {
+                    keep.extend(wi3.x.iter().zip(wi3.y).zip(wi3.z).map(|((&x, &y), &z)| {
+                        u32::from((x != 0.0) | (y != 0.0) | (z != 0.0)).wrapping_neg()
+                    }));
+                });
+                Some(&keep[..])
+            } else {
+                None
+            };
+            if let Some([dr, dg, db]) = f {
+                stream_copy_masked(dr, fr, mask);
+                stream_copy_masked(dg, fg, mask);
+                stream_copy_masked(db, fb, mask);
+            }
+            if let Some(p) = p {
+                stream_copy_masked(p, pdf, mask);
             }
             Ok(())
         })
@@ -1059,6 +1238,53 @@ mod tests {
             }
         }
         assert!(worst < 1e-3, "{worst}");
+    }
+
+    #[test]
+    fn a_uniform_of_one_is_sampled_as_the_value_below_one() {
+        // The kernels run before the checks; a block with u = 1 runs again
+        // on the moved values (`check_uniform`), so the result is that of
+        // the largest f32 below one, in that block and in no other.
+        let m = ggx();
+        let n = 2 * BLOCK + 9;
+        let (wo, u) = inputs(n);
+        let e = Engine::new(&m, BsdfStrategy::Vndf, false).unwrap();
+        let wo32 = wo.mapv(|x| x as f32);
+        let mut with_one = u.mapv(|x| x as f32);
+        let mut below = with_one.clone();
+        for &(r, c) in &[(3, 0), (BLOCK + 5, 1), (2 * BLOCK + 8, 0)] {
+            with_one[[r, c]] = 1.0;
+            below[[r, c]] = f32::BELOW_ONE;
+        }
+        let a = sample32(&e, &In2::F32(wo32.view()), &In2::F32(with_one.view()), None).unwrap();
+        let b = sample32(&e, &In2::F32(wo32.view()), &In2::F32(below.view()), None).unwrap();
+        assert_eq!(a, b);
+    }
+
+    #[test]
+    fn streaming_copies_equal_plain_copies_at_every_alignment() {
+        let src: Vec<f32> = (0..200).map(|i| i as f32 * 0.5 - 7.0).collect();
+        let mask: Vec<u32> = (0..200).map(|i| if i % 3 == 0 { 0 } else { !0 }).collect();
+        for off in 0..5 {
+            for len in [0, 1, 3, 4, 15, 16, 17, 63, 64, 65, 150] {
+                let s = &src[off..off + len];
+                let mut a = vec![9.0f32; len + 8];
+                stream_copy(&mut a[off..off + len], s);
+                assert_eq!(&a[off..off + len], s, "offset {off}, length {len}");
+                assert!(a[..off].iter().chain(&a[off + len..]).all(|&x| x == 9.0));
+                let mut b = vec![9.0f32; len + 8];
+                stream_copy_masked(&mut b[off..off + len], s, Some(&mask[off..off + len]));
+                for (k, &x) in b[off..off + len].iter().enumerate() {
+                    let want = if mask[off + k] == 0 { 0.0 } else { s[k] };
+                    assert_eq!(x, want, "offset {off}, length {len}, index {k}");
+                }
+                assert!(b[..off].iter().chain(&b[off + len..]).all(|&x| x == 9.0));
+                let bytes: Vec<u8> = (0..len as u8).collect();
+                let mut c = vec![7u8; len + 8];
+                stream_copy(&mut c[off..off + len], &bytes);
+                assert_eq!(&c[off..off + len], &bytes[..]);
+            }
+        }
     }
 
     #[test]
