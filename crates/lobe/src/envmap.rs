@@ -136,11 +136,25 @@ impl Distribution1D {
     }
 }
 
+/// Radiance and the two light-sampling densities of one direction
+/// ([`EnvMap::lookup`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EnvLookup {
+    /// The radiance arriving from the direction ([`EnvMap::eval`]).
+    pub radiance: Rgb,
+    /// [`EnvMap::pdf`], solid angle.
+    pub pdf: f64,
+    /// [`EnvMap::pdf_compensated`], solid angle.
+    pub pdf_compensated: f64,
+}
+
 /// An equirectangular environment map with its sampling distribution.
 #[derive(Debug, Clone, PartialEq)]
 pub struct EnvMap {
     width: usize,
     height: usize,
+    /// `cos(π j / height)` for `j = 0..=height`: the rows' edges.
+    row_cos: Vec<f64>,
     texels: Vec<Rgb>,
     scale: f64,
     /// cos and sin of the rotation about +Y.
@@ -276,6 +290,9 @@ impl EnvMap {
             EnvMap {
                 width,
                 height,
+                row_cos: (0..=height)
+                    .map(|j| (PI * j as f64 / height as f64).cos())
+                    .collect(),
                 texels,
                 scale,
                 rot: (r.cos(), r.sin()),
@@ -410,6 +427,59 @@ impl EnvMap {
         }
         let (i, j) = self.texel_index(d);
         t.weights[j * self.width + i] / t.norm
+    }
+
+    /// Radiance and both densities ([`EnvMap::pdf`],
+    /// [`EnvMap::pdf_compensated`]) at world direction `d` (unit), from one
+    /// texel lookup: the same values as the three calls.
+    #[inline]
+    #[must_use]
+    pub fn lookup(&self, d: DVec3) -> EnvLookup {
+        let (i, j) = self.texel_index(d);
+        self.texel_lookup(j * self.width + i)
+    }
+
+    #[inline]
+    fn texel_lookup(&self, k: usize) -> EnvLookup {
+        let pdf = |t: &TexelSampler| {
+            if t.norm > 0.0 {
+                t.weights[k] / t.norm
+            } else {
+                0.0
+            }
+        };
+        EnvLookup {
+            radiance: self.texels[k] * self.scale,
+            pdf: pdf(&self.plain),
+            pdf_compensated: pdf(&self.compensated),
+        }
+    }
+
+    /// Draw a world direction as [`EnvMap::sample`] (`compensated = false`)
+    /// or [`EnvMap::sample_compensated`] (`true`) do, from the same
+    /// distribution over the texels and uniformly in solid angle inside the
+    /// texel, and return it with the [`EnvLookup`] of the texel it was drawn
+    /// in (no second lookup, and no `acos`: `sin θ` comes from `cos θ`).
+    /// `None` for a black map. The direction can differ from
+    /// [`EnvMap::sample`]'s in its last bits.
+    #[inline]
+    #[must_use]
+    pub fn sample_lookup(&self, compensated: bool, u: DVec2) -> Option<(DVec3, EnvLookup)> {
+        let t = if compensated {
+            &self.compensated
+        } else {
+            &self.plain
+        };
+        let (j, ru) = t.rows.sample(u.x)?;
+        let (i, rv) = t.cols[j].sample(u.y)?;
+        let (c0, c1) = (self.row_cos[j], self.row_cos[j + 1]);
+        let ct = (c0 + (c1 - c0) * ru).clamp(c1.min(c0), c0.max(c1));
+        let st = (1.0 - ct * ct).max(0.0).sqrt();
+        let (sp, cp) = (2.0 * PI * (i as f64 + rv) / self.width as f64).sin_cos();
+        let d = self.rotate(DVec3::new(st * sp, ct, -st * cp));
+        let l = self.texel_lookup(j * self.width + i);
+        let p = if compensated { l.pdf_compensated } else { l.pdf };
+        (p > 0.0).then_some((d, l))
     }
 
     /// The solid-angle region of texel `(i, j)`: `(θ₀, θ₁)`, `(φ₀, φ₁)` in the
@@ -585,5 +655,42 @@ mod tests {
                 .sample(DVec2::splat(0.5))
                 .is_none()
         );
+    }
+
+    /// `sample_lookup` draws inside the texel whose lookup it returns, that
+    /// lookup is `lookup` of the direction, and it is `sample`'s
+    /// distribution (the same texel for the same numbers).
+    #[test]
+    fn sample_lookup_agrees_with_sample_and_lookup() {
+        let (m, _) = EnvMap::new(
+            64,
+            32,
+            EnvMap::sky(64, 32, 30.0, 40.0).texels.clone(),
+            1.5,
+            33.0,
+        )
+        .unwrap();
+        for comp in [false, true] {
+            for k in 0..2000 {
+                let u = DVec2::new(
+                    (k as f64 * 0.618_033_988_7 + 0.01) % 1.0,
+                    (k as f64 * 0.414_213_562 + 0.02) % 1.0,
+                );
+                let (d, l) = m.sample_lookup(comp, u).unwrap();
+                assert!((d.length() - 1.0).abs() < 1e-12);
+                let (d0, p0) = if comp {
+                    m.sample_compensated(u).unwrap()
+                } else {
+                    m.sample(u).unwrap()
+                };
+                assert!((d - d0).length() < 1e-9, "{d} {d0}");
+                let p = if comp { l.pdf_compensated } else { l.pdf };
+                assert!((p - p0).abs() <= 1e-12 * p0);
+                assert_eq!(m.lookup(d), l);
+                assert_eq!(l.radiance, m.eval(d));
+                assert_eq!(l.pdf, m.pdf(d));
+                assert_eq!(l.pdf_compensated, m.pdf_compensated(d));
+            }
+        }
     }
 }
