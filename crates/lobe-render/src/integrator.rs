@@ -75,7 +75,7 @@
 //! number of passes.
 
 use crate::geometry::{Hit, spawn_ray};
-pub use crate::options::RenderOptions;
+pub use crate::options::{RenderLoop, RenderOptions};
 use crate::scene::Scene;
 use glam::{DVec2, DVec3};
 use lobe::estimator::{
@@ -88,6 +88,9 @@ use lobe::sequence::{Sequence, hash64, pair_point};
 use lobe::{BsdfSampler, BsdfStrategy, Frame, Material};
 use rayon::prelude::*;
 use std::time::{Duration, Instant};
+
+mod wavefront;
+pub use wavefront::{BLOCK, batch_refusal};
 
 /// The dimension pairs of one sample ([`lobe::sequence::pair_point`]).
 pub mod dims {
@@ -390,9 +393,11 @@ fn context<'a>(
     light: &'a Light,
     shading: &'a [ObjectShading<'a>],
     progress: &'a (dyn Fn(u64) + Sync),
+    batch: Option<&'a wavefront::Batch<'a>>,
 ) -> Context<'a> {
     Context {
         progress,
+        batch,
         scene,
         light,
         shading,
@@ -434,7 +439,7 @@ fn pilot_phase(scene: &Scene, opts: &RenderOptions) -> (Vec<Pilot>, RenderStats)
         spp: pilot_spp(opts.spp.max(1)),
         ..*opts
     };
-    let ctx = context(scene, &pilot_opts, 0, &light, &shading, &|_| {});
+    let ctx = context(scene, &pilot_opts, 0, &light, &shading, &|_| {}, None);
     let k = ctx.spp;
     let rows: Vec<(Vec<(Rgb, Pilot)>, RenderStats)> = (0..h)
         .into_par_iter()
@@ -486,7 +491,19 @@ fn render_on_pool(
     let (w, h) = (scene.camera.width as usize, scene.camera.height as usize);
     let shading = shadings(scene, opts);
     let light = Light::Env(scene.environment.clone());
-    let ctx = context(scene, opts, pass, &light, &shading, progress);
+    let batch = match opts.render_loop {
+        RenderLoop::Batch => wavefront::Batch::new(scene, opts.strategy, opts.max_depth.max(1)).ok(),
+        RenderLoop::Scalar => None,
+    };
+    let ctx = context(
+        scene,
+        opts,
+        pass,
+        &light,
+        &shading,
+        progress,
+        batch.as_ref(),
+    );
     let mut img = Image::new(w, h);
     if w == 0 || h == 0 {
         return (img, Vec::new());
@@ -535,6 +552,9 @@ fn render_rows(
         .par_chunks_mut(w)
         .enumerate()
         .map(|(y, row)| {
+            if let Some(b) = ctx.batch {
+                return b.row(ctx, y, row, &|x| plan(x, y).1);
+            }
             let mut stats = RenderStats::default();
             for (x, px) in row.iter_mut().enumerate() {
                 let (range, mode) = plan(x, y);
@@ -557,6 +577,8 @@ const PROGRESS_STEP: u64 = 4096;
 
 struct Context<'a> {
     progress: &'a (dyn Fn(u64) + Sync),
+    /// The batch loop, where it renders the scene (never for the pilot).
+    batch: Option<&'a wavefront::Batch<'a>>,
     scene: &'a Scene,
     light: &'a Light,
     shading: &'a [ObjectShading<'a>],

@@ -6,6 +6,7 @@ use glam::DVec3;
 use lobe::envmap::EnvMap;
 use lobe::estimator::{Heuristic, Strategy};
 use lobe::{BsdfStrategy, Material, MaterialDesc, Rgb};
+use lobe_render::integrator::RenderLoop;
 use lobe_render::{Camera, Image, Mesh, Object, RenderOptions, Scene, load_scene, render};
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -22,6 +23,7 @@ fn opts(method: Strategy, spp: u64) -> RenderOptions {
         sequence: lobe::sequence::Sequence::Sobol,
         max_depth: 1,
         threads: None,
+        render_loop: RenderLoop::Batch,
     }
 }
 
