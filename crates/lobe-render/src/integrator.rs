@@ -73,6 +73,32 @@
 //! fresh stratification for `stratified`. [`render_progressive`] averages
 //! whole passes until a time budget is spent; its image depends only on the
 //! number of passes.
+//!
+//! # Batch loop
+//!
+//! [`RenderOptions::render_loop`] is [`RenderLoop::Batch`] by default: for
+//! direct lighting (`max_depth = 1`) with a BSDF strategy, `light`, or MIS
+//! with one BSDF and one light draw (`mis`, `mis-balance`, `mis-power`),
+//! each row is rendered in blocks of [`BLOCK`] samples (consecutive samples
+//! of consecutive pixels): the camera rays and their hits (f64, scalar),
+//! then every BSDF draw of the block in one
+//! [`lobe::batch::BatchSampler::sample`] call per object and every light
+//! draw's `f` and BSDF pdf in one [`lobe::batch::BatchSampler::eval_pdf`]
+//! call per object (f32 lanes, structure of arrays, AVX-512 / AVX2 /
+//! portable as [`lobe::batch::SimdLevel::from_env`] says), the light draws
+//! from [`lobe::envmap::EnvMap::sample_lookup`] (guide-table CDF inversion,
+//! O(1) per sample, with the drawn texel's radiance and pdfs), each BSDF
+//! direction's radiance and pdfs from one [`lobe::envmap::EnvMap::lookup`],
+//! then the block's shadow rays. It draws the same numbers from the same
+//! dimensions as the scalar loop and weights them the same way, so the two
+//! loops estimate the same image and, for one seed, agree to f32 rounding
+//! (the test `batch_loop_matches_the_scalar_loop`). Adaptive MIS's pilot
+//! runs on the scalar loop. Where the batch loop does not apply (bounces,
+//! one-sample MIS, a material without batch kernels: Phong, Blinn-Phong,
+//! `spherical-caps`, `bounded-vndf`), the scalar loop renders the whole
+//! image and [`batch_refusal`] says why (`lobe render` prints it once);
+//! [`RenderLoop::Scalar`] forces the scalar loop. Both give the same bits
+//! for any thread count.
 
 use crate::geometry::{Hit, spawn_ray};
 pub use crate::options::{RenderLoop, RenderOptions};
