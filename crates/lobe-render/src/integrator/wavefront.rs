@@ -200,42 +200,8 @@ struct PixelSeeds {
 
 impl Batch<'_> {
     /// Samples `0..spp` of every pixel of row `y`, the pixel sums (not
-    /// divided) into `row`; `mode(x)` is pixel `x`'s first-bounce mode.
-    ///
-    /// The scalar f64 parts of the block (camera rays, hits, the map, the
-    /// sample points) are compiled twice: for the baseline x86-64 and with
-    /// AVX2 (chosen at run time). Both give the same bits: Rust contracts
-    /// no `a·b + c` into a fused multiply-add by itself, and the libm calls
-    /// are the same.
+    /// divided) into `row`; `modes[x]` is pixel `x`'s first-bounce mode.
     pub(super) fn row(
-        &self,
-        ctx: &Context<'_>,
-        y: usize,
-        row: &mut [Rgb],
-        mode: &(dyn Fn(usize) -> FirstBounce + Sync),
-    ) -> RenderStats {
-        #[cfg(target_arch = "x86_64")]
-        if std::arch::is_x86_feature_detected!("avx2") {
-            // SAFETY: the CPU has AVX2 (checked just above).
-            return unsafe { self.row_avx2(ctx, y, row, mode) };
-        }
-        self.row_body(ctx, y, row, mode)
-    }
-
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    unsafe fn row_avx2(
-        &self,
-        ctx: &Context<'_>,
-        y: usize,
-        row: &mut [Rgb],
-        mode: &(dyn Fn(usize) -> FirstBounce + Sync),
-    ) -> RenderStats {
-        self.row_body(ctx, y, row, mode)
-    }
-
-    #[inline(always)]
-    fn row_body(
         &self,
         ctx: &Context<'_>,
         y: usize,
@@ -292,7 +258,6 @@ impl Batch<'_> {
 
     /// The camera ray of one sample, its hit and shading frame, and its
     /// numbers.
-    #[inline(always)]
     fn camera_point(
         &self,
         ctx: &Context<'_>,
@@ -378,7 +343,6 @@ impl Batch<'_> {
 
     /// The draws of a block: BSDF samples and light samples' `f` and pdf
     /// in batches per object, then the shadow rays and the estimates.
-    #[inline(always)]
     fn shade(
         &self,
         scene: &Scene,
@@ -487,7 +451,6 @@ impl Batch<'_> {
 
     /// The draws `keys[range]` (all of object `obj`): BSDF draws sampled,
     /// light draws evaluated, each kind in one batch call.
-    #[inline(always)]
     fn batch_group(
         &self,
         obj: usize,
