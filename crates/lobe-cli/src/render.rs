@@ -169,11 +169,6 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         eprintln!("lobe: warning: {w}");
     }
     if !args.quiet {
-        if opts.render_loop == RenderLoop::Batch
-            && let Some(why) = batch_refusal(&scene, opts.strategy, opts.max_depth)
-        {
-            eprintln!("lobe: note: the scalar loop renders this: {why}");
-        }
         for f in fallbacks(&scene, opts.strategy) {
             eprintln!(
                 "lobe: note: object {} ({}): {} does not apply to its material, using {}",
@@ -198,6 +193,13 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             "--spp {}: the sobol sequence has 2^32 points per pixel; use fewer spp or --sequence stratified",
             opts.spp
         );
+    }
+    // Said after every check of the arguments, so that an error stays one line.
+    if !args.quiet
+        && opts.render_loop == RenderLoop::Batch
+        && let Some(why) = batch_refusal(&scene, opts.strategy, opts.max_depth)
+    {
+        eprintln!("lobe: note: the scalar loop renders this: {why}");
     }
     let pb = progress(total, "rendering", args.quiet);
     let template = if budget.is_some() {
