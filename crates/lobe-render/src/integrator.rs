@@ -518,7 +518,9 @@ fn render_on_pool(
     let shading = shadings(scene, opts);
     let light = Light::Env(scene.environment.clone());
     let batch = match opts.render_loop {
-        RenderLoop::Batch => wavefront::Batch::new(scene, opts.strategy, opts.max_depth.max(1)).ok(),
+        RenderLoop::Batch => {
+            wavefront::Batch::new(scene, opts.strategy, opts.max_depth.max(1)).ok()
+        }
         RenderLoop::Scalar => None,
     };
     let ctx = context(

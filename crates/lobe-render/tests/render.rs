@@ -301,7 +301,10 @@ fn batch_loop_matches_the_scalar_loop() {
         let reference = render(&scene, &scalar(o), |_| {});
         let same = render(&scene, &o, |_| {});
         let (a, b) = (mean(&same), mean(&reference));
-        assert!((a - b).abs() < 2e-4 * b, "{method}: same seed, batch {a} scalar {b}");
+        assert!(
+            (a - b).abs() < 2e-4 * b,
+            "{method}: same seed, batch {a} scalar {b}"
+        );
         let other = render(&scene, &RenderOptions { seed: 11, ..o }, |_| {});
         let diff = Image {
             pixels: other
@@ -335,7 +338,11 @@ fn batch_loop_matches_the_scalar_loop() {
             max_depth: depth,
             ..opts(method, 2)
         };
-        assert_eq!(render(sc, &o, |_| {}), render(sc, &scalar(o), |_| {}), "{why:?}");
+        assert_eq!(
+            render(sc, &o, |_| {}),
+            render(sc, &scalar(o), |_| {}),
+            "{why:?}"
+        );
     }
 }
 

@@ -153,8 +153,7 @@ pub struct EnvLookup {
 #[inline]
 fn atan_01(t: f64) -> f64 {
     let t2 = t * t;
-    t * (0.999_866
-        + t2 * (-0.330_299_5 + t2 * (0.180_141 + t2 * (-0.085_133 + t2 * 0.020_835_1))))
+    t * (0.999_866 + t2 * (-0.330_299_5 + t2 * (0.180_141 + t2 * (-0.085_133 + t2 * 0.020_835_1))))
 }
 
 /// `acos(y)` within 1e-4 (Abramowitz and Stegun 4.4.45), a guess.
@@ -558,7 +557,11 @@ impl EnvMap {
         let (sp, cp) = (2.0 * PI * (i as f64 + rv) / self.width as f64).sin_cos();
         let d = self.rotate(DVec3::new(st * sp, ct, -st * cp));
         let l = self.texel_lookup(j * self.width + i);
-        let p = if compensated { l.pdf_compensated } else { l.pdf };
+        let p = if compensated {
+            l.pdf_compensated
+        } else {
+            l.pdf
+        };
         (p > 0.0).then_some((d, l))
     }
 
@@ -767,7 +770,14 @@ mod tests {
                 }
             }
             // Poles, the seam and the axes.
-            for d in [DVec3::Y, -DVec3::Y, DVec3::X, -DVec3::X, DVec3::Z, -DVec3::Z] {
+            for d in [
+                DVec3::Y,
+                -DVec3::Y,
+                DVec3::X,
+                -DVec3::X,
+                DVec3::Z,
+                -DVec3::Z,
+            ] {
                 let (i, j) = m.texel_index(d);
                 assert!(i < w && j < h);
             }

@@ -67,7 +67,11 @@ pub fn batch_refusal(scene: &Scene, strategy: Strategy, max_depth: u32) -> Optio
 }
 
 impl<'a> Batch<'a> {
-    pub(super) fn new(scene: &'a Scene, strategy: Strategy, max_depth: u32) -> Result<Self, String> {
+    pub(super) fn new(
+        scene: &'a Scene,
+        strategy: Strategy,
+        max_depth: u32,
+    ) -> Result<Self, String> {
         if max_depth > 1 {
             return Err(format!(
                 "max_depth {max_depth} (the batch loop does direct lighting, max_depth 1)"
@@ -377,7 +381,9 @@ impl Batch<'_> {
                         d.light = Some(l);
                     }
                 }
-                lanes.keys.push((u64::from(pt.obj) << 32) | (2 * i + s) as u64);
+                lanes
+                    .keys
+                    .push((u64::from(pt.obj) << 32) | (2 * i + s) as u64);
             }
         }
         lanes.keys.sort_unstable();
@@ -434,7 +440,11 @@ impl Batch<'_> {
                             continue;
                         }
                         let v = d.f * l.radiance * d.wi.z;
-                        let p = if compensated { l.pdf_compensated } else { l.pdf };
+                        let p = if compensated {
+                            l.pdf_compensated
+                        } else {
+                            l.pdf
+                        };
                         sum += match pt.plan.mis {
                             None => v / p,
                             Some(h) => v * (h.weight(p, d.pdf) / p),
@@ -574,4 +584,3 @@ impl Batch<'_> {
         }
     }
 }
-
