@@ -51,7 +51,9 @@ and with the envmap's `mis_compensation` (Karlik et al. 2019: light samples
 from max(0, luminance - mean), which lobe's `mis` also does; --mis-compensation
 picks off, on or both). lobe: `lobe render --strategy mis` (one
 BSDF and one light sample per spp, MIS) as one process per render, timed from
-spawn to exit (loading the map, rendering, writing EXR + PNG).
+spawn to exit (loading the map, rendering, writing EXR + PNG); --lobe-sequence
+and --lobe-loop add rows for other sample patterns and for the scalar
+reference loop (`--loop scalar`) beside the default batch loop.
 
 Error: relative RMSE over the sphere pixels = sqrt(mean over those pixels and
 the three channels of (image - reference)^2) / (mean of the reference over
@@ -335,8 +337,11 @@ def main():
     p.add_argument("--samplers", default=",".join(SAMPLERS))
     p.add_argument("--lobe-strategy", default="mis", help="lobe render --strategy (default mis)")
     p.add_argument("--lobe-sequence", default="",
-                   help="comma-separated `lobe render --sequence` values, one lobe row each (issue 10 "
-                        "asks for the flag; lobe 0.1 does not have it yet: leave empty)")
+                   help="comma-separated `lobe render --sequence` values (sobol, stratified, independent), "
+                        "one lobe row each (default: lobe's default, sobol)")
+    p.add_argument("--lobe-loop", default="",
+                   help="comma-separated `lobe render --loop` values (batch, scalar), one lobe row each "
+                        "per --lobe-sequence (default: lobe's default loop, batch)")
     p.add_argument("--mis-compensation", choices=["off", "on", "both"], default="both",
                    help="Mitsuba envmap mis_compensation (Karlik et al. 2019; default: both, one row each)")
     p.add_argument("--ref-spp", type=int, default=16384)
@@ -419,15 +424,18 @@ def main():
                                args.max_seconds, args.max_spp, log)
 
     seqs = [q.strip() for q in args.lobe_sequence.split(",") if q.strip()] or [None]
-    for seq in [] if args.skip_lobe else seqs:
-        name = f"lobe {args.lobe_strategy}" + (f" --sequence {seq}" if seq else "")
+    loops = [q.strip() for q in args.lobe_loop.split(",") if q.strip()] or [None]
+    for seq, lp in [] if args.skip_lobe else [(q, l) for q in seqs for l in loops]:
+        name = (f"lobe {args.lobe_strategy}" + (f" --sequence {seq}" if seq else "")
+                + (f" --loop {lp}" if lp else ""))
         print(name, file=sys.stderr, flush=True)
 
-        def render_lobe(spp, k, seq=seq):
-            out = os.path.join(args.out, f"lobe-{seq + '-' if seq else ''}{spp}")
+        def render_lobe(spp, k, seq=seq, lp=lp):
+            tag = (seq + "-" if seq else "") + (lp + "-" if lp else "")
+            out = os.path.join(args.out, f"lobe-{tag}{spp}")
             cmd = [args.lobe, "render", lobe_scene, "--spp", str(spp), "--seed", str(k + 1),
                    "--threads", str(args.threads), "--strategy", args.lobe_strategy,
-                   "--out", out, "-q"] + (["--sequence", seq] if seq else [])
+                   "--out", out, "-q"] + (["--sequence", seq] if seq else []) + (["--loop", lp] if lp else [])
             c0 = cpu_time(resource.RUSAGE_CHILDREN)
             t0 = time.perf_counter()
             r = subprocess.run(cmd, capture_output=True, text=True)
@@ -494,7 +502,7 @@ def main():
             json.dump({"reference_err": ref_err, "ladders": results}, f, indent=2)
     for name in log["last_img"]:
         save_png(os.path.join(args.out, name.replace(" + ", "+").replace(" --sequence ", "-")
-                              .replace(" ", "-") + ".png"),
+                              .replace(" --loop ", "-").replace(" ", "-") + ".png"),
                  log["last_img"][name])
 
 

@@ -4,7 +4,7 @@ use crate::common::progress;
 use anyhow::{Result, anyhow, bail};
 use clap::Args;
 use lobe::estimator::Strategy;
-use lobe_render::integrator::render_progressive;
+use lobe_render::integrator::{RenderLoop, batch_refusal, render_progressive};
 use lobe_render::{fallbacks, load_scene, render};
 use std::path::PathBuf;
 use std::time::Instant;
@@ -55,6 +55,12 @@ pub struct RenderArgs {
     /// Worker threads (default: one per core)
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=4096))]
     pub threads: Option<u32>,
+    /// The loop that renders: batch (the default: blocks of samples on the
+    /// f32 SIMD kernels of lobe::batch, direct lighting; a scene or
+    /// technique it does not cover is rendered by the scalar loop, with a
+    /// note) or scalar (the f64 reference loop)
+    #[arg(long = "loop", value_name = "LOOP")]
+    pub render_loop: Option<String>,
     /// Output name: writes NAME.exr (linear) and NAME.png (tone-mapped,
     /// sRGB) (default: the scene file's stem, in the current directory)
     #[arg(long, value_name = "NAME")]
@@ -155,6 +161,9 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         Some(t) => bail!("--time {t}: must be a number of seconds in (0, 1e7]"),
     };
     opts.threads = args.threads.map(|t| t as usize);
+    if let Some(l) = &args.render_loop {
+        opts.render_loop = l.parse().map_err(|m| anyhow!("--loop: {m}"))?;
+    }
     scene.options = opts;
     for w in &scene.warnings {
         eprintln!("lobe: warning: {w}");
@@ -184,6 +193,13 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             "--spp {}: the sobol sequence has 2^32 points per pixel; use fewer spp or --sequence stratified",
             opts.spp
         );
+    }
+    // Said after every check of the arguments, so that an error stays one line.
+    if !args.quiet
+        && opts.render_loop == RenderLoop::Batch
+        && let Some(why) = batch_refusal(&scene, opts.strategy, opts.max_depth)
+    {
+        eprintln!("lobe: note: the scalar loop renders this: {why}");
     }
     let pb = progress(total, "rendering", args.quiet);
     let template = if budget.is_some() {

@@ -107,6 +107,20 @@ fn writes_exr_and_png() {
         "{stdout}"
     );
     assert!(d.join("scene.exr").exists() && d.join("scene.png").exists());
+
+    // The Phong plane has no batch kernels: the scalar loop renders the
+    // scene, and says so once; with --loop scalar there is nothing to say.
+    let note = |extra: &[&str]| {
+        let mut args = vec!["render", "scene.toml", "--spp", "1", "--out", "n"];
+        args.extend_from_slice(extra);
+        let o = lobe(&args, Some(&d));
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        String::from_utf8_lossy(&o.stderr).into_owned()
+    };
+    let e = note(&[]);
+    assert_eq!(e.matches("the scalar loop renders this").count(), 1, "{e}");
+    assert!(e.contains("object 1 (phong"), "{e}");
+    assert!(!note(&["--loop", "scalar"]).contains("scalar loop"));
 }
 
 #[test]
@@ -193,6 +207,11 @@ fn errors_are_one_line_and_name_file_line_and_field() {
         None,
     ));
     assert!(e.contains("--strategy: unknown strategy `fast`"), "{e}");
+    let e = one_line_error(&lobe(
+        &["render", scene.to_str().unwrap(), "--loop", "fast"],
+        None,
+    ));
+    assert!(e.contains("--loop: unknown loop `fast`"), "{e}");
     let e = one_line_error(&lobe(
         &["render", d.join("none.toml").to_str().unwrap()],
         None,

@@ -177,6 +177,7 @@ pub fn run_comparison(
             sequence: s.sequence,
             max_depth: s.max_depth,
             threads: s.threads,
+            ..RenderOptions::default()
         };
         render_one(scene, &opts, &label(method, spp, what), progress, clock)
     };

@@ -73,9 +73,35 @@
 //! fresh stratification for `stratified`. [`render_progressive`] averages
 //! whole passes until a time budget is spent; its image depends only on the
 //! number of passes.
+//!
+//! # Batch loop
+//!
+//! [`RenderOptions::render_loop`] is [`RenderLoop::Batch`] by default: for
+//! direct lighting (`max_depth = 1`) with a BSDF strategy, `light`, or MIS
+//! with one BSDF and one light draw (`mis`, `mis-balance`, `mis-power`),
+//! each row is rendered in blocks of [`BLOCK`] samples (consecutive samples
+//! of consecutive pixels): the camera rays and their hits (f64, scalar),
+//! then every BSDF draw of the block in one
+//! [`lobe::batch::BatchSampler::sample`] call per object and every light
+//! draw's `f` and BSDF pdf in one [`lobe::batch::BatchSampler::eval_pdf`]
+//! call per object (f32 lanes, structure of arrays, AVX-512 / AVX2 /
+//! portable as [`lobe::batch::SimdLevel::from_env`] says), the light draws
+//! from [`lobe::envmap::EnvMap::sample_lookup`] (guide-table CDF inversion,
+//! O(1) per sample, with the drawn texel's radiance and pdfs), each BSDF
+//! direction's radiance and pdfs from one [`lobe::envmap::EnvMap::lookup`],
+//! then the block's shadow rays. It draws the same numbers from the same
+//! dimensions as the scalar loop and weights them the same way, so the two
+//! loops estimate the same image and, for one seed, agree to f32 rounding
+//! (the test `batch_loop_matches_the_scalar_loop`). Adaptive MIS's pilot
+//! runs on the scalar loop. Where the batch loop does not apply (bounces,
+//! one-sample MIS, a material without batch kernels: Phong, Blinn-Phong,
+//! `spherical-caps`, `bounded-vndf`), the scalar loop renders the whole
+//! image and [`batch_refusal`] says why (`lobe render` prints it once);
+//! [`RenderLoop::Scalar`] forces the scalar loop. Both give the same bits
+//! for any thread count.
 
 use crate::geometry::{Hit, spawn_ray};
-pub use crate::options::RenderOptions;
+pub use crate::options::{RenderLoop, RenderOptions};
 use crate::scene::Scene;
 use glam::{DVec2, DVec3};
 use lobe::estimator::{
@@ -88,6 +114,9 @@ use lobe::sequence::{Sequence, hash64, pair_point};
 use lobe::{BsdfSampler, BsdfStrategy, Frame, Material};
 use rayon::prelude::*;
 use std::time::{Duration, Instant};
+
+mod wavefront;
+pub use wavefront::{BLOCK, batch_refusal};
 
 /// The dimension pairs of one sample ([`lobe::sequence::pair_point`]).
 pub mod dims {
@@ -390,9 +419,11 @@ fn context<'a>(
     light: &'a Light,
     shading: &'a [ObjectShading<'a>],
     progress: &'a (dyn Fn(u64) + Sync),
+    batch: Option<&'a wavefront::Batch<'a>>,
 ) -> Context<'a> {
     Context {
         progress,
+        batch,
         scene,
         light,
         shading,
@@ -434,7 +465,7 @@ fn pilot_phase(scene: &Scene, opts: &RenderOptions) -> (Vec<Pilot>, RenderStats)
         spp: pilot_spp(opts.spp.max(1)),
         ..*opts
     };
-    let ctx = context(scene, &pilot_opts, 0, &light, &shading, &|_| {});
+    let ctx = context(scene, &pilot_opts, 0, &light, &shading, &|_| {}, None);
     let k = ctx.spp;
     let rows: Vec<(Vec<(Rgb, Pilot)>, RenderStats)> = (0..h)
         .into_par_iter()
@@ -486,7 +517,21 @@ fn render_on_pool(
     let (w, h) = (scene.camera.width as usize, scene.camera.height as usize);
     let shading = shadings(scene, opts);
     let light = Light::Env(scene.environment.clone());
-    let ctx = context(scene, opts, pass, &light, &shading, progress);
+    let batch = match opts.render_loop {
+        RenderLoop::Batch => {
+            wavefront::Batch::new(scene, opts.strategy, opts.max_depth.max(1)).ok()
+        }
+        RenderLoop::Scalar => None,
+    };
+    let ctx = context(
+        scene,
+        opts,
+        pass,
+        &light,
+        &shading,
+        progress,
+        batch.as_ref(),
+    );
     let mut img = Image::new(w, h);
     if w == 0 || h == 0 {
         return (img, Vec::new());
@@ -535,6 +580,9 @@ fn render_rows(
         .par_chunks_mut(w)
         .enumerate()
         .map(|(y, row)| {
+            if let Some(b) = ctx.batch {
+                return b.row(ctx, y, row, &|x| plan(x, y).1);
+            }
             let mut stats = RenderStats::default();
             for (x, px) in row.iter_mut().enumerate() {
                 let (range, mode) = plan(x, y);
@@ -557,6 +605,8 @@ const PROGRESS_STEP: u64 = 4096;
 
 struct Context<'a> {
     progress: &'a (dyn Fn(u64) + Sync),
+    /// The batch loop, where it renders the scene (never for the pilot).
+    batch: Option<&'a wavefront::Batch<'a>>,
     scene: &'a Scene,
     light: &'a Light,
     shading: &'a [ObjectShading<'a>],

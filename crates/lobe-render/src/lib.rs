@@ -30,7 +30,11 @@
 //!     .with(Object::sphere(DVec3::ZERO, 1.0, Material::lambert(Rgb::ONE)?)?);
 //! let opts = RenderOptions { spp: 4, strategy: Strategy::Bsdf(BsdfStrategy::Cosine), ..Default::default() };
 //! let img = render(&scene, &opts, |_| {});
-//! assert!((img.get(4, 3).x - 1.0).abs() < 1e-9); // the white furnace
+//! // The white furnace: 1 to f32 rounding on the batch loop (the default)...
+//! assert!((img.get(4, 3).x - 1.0).abs() < 1e-6);
+//! // ... and to f64 rounding on the scalar one.
+//! let opts = RenderOptions { render_loop: lobe_render::RenderLoop::Scalar, ..opts };
+//! assert!((render(&scene, &opts, |_| {}).get(4, 3).x - 1.0).abs() < 1e-9);
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
@@ -49,6 +53,6 @@ pub use envmap_io::{LoadError, LoadedEnvMap, load_envmap, load_envmap_checked};
 pub use geometry::{Hit, Ray};
 pub use integrator::{Image, RenderStats, fallbacks, render, strategy_for};
 pub use mesh::{Mesh, MeshError};
-pub use options::RenderOptions;
+pub use options::{RenderLoop, RenderOptions};
 pub use output::{OutputError, ToneMap};
 pub use scene::{Object, Scene, SceneDesc, SceneError, Shape, load_scene, parse_scene, showcase};

@@ -23,6 +23,47 @@ pub struct RenderOptions {
     pub max_depth: u32,
     /// Threads of a local pool; `None` runs on rayon's current pool.
     pub threads: Option<usize>,
+    /// The batch loop (the default) or the scalar one, its reference.
+    pub render_loop: RenderLoop,
+}
+
+/// Which loop renders: the batch (wavefront) loop on `lobe::batch`'s f32
+/// SIMD kernels where it covers the scene and the technique
+/// ([`crate::integrator::batch_refusal`] says why not; the scalar loop
+/// renders it then), or the scalar f64 loop, the reference.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub enum RenderLoop {
+    #[default]
+    Batch,
+    Scalar,
+}
+
+impl RenderLoop {
+    pub const ALL: [RenderLoop; 2] = [RenderLoop::Batch, RenderLoop::Scalar];
+
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            RenderLoop::Batch => "batch",
+            RenderLoop::Scalar => "scalar",
+        }
+    }
+}
+
+impl std::fmt::Display for RenderLoop {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::str::FromStr for RenderLoop {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        RenderLoop::ALL
+            .into_iter()
+            .find(|l| l.name() == s)
+            .ok_or_else(|| format!("unknown loop `{s}`, expected one of: batch, scalar"))
+    }
 }
 
 impl Default for RenderOptions {
@@ -34,6 +75,7 @@ impl Default for RenderOptions {
             sequence: Sequence::Sobol,
             max_depth: 1,
             threads: None,
+            render_loop: RenderLoop::Batch,
         }
     }
 }

@@ -35,7 +35,7 @@ use crate::camera::{Camera, CameraError};
 use crate::envmap_io::load_envmap_checked;
 use crate::geometry::{Hit, Plane, Ray, Sphere};
 use crate::mesh::Mesh;
-use crate::options::RenderOptions;
+use crate::options::{RenderLoop, RenderOptions};
 use glam::DVec3;
 use lobe::envmap::EnvMap;
 use lobe::estimator::Strategy;
@@ -639,6 +639,7 @@ fn build(desc: &SceneDesc, base: &Path) -> FieldResult<Scene> {
         sequence,
         max_depth: r.max_depth,
         threads: None,
+        render_loop: RenderLoop::Batch,
     };
     let mut meshes: HashMap<PathBuf, Arc<Mesh>> = HashMap::new();
     for (i, o) in desc.objects.iter().enumerate() {

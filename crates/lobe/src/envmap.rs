@@ -136,11 +136,44 @@ impl Distribution1D {
     }
 }
 
+/// Radiance and the two light-sampling densities of one direction
+/// ([`EnvMap::lookup`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EnvLookup {
+    /// The radiance arriving from the direction ([`EnvMap::eval`]).
+    pub radiance: Rgb,
+    /// [`EnvMap::pdf`], solid angle.
+    pub pdf: f64,
+    /// [`EnvMap::pdf_compensated`], solid angle.
+    pub pdf_compensated: f64,
+}
+
+/// `atan(t)` for `t ∈ [0, 1]` within 2e-5 (a polynomial: a guess that
+/// [`EnvMap::texel_index`] corrects).
+#[inline]
+fn atan_01(t: f64) -> f64 {
+    let t2 = t * t;
+    t * (0.999_866 + t2 * (-0.330_299_5 + t2 * (0.180_141 + t2 * (-0.085_133 + t2 * 0.020_835_1))))
+}
+
+/// `acos(y)` within 1e-4 (Abramowitz and Stegun 4.4.45), a guess.
+#[inline]
+fn acos_guess(y: f64) -> f64 {
+    let x = y.abs();
+    let r = (1.0 - x).max(0.0).sqrt()
+        * (1.570_728_8 + x * (-0.212_114_4 + x * (0.074_261 - 0.018_729_3 * x)));
+    if y < 0.0 { PI - r } else { r }
+}
+
 /// An equirectangular environment map with its sampling distribution.
 #[derive(Debug, Clone, PartialEq)]
 pub struct EnvMap {
     width: usize,
     height: usize,
+    /// `cos(π j / height)` for `j = 0..=height`: the rows' edges.
+    row_cos: Vec<f64>,
+    /// `(sin, cos)(2π i / width)` for `i = 0..=width`: the columns' edges.
+    col_cs: Vec<(f64, f64)>,
     texels: Vec<Rgb>,
     scale: f64,
     /// cos and sin of the rotation about +Y.
@@ -276,6 +309,12 @@ impl EnvMap {
             EnvMap {
                 width,
                 height,
+                row_cos: (0..=height)
+                    .map(|j| (PI * j as f64 / height as f64).cos())
+                    .collect(),
+                col_cs: (0..=width)
+                    .map(|i| (2.0 * PI * i as f64 / width as f64).sin_cos())
+                    .collect(),
                 texels,
                 scale,
                 rot: (r.cos(), r.sin()),
@@ -344,7 +383,64 @@ impl EnvMap {
         DVec3::new(c * d.x - s * d.z, d.y, s * d.x + c * d.z)
     }
 
+    /// The texel of unit world direction `d`, as `direction_to_uv`'s
+    /// `(⌊u·width⌋, ⌊v·height⌋)` would give it, without `atan2` and `acos`:
+    /// a polynomial guess of `φ` and `θ` (error under 1e-4 rad), corrected
+    /// by exact comparisons with the texel edges (the signs of
+    /// `sin(φ − φ_k)` and of `cos θ − cos θ_k`). The two differ only for a
+    /// direction within rounding of an edge.
+    #[inline]
     fn texel_index(&self, d: DVec3) -> (usize, usize) {
+        let d = self.unrotate(d);
+        let (w, h) = (self.width, self.height);
+        // φ = atan2(sx, cx) in (−π, π]: u = φ / 2π, wrapped.
+        let (sx, cx) = (d.x, -d.z);
+        let mut i = 0;
+        let (ax, ay) = (cx.abs(), sx.abs());
+        let (lo, hi) = if ay > ax { (ax, ay) } else { (ay, ax) };
+        // (hi = 0: a pole, column 0.)
+        if w > 1 && hi > 0.0 {
+            let t = lo / hi;
+            let mut a = atan_01(t);
+            if ay > ax {
+                a = 0.5 * PI - a;
+            }
+            if cx < 0.0 {
+                a = PI - a;
+            }
+            let mut u = a / (2.0 * PI);
+            if sx < 0.0 {
+                u = 1.0 - u;
+            }
+            // As `direction_to_uv`: a u that rounds to 1 is 0.
+            if u >= 1.0 {
+                u = 0.0;
+            }
+            i = ((u * w as f64) as usize).min(w - 1);
+            // sin(φ − φ_k) ≥ 0: at or past edge k.
+            let past = |k: usize| sx * self.col_cs[k].1 - cx * self.col_cs[k].0 >= 0.0;
+            while i > 0 && !past(i) {
+                i -= 1;
+            }
+            while i + 1 < w && past(i + 1) {
+                i += 1;
+            }
+        }
+        // Row j: cos θ_{j+1} < y ≤ cos θ_j.
+        let y = d.y.clamp(-1.0, 1.0);
+        let mut j = ((acos_guess(y) * (h as f64 / PI)) as usize).min(h - 1);
+        while j > 0 && y > self.row_cos[j] {
+            j -= 1;
+        }
+        while j + 1 < h && y <= self.row_cos[j + 1] {
+            j += 1;
+        }
+        (i, j)
+    }
+
+    /// The texel by `direction_to_uv` (the reference of `texel_index`).
+    #[cfg(test)]
+    fn texel_index_by_uv(&self, d: DVec3) -> (usize, usize) {
         let uv = self.direction_to_uv(d);
         let i = ((uv.x * self.width as f64) as usize).min(self.width - 1);
         let j = ((uv.y * self.height as f64) as usize).min(self.height - 1);
@@ -410,6 +506,63 @@ impl EnvMap {
         }
         let (i, j) = self.texel_index(d);
         t.weights[j * self.width + i] / t.norm
+    }
+
+    /// Radiance and both densities ([`EnvMap::pdf`],
+    /// [`EnvMap::pdf_compensated`]) at world direction `d` (unit), from one
+    /// texel lookup: the same values as the three calls.
+    #[inline]
+    #[must_use]
+    pub fn lookup(&self, d: DVec3) -> EnvLookup {
+        let (i, j) = self.texel_index(d);
+        self.texel_lookup(j * self.width + i)
+    }
+
+    #[inline]
+    fn texel_lookup(&self, k: usize) -> EnvLookup {
+        let pdf = |t: &TexelSampler| {
+            if t.norm > 0.0 {
+                t.weights[k] / t.norm
+            } else {
+                0.0
+            }
+        };
+        EnvLookup {
+            radiance: self.texels[k] * self.scale,
+            pdf: pdf(&self.plain),
+            pdf_compensated: pdf(&self.compensated),
+        }
+    }
+
+    /// Draw a world direction as [`EnvMap::sample`] (`compensated = false`)
+    /// or [`EnvMap::sample_compensated`] (`true`) do, from the same
+    /// distribution over the texels and uniformly in solid angle inside the
+    /// texel, and return it with the [`EnvLookup`] of the texel it was drawn
+    /// in (no second lookup, and no `acos`: `sin θ` comes from `cos θ`).
+    /// `None` for a black map. The direction can differ from
+    /// [`EnvMap::sample`]'s in its last bits.
+    #[inline]
+    #[must_use]
+    pub fn sample_lookup(&self, compensated: bool, u: DVec2) -> Option<(DVec3, EnvLookup)> {
+        let t = if compensated {
+            &self.compensated
+        } else {
+            &self.plain
+        };
+        let (j, ru) = t.rows.sample(u.x)?;
+        let (i, rv) = t.cols[j].sample(u.y)?;
+        let (c0, c1) = (self.row_cos[j], self.row_cos[j + 1]);
+        let ct = (c0 + (c1 - c0) * ru).clamp(c1.min(c0), c0.max(c1));
+        let st = (1.0 - ct * ct).max(0.0).sqrt();
+        let (sp, cp) = (2.0 * PI * (i as f64 + rv) / self.width as f64).sin_cos();
+        let d = self.rotate(DVec3::new(st * sp, ct, -st * cp));
+        let l = self.texel_lookup(j * self.width + i);
+        let p = if compensated {
+            l.pdf_compensated
+        } else {
+            l.pdf
+        };
+        (p > 0.0).then_some((d, l))
     }
 
     /// The solid-angle region of texel `(i, j)`: `(θ₀, θ₁)`, `(φ₀, φ₁)` in the
@@ -585,5 +738,86 @@ mod tests {
                 .sample(DVec2::splat(0.5))
                 .is_none()
         );
+    }
+
+    /// The fast texel search agrees with `direction_to_uv`'s texel except
+    /// within rounding of an edge; the guesses are within their bounds.
+    #[test]
+    fn texel_index_agrees_with_direction_to_uv() {
+        let mut worst: f64 = 0.0;
+        for k in 0..=1000 {
+            let t = k as f64 / 1000.0;
+            worst = worst.max((atan_01(t) - t.atan()).abs());
+            let y = 2.0 * t - 1.0;
+            assert!((acos_guess(y) - y.acos()).abs() < 1e-4, "acos {y}");
+        }
+        assert!(worst < 2e-5, "atan {worst}");
+        for (w, h, rot) in [(64, 32, 33.0), (1024, 512, 0.0), (3, 2, -10.0), (1, 1, 0.0)] {
+            let (m, _) = EnvMap::new(w, h, vec![Rgb::ONE; w * h], 1.0, rot).unwrap();
+            let mut state = 0x9e37_79b9_7f4a_7c15u64;
+            let mut next = || {
+                state = crate::sequence::hash64(state);
+                (state >> 11) as f64 / (1u64 << 53) as f64
+            };
+            for _ in 0..20_000 {
+                let d = crate::warp::square_to_uniform_sphere(DVec2::new(next(), next()));
+                let (a, b) = (m.texel_index(d), m.texel_index_by_uv(d));
+                if a != b {
+                    let uv = m.direction_to_uv(d);
+                    let (fu, fv) = (uv.x * w as f64, uv.y * h as f64);
+                    let edge = |x: f64| (x - x.round()).abs() < 1e-9;
+                    assert!(edge(fu) || edge(fv), "{w}x{h} {d}: {a:?} vs {b:?}");
+                }
+            }
+            // Poles, the seam and the axes.
+            for d in [
+                DVec3::Y,
+                -DVec3::Y,
+                DVec3::X,
+                -DVec3::X,
+                DVec3::Z,
+                -DVec3::Z,
+            ] {
+                let (i, j) = m.texel_index(d);
+                assert!(i < w && j < h);
+            }
+        }
+    }
+
+    /// `sample_lookup` draws inside the texel whose lookup it returns, that
+    /// lookup is `lookup` of the direction, and it is `sample`'s
+    /// distribution (the same texel for the same numbers).
+    #[test]
+    fn sample_lookup_agrees_with_sample_and_lookup() {
+        let (m, _) = EnvMap::new(
+            64,
+            32,
+            EnvMap::sky(64, 32, 30.0, 40.0).texels.clone(),
+            1.5,
+            33.0,
+        )
+        .unwrap();
+        for comp in [false, true] {
+            for k in 0..2000 {
+                let u = DVec2::new(
+                    (k as f64 * 0.618_033_988_7 + 0.01) % 1.0,
+                    (k as f64 * 0.414_213_562 + 0.02) % 1.0,
+                );
+                let (d, l) = m.sample_lookup(comp, u).unwrap();
+                assert!((d.length() - 1.0).abs() < 1e-12);
+                let (d0, p0) = if comp {
+                    m.sample_compensated(u).unwrap()
+                } else {
+                    m.sample(u).unwrap()
+                };
+                assert!((d - d0).length() < 1e-9, "{d} {d0}");
+                let p = if comp { l.pdf_compensated } else { l.pdf };
+                assert!((p - p0).abs() <= 1e-12 * p0);
+                assert_eq!(m.lookup(d), l);
+                assert_eq!(l.radiance, m.eval(d));
+                assert_eq!(l.pdf, m.pdf(d));
+                assert_eq!(l.pdf_compensated, m.pdf_compensated(d));
+            }
+        }
     }
 }

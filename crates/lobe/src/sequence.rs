@@ -210,12 +210,101 @@ const fn matrices() -> [[u32; 32]; 4] {
     v
 }
 
+#[cfg(test)]
 static SOBOL_MATRICES: [[u32; 32]; 4] = matrices();
+
+/// `SOBOL_BYTES[d][b][v]`: the xor of the generator columns of dimension
+/// `d` selected by the bits of byte value `v` at byte `b` of the index, so
+/// that a point is four table lookups instead of a loop over 32 bits.
+const fn byte_tables() -> [[[u32; 256]; 4]; 4] {
+    let m = matrices();
+    let mut t = [[[0u32; 256]; 4]; 4];
+    let mut d = 0;
+    while d < 4 {
+        let mut b = 0;
+        while b < 4 {
+            let mut v = 0;
+            while v < 256 {
+                let mut x = 0u32;
+                let mut k = 0;
+                while k < 8 {
+                    if (v >> k) & 1 == 1 {
+                        x ^= m[d][8 * b + k];
+                    }
+                    k += 1;
+                }
+                t[d][b][v] = x;
+                v += 1;
+            }
+            b += 1;
+        }
+        d += 1;
+    }
+    t
+}
+
+static SOBOL_BYTES: [[[u32; 256]; 4]; 4] = byte_tables();
+
+/// The byte tables of the bit-reversed point of a bit-reversed index:
+/// `SOBOL_REV[d]` applied to `i.reverse_bits()` gives
+/// `sobol(i, d).reverse_bits()`. Burley's scramble works on reversed bits,
+/// so [`pair_point_seeded`] stays in reversed order between its scrambles
+/// and reverses three times per pair instead of six.
+const fn reversed_tables() -> [[[u32; 256]; 4]; 4] {
+    let m = matrices();
+    let mut t = [[[0u32; 256]; 4]; 4];
+    let mut d = 0;
+    while d < 4 {
+        let mut b = 0;
+        while b < 4 {
+            let mut v = 0;
+            while v < 256 {
+                let mut x = 0u32;
+                let mut k = 0;
+                while k < 8 {
+                    if (v >> k) & 1 == 1 {
+                        x ^= m[d][31 - (8 * b + k)].reverse_bits();
+                    }
+                    k += 1;
+                }
+                t[d][b][v] = x;
+                v += 1;
+            }
+            b += 1;
+        }
+        d += 1;
+    }
+    t
+}
+
+static SOBOL_REV: [[[u32; 256]; 4]; 4] = reversed_tables();
+
+/// `sobol(r.reverse_bits(), d).reverse_bits()`.
+#[inline]
+fn sobol_reversed(r: u32, d: usize) -> u32 {
+    let t = &SOBOL_REV[d];
+    t[0][(r & 0xff) as usize]
+        ^ t[1][((r >> 8) & 0xff) as usize]
+        ^ t[2][((r >> 16) & 0xff) as usize]
+        ^ t[3][(r >> 24) as usize]
+}
 
 /// Point `i` of the unscrambled Sobol sequence in dimension `d` (< 4), as a
 /// 32-bit fixed-point fraction.
+#[inline]
 #[must_use]
-pub fn sobol(mut i: u32, d: usize) -> u32 {
+pub fn sobol(i: u32, d: usize) -> u32 {
+    let t = &SOBOL_BYTES[d];
+    t[0][(i & 0xff) as usize]
+        ^ t[1][((i >> 8) & 0xff) as usize]
+        ^ t[2][((i >> 16) & 0xff) as usize]
+        ^ t[3][(i >> 24) as usize]
+}
+
+/// Point `i` of dimension `d` by the loop over the index's bits (the
+/// reference for the byte tables).
+#[cfg(test)]
+fn sobol_by_bits(mut i: u32, d: usize) -> u32 {
     let mut x = 0;
     let mut k = 0;
     while i != 0 {
@@ -232,13 +321,18 @@ pub fn sobol(mut i: u32, d: usize) -> u32 {
 /// reversed bits, so that each bit is flipped by a hash of the bits above it.
 #[must_use]
 pub fn nested_uniform_scramble(x: u32, seed: u32) -> u32 {
-    let mut v = x.reverse_bits();
+    laine_karras(x.reverse_bits(), seed).reverse_bits()
+}
+
+/// The hash of [`nested_uniform_scramble`] on bits already reversed.
+#[inline]
+fn laine_karras(mut v: u32, seed: u32) -> u32 {
     v = v.wrapping_add(seed);
     v ^= v.wrapping_mul(0x6c50_b47c);
     v ^= v.wrapping_mul(0xb82f_1e52);
     v ^= v.wrapping_mul(0xc7af_e638);
     v ^= v.wrapping_mul(0x8d22_f6e6);
-    v.reverse_bits()
+    v
 }
 
 /// A 64-bit mixing hash (SplitMix64's finalizer).
@@ -303,9 +397,27 @@ pub fn permute(i: u64, n: u64, seed: u32) -> u64 {
 ///
 /// `seed` selects the randomization (one per pixel); `n` matters only to
 /// `Stratified`. The numbers are in [0, 1).
+#[inline]
 #[must_use]
 pub fn pair_point(seq: Sequence, seed: u64, n: u64, index: u64, dim: u32) -> [f64; 2] {
-    let s = hash64(seed ^ hash64(0x7061_6972_0000_0000 ^ u64::from(dim)));
+    pair_point_seeded(seq, pair_seed(seed, dim), n, index)
+}
+
+/// The randomization of dimension pair `dim` under `seed`, the first step
+/// of [`pair_point`]: a caller that draws many samples of one pair (a
+/// renderer's pixel) computes it once and calls [`pair_point_seeded`].
+#[inline]
+#[must_use]
+pub fn pair_seed(seed: u64, dim: u32) -> u64 {
+    hash64(seed ^ hash64(0x7061_6972_0000_0000 ^ u64::from(dim)))
+}
+
+/// [`pair_point`] with the pair's randomization `s = pair_seed(seed, dim)`
+/// already computed: `pair_point_seeded(q, pair_seed(seed, d), n, i)` is
+/// `pair_point(q, seed, n, i, d)`, bit for bit.
+#[inline]
+#[must_use]
+pub fn pair_point_seeded(seq: Sequence, s: u64, n: u64, index: u64) -> [f64; 2] {
     let unit = |bits: u64| (bits >> 11) as f64 * (1.0 / (1u64 << 53) as f64);
     match seq {
         Sequence::Independent => {
@@ -331,9 +443,11 @@ pub fn pair_point(seq: Sequence, seed: u64, n: u64, index: u64, dim: u32) -> [f6
         }
         Sequence::Sobol => {
             debug_assert!(index <= u64::from(u32::MAX));
-            let i = nested_uniform_scramble(index as u32, s as u32);
-            let x = nested_uniform_scramble(sobol(i, 0), (s >> 32) as u32);
-            let y = nested_uniform_scramble(sobol(i, 1), hash64(s) as u32);
+            // nested_uniform_scramble(sobol(nested_uniform_scramble(index)))
+            // per coordinate, kept in reversed bit order in between.
+            let ir = laine_karras((index as u32).reverse_bits(), s as u32);
+            let x = laine_karras(sobol_reversed(ir, 0), (s >> 32) as u32).reverse_bits();
+            let y = laine_karras(sobol_reversed(ir, 1), hash64(s) as u32).reverse_bits();
             let k = 1.0 / 4_294_967_296.0;
             [f64::from(x) * k, f64::from(y) * k]
         }
@@ -393,6 +507,41 @@ mod tests {
         // Progressive: the sequence goes on past n.
         let later = pair_point(Sequence::Sobol, 3, n, 300, 5);
         assert!(later.iter().all(|x| (0.0..1.0).contains(x)));
+    }
+
+    #[test]
+    fn sobol_byte_tables_match_the_bit_loop() {
+        let mut x = 0x1234_5678u32;
+        for k in 0..20_000u32 {
+            x = x.wrapping_mul(0x9e37_79b9).wrapping_add(k);
+            let i = if k < 1000 { k } else { x };
+            for d in 0..4 {
+                assert_eq!(sobol(i, d), sobol_by_bits(i, d), "index {i} dimension {d}");
+            }
+        }
+        for k in 0..5000u32 {
+            let r = k.wrapping_mul(0x9e37_79b9) ^ (k << 7);
+            for d in 0..4 {
+                assert_eq!(
+                    sobol_reversed(r, d),
+                    sobol_by_bits(r.reverse_bits(), d).reverse_bits()
+                );
+            }
+            // pair_point is the three scrambles of the definition.
+            let s = pair_seed(9, k % 7);
+            let i = nested_uniform_scramble(k, s as u32);
+            let x = nested_uniform_scramble(sobol(i, 0), (s >> 32) as u32);
+            let y = nested_uniform_scramble(sobol(i, 1), hash64(s) as u32);
+            let k2 = 1.0 / 4_294_967_296.0;
+            assert_eq!(
+                pair_point(Sequence::Sobol, 9, 64, u64::from(k), k % 7),
+                [f64::from(x) * k2, f64::from(y) * k2]
+            );
+        }
+        assert_eq!(
+            pair_point(Sequence::Sobol, 9, 64, 17, 3),
+            pair_point_seeded(Sequence::Sobol, pair_seed(9, 3), 64, 17)
+        );
     }
 
     #[test]

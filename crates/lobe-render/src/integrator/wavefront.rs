@@ -1,0 +1,586 @@
+//! The batch loop: direct lighting in blocks of [`BLOCK`] samples, the BSDF
+//! sampled and evaluated by [`lobe::batch::BatchSampler`] (f32 lanes,
+//! structure of arrays) per object, the environment looked up once per
+//! direction ([`lobe::envmap::EnvMap::lookup`], [`lobe::envmap::EnvMap::sample_lookup`]),
+//! shadow rays traced for the whole block. See the parent module's doc
+//! ("Batch loop") for what it covers and how it is checked.
+
+use super::{Context, FirstBounce, RenderStats, dims, pixel_seed};
+use crate::geometry::spawn_ray;
+use crate::scene::Scene;
+use glam::{DVec2, DVec3};
+use lobe::batch::{BatchSampler, Dirs, DirsMut, EvalPdfOutput, RgbMut, SampleInput, SampleOutput};
+use lobe::envmap::{EnvLookup, EnvMap};
+use lobe::estimator::{Allocation, Heuristic, MisForm, Strategy};
+use lobe::math::Rgb;
+use lobe::sequence::{Sequence, hash64, pair_point_seeded, pair_seed};
+use lobe::{BsdfStrategy, Frame};
+
+/// Samples shaded together: camera rays, then every BSDF draw of the block
+/// in one [`BatchSampler::sample`] call per object, every light draw in one
+/// [`BatchSampler::eval_pdf`] call per object, then the shadow rays.
+pub const BLOCK: usize = 256;
+
+/// The technique of a render, as the batch loop runs it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Kind {
+    /// One BSDF draw.
+    Bsdf,
+    /// One light draw from the plain distribution.
+    Light,
+    /// One BSDF and one compensated light draw, weighted by the heuristic.
+    Mis(Heuristic),
+    /// Adaptive MIS: per pixel, as the allocation says.
+    Adaptive,
+}
+
+/// What one of a sample's two draws is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Slot {
+    Unused,
+    Bsdf,
+    Light { compensated: bool },
+}
+
+/// A pixel's draws and how they combine.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct PixelPlan {
+    slots: [Slot; 2],
+    /// `None`: the mean of the draws; `Some(h)`: slot 0 (BSDF) and slot 1
+    /// (compensated light) weighted by `h`.
+    mis: Option<Heuristic>,
+}
+
+/// The batch loop's state for one render: a batch sampler per object.
+#[derive(Debug)]
+pub(super) struct Batch<'a> {
+    samplers: Vec<BatchSampler>,
+    kind: Kind,
+    env: &'a EnvMap,
+}
+
+/// Why the batch loop does not render `scene` with `strategy` and
+/// `max_depth` (the scalar loop does), or `None` when it does.
+#[must_use]
+pub fn batch_refusal(scene: &Scene, strategy: Strategy, max_depth: u32) -> Option<String> {
+    Batch::new(scene, strategy, max_depth).err()
+}
+
+impl<'a> Batch<'a> {
+    pub(super) fn new(
+        scene: &'a Scene,
+        strategy: Strategy,
+        max_depth: u32,
+    ) -> Result<Self, String> {
+        if max_depth > 1 {
+            return Err(format!(
+                "max_depth {max_depth} (the batch loop does direct lighting, max_depth 1)"
+            ));
+        }
+        let kind = match strategy {
+            Strategy::Bsdf(_) => Kind::Bsdf,
+            Strategy::Light => Kind::Light,
+            Strategy::Mis(m) if m.n_bsdf == 1 && m.n_light == 1 => match m.form {
+                MisForm::MultiSample => Kind::Mis(m.heuristic),
+                MisForm::Adaptive => Kind::Adaptive,
+                MisForm::OneSample => {
+                    return Err(format!("one-sample MIS `{strategy}` (not batched)"));
+                }
+            },
+            Strategy::Mis(_) => {
+                return Err(format!(
+                    "MIS `{strategy}` with other than one BSDF and one light draw (not batched)"
+                ));
+            }
+        };
+        let mut samplers = Vec::with_capacity(scene.objects.len());
+        for (i, o) in scene.objects.iter().enumerate() {
+            let m = &o.material;
+            let est = super::object_shading(strategy, m).estimator;
+            // The scalar path's BSDF strategy for the object; light sampling
+            // only evaluates `f`, which every strategy's kernel gives.
+            let s = match est.sampler() {
+                Some(s) => s.strategy(),
+                None => m.best_bsdf_strategy(),
+            };
+            let b = BatchSampler::new(m, s)
+                .or_else(|e| match est.sampler() {
+                    None => BatchSampler::new(m, BsdfStrategy::Brdf),
+                    Some(_) => Err(e),
+                })
+                .map_err(|e| format!("object {i} ({}, {s}): {e}", m.model_name()))?;
+            samplers.push(b);
+        }
+        Ok(Batch {
+            samplers,
+            kind,
+            env: &scene.environment,
+        })
+    }
+
+    fn plan(&self, mode: FirstBounce) -> PixelPlan {
+        let mean = |slots| PixelPlan { slots, mis: None };
+        let mis = |h| PixelPlan {
+            slots: [Slot::Bsdf, Slot::Light { compensated: true }],
+            mis: Some(h),
+        };
+        let plain = Slot::Light { compensated: false };
+        match (self.kind, mode) {
+            (Kind::Bsdf, _) => mean([Slot::Bsdf, Slot::Unused]),
+            (Kind::Light, _) => mean([plain, Slot::Unused]),
+            (Kind::Mis(h), _) => mis(h),
+            (Kind::Adaptive, FirstBounce::Allocated(Allocation::Bsdf)) => {
+                mean([Slot::Bsdf, Slot::Bsdf])
+            }
+            (Kind::Adaptive, FirstBounce::Allocated(Allocation::Light)) => mean([plain, plain]),
+            (Kind::Adaptive, _) => mis(Heuristic::Balance),
+        }
+    }
+}
+
+/// Per sample of a block.
+#[derive(Debug, Clone, Copy)]
+struct Point {
+    /// The pixel's column.
+    x: u32,
+    /// The object hit (`u32::MAX`: none, or no light reflected: `value` is
+    /// the sample's value).
+    obj: u32,
+    p: DVec3,
+    ng: DVec3,
+    frame: Frame,
+    wo: DVec3,
+    plan: PixelPlan,
+    /// The numbers of the two draws, `[uc, u₁, u₂]`.
+    u: [[f64; 3]; 2],
+    value: Rgb,
+}
+
+/// Per draw (two per sample) of a block.
+#[derive(Debug, Clone, Copy, Default)]
+struct Draw {
+    /// A BSDF draw: `wi` local; a light draw: the world direction.
+    dir: DVec3,
+    /// The light draw's local `wi`.
+    wi: DVec3,
+    /// The light draw's lookup.
+    light: Option<EnvLookup>,
+    /// BSDF draw: the weight `f cos / p`; light draw: `f`.
+    f: Rgb,
+    /// BSDF draw: its pdf; light draw: the BSDF strategy's pdf at `wi`.
+    pdf: f64,
+    ok: bool,
+}
+
+/// Reusable structure-of-arrays buffers of one row.
+struct Lanes {
+    a: [Vec<f32>; 6],
+    out: [Vec<f32>; 10],
+    valid: Vec<u8>,
+    /// (object, draw index) of every BSDF or light draw, sorted by object.
+    keys: Vec<u64>,
+}
+
+impl Lanes {
+    fn new() -> Self {
+        let v = || vec![0.0f32; 2 * BLOCK];
+        Lanes {
+            a: std::array::from_fn(|_| v()),
+            out: std::array::from_fn(|_| v()),
+            valid: vec![0; 2 * BLOCK],
+            keys: Vec::with_capacity(2 * BLOCK),
+        }
+    }
+}
+
+/// The pair seeds of one pixel.
+#[derive(Debug, Clone, Copy)]
+struct PixelSeeds {
+    camera: u64,
+    bsdf_u: u64,
+    bsdf_uc: u64,
+    light: u64,
+}
+
+impl Batch<'_> {
+    /// Samples `0..spp` of every pixel of row `y`, the pixel sums (not
+    /// divided) into `row`; `modes[x]` is pixel `x`'s first-bounce mode.
+    pub(super) fn row(
+        &self,
+        ctx: &Context<'_>,
+        y: usize,
+        row: &mut [Rgb],
+        mode: &(dyn Fn(usize) -> FirstBounce + Sync),
+    ) -> RenderStats {
+        let mut stats = RenderStats::default();
+        let mut lanes = Lanes::new();
+        let mut pts: Vec<Point> = Vec::with_capacity(BLOCK);
+        let mut draws = vec![Draw::default(); 2 * BLOCK];
+        let spp = ctx.spp;
+        let total = row.len() as u64 * spp;
+        let mut k = 0u64;
+        while k < total {
+            let end = (k + BLOCK as u64).min(total);
+            pts.clear();
+            let mut cur: Option<(usize, PixelSeeds, PixelPlan, u64)> = None;
+            for f in k..end {
+                let (x, i) = ((f / spp) as usize, f % spp);
+                if cur.is_none_or(|c| c.0 != x) {
+                    let ps = pixel_seed(ctx.seed, (y * ctx.width + x) as u64);
+                    let seed = match ctx.sequence {
+                        Sequence::Stratified => hash64(ps ^ hash64(ctx.pass)),
+                        Sequence::Sobol | Sequence::Independent => ps,
+                    };
+                    let seeds = PixelSeeds {
+                        camera: pair_seed(seed, dims::CAMERA),
+                        bsdf_u: pair_seed(seed, dims::bsdf_u(0)),
+                        bsdf_uc: pair_seed(seed, dims::bsdf_uc(0)),
+                        light: pair_seed(seed, dims::light(0)),
+                    };
+                    cur = Some((x, seeds, self.plan(mode(x)), seed));
+                }
+                let (_, seeds, plan, _) = cur.expect("set above");
+                let index = match ctx.sequence {
+                    Sequence::Stratified => i,
+                    Sequence::Sobol | Sequence::Independent => ctx.pass * spp + i,
+                };
+                pts.push(self.camera_point(ctx, (x, y), index, &seeds, plan, &mut stats));
+            }
+            self.shade(ctx.scene, &mut pts, &mut draws, &mut lanes, &mut stats);
+            for pt in &pts {
+                if pt.value.is_finite() {
+                    row[pt.x as usize] += pt.value;
+                } else {
+                    stats.nonfinite += 1;
+                }
+            }
+            (ctx.progress)(end - k);
+            k = end;
+        }
+        stats
+    }
+
+    /// The camera ray of one sample, its hit and shading frame, and its
+    /// numbers.
+    fn camera_point(
+        &self,
+        ctx: &Context<'_>,
+        (x, y): (usize, usize),
+        index: u64,
+        seeds: &PixelSeeds,
+        plan: PixelPlan,
+        stats: &mut RenderStats,
+    ) -> Point {
+        let pair = |s: u64| DVec2::from_array(pair_point_seeded(ctx.sequence, s, ctx.spp, index));
+        let j = pair(seeds.camera);
+        let ray = ctx.scene.camera.ray(x as f64 + j.x, y as f64 + j.y);
+        stats.camera_rays += 1;
+        stats.rays += 1;
+        let mut pt = Point {
+            x: x as u32,
+            obj: u32::MAX,
+            p: DVec3::ZERO,
+            ng: DVec3::Z,
+            frame: Frame::from_normal(DVec3::Z),
+            wo: DVec3::Z,
+            plan,
+            u: [[0.0; 3]; 2],
+            value: Rgb::ZERO,
+        };
+        let Some((hit, obj)) = ctx.scene.intersect(&ray, f64::INFINITY) else {
+            pt.value = self.env.eval(ray.dir);
+            return pt;
+        };
+        // The scalar loop's normals (see `Context::radiance`).
+        let wo_world = -ray.dir;
+        let ng = if hit.ng.dot(wo_world) < 0.0 {
+            -hit.ng
+        } else {
+            hit.ng
+        };
+        let mut ns = if hit.ns.dot(ng) < 0.0 {
+            -hit.ns
+        } else {
+            hit.ns
+        };
+        if ns.dot(wo_world) <= 0.0 {
+            ns = ng;
+        }
+        let frame = Frame::from_normal(ns);
+        let wo = frame.to_local(wo_world);
+        if wo.z <= 0.0 {
+            return pt;
+        }
+        // The scalar loop's points: the BSDF point [bsdf_uc.x, bsdf_u], the
+        // light point [bsdf_uc.y, light]; light sampling alone takes the
+        // light point.
+        let light_alone = matches!(self.kind, Kind::Light);
+        // Light draws do not read `uc`.
+        let uc = if plan.slots.contains(&Slot::Bsdf) {
+            pair(seeds.bsdf_uc)
+        } else {
+            DVec2::ZERO
+        };
+        let bsdf_point = || {
+            let u = pair(seeds.bsdf_u);
+            [uc.x, u.x, u.y]
+        };
+        let light_point = || {
+            let u = pair(seeds.light);
+            [uc.y, u.x, u.y]
+        };
+        pt.u[0] = if light_alone {
+            light_point()
+        } else {
+            bsdf_point()
+        };
+        if plan.slots[1] != Slot::Unused {
+            pt.u[1] = light_point();
+        }
+        pt.obj = obj as u32;
+        pt.p = hit.p;
+        pt.ng = ng;
+        pt.frame = frame;
+        pt.wo = wo;
+        pt
+    }
+
+    /// The draws of a block: BSDF samples and light samples' `f` and pdf
+    /// in batches per object, then the shadow rays and the estimates.
+    fn shade(
+        &self,
+        scene: &Scene,
+        pts: &mut [Point],
+        draws: &mut [Draw],
+        lanes: &mut Lanes,
+        stats: &mut RenderStats,
+    ) {
+        // Light draws first: their directions, by scalar sampling of the map.
+        lanes.keys.clear();
+        for (i, pt) in pts.iter().enumerate() {
+            if pt.obj == u32::MAX {
+                continue;
+            }
+            for s in 0..2 {
+                let d = &mut draws[2 * i + s];
+                *d = Draw::default();
+                match pt.plan.slots[s] {
+                    Slot::Unused => continue,
+                    Slot::Bsdf => {}
+                    Slot::Light { compensated } => {
+                        let u = DVec2::new(pt.u[s][1], pt.u[s][2]);
+                        let Some((dir, l)) = self.env.sample_lookup(compensated, u) else {
+                            continue;
+                        };
+                        let wi = pt.frame.to_local(dir);
+                        if wi.z <= 0.0 {
+                            continue;
+                        }
+                        d.dir = dir;
+                        d.wi = wi;
+                        d.light = Some(l);
+                    }
+                }
+                lanes
+                    .keys
+                    .push((u64::from(pt.obj) << 32) | (2 * i + s) as u64);
+            }
+        }
+        lanes.keys.sort_unstable();
+        // One batch call per object and kind of draw.
+        let mut g = 0;
+        while g < lanes.keys.len() {
+            let obj = (lanes.keys[g] >> 32) as usize;
+            let mut e = g;
+            while e < lanes.keys.len() && (lanes.keys[e] >> 32) as usize == obj {
+                e += 1;
+            }
+            self.batch_group(obj, g..e, pts, draws, lanes);
+            g = e;
+        }
+        // Shadow rays and the estimates, in sample order.
+        for (i, pt) in pts.iter_mut().enumerate() {
+            if pt.obj == u32::MAX {
+                continue;
+            }
+            let mut sum = Rgb::ZERO;
+            let mut n = 0.0;
+            for s in 0..2 {
+                let slot = pt.plan.slots[s];
+                if slot == Slot::Unused {
+                    continue;
+                }
+                n += 1.0;
+                let d = &draws[2 * i + s];
+                if !d.ok {
+                    continue;
+                }
+                match slot {
+                    Slot::Unused => {}
+                    Slot::Bsdf => {
+                        let dir = pt.frame.to_world(d.dir).normalize();
+                        stats.rays += 1;
+                        if scene.occluded(&spawn_ray(pt.p, pt.ng, dir)) {
+                            continue;
+                        }
+                        let l = self.env.lookup(dir);
+                        let v = d.f * l.radiance;
+                        sum += match pt.plan.mis {
+                            None => v,
+                            Some(h) => v * h.weight(d.pdf, l.pdf_compensated),
+                        };
+                    }
+                    Slot::Light { compensated } => {
+                        let l = d.light.expect("a light draw");
+                        if d.f == Rgb::ZERO {
+                            continue;
+                        }
+                        stats.rays += 1;
+                        if scene.occluded(&spawn_ray(pt.p, pt.ng, d.dir)) {
+                            continue;
+                        }
+                        let v = d.f * l.radiance * d.wi.z;
+                        let p = if compensated {
+                            l.pdf_compensated
+                        } else {
+                            l.pdf
+                        };
+                        sum += match pt.plan.mis {
+                            None => v / p,
+                            Some(h) => v * (h.weight(p, d.pdf) / p),
+                        };
+                    }
+                }
+            }
+            pt.value = match pt.plan.mis {
+                None if n > 1.0 => sum / n,
+                _ => sum,
+            };
+        }
+    }
+
+    /// The draws `keys[range]` (all of object `obj`): BSDF draws sampled,
+    /// light draws evaluated, each kind in one batch call.
+    fn batch_group(
+        &self,
+        obj: usize,
+        range: std::ops::Range<usize>,
+        pts: &[Point],
+        draws: &mut [Draw],
+        lanes: &mut Lanes,
+    ) {
+        let sampler = &self.samplers[obj];
+        for bsdf in [true, false] {
+            let mut m = 0;
+            for &key in &lanes.keys[range.clone()] {
+                let di = (key & 0xffff_ffff) as usize;
+                let (pt, s) = (&pts[di / 2], di % 2);
+                if (pt.plan.slots[s] == Slot::Bsdf) != bsdf {
+                    continue;
+                }
+                let a = &mut lanes.a;
+                a[0][m] = pt.wo.x as f32;
+                a[1][m] = pt.wo.y as f32;
+                a[2][m] = pt.wo.z as f32;
+                if bsdf {
+                    a[3][m] = pt.u[s][1] as f32;
+                    a[4][m] = pt.u[s][2] as f32;
+                    a[5][m] = pt.u[s][0] as f32;
+                } else {
+                    let wi = draws[di].wi;
+                    a[3][m] = wi.x as f32;
+                    a[4][m] = wi.y as f32;
+                    a[5][m] = wi.z as f32;
+                }
+                m += 1;
+            }
+            if m == 0 {
+                continue;
+            }
+            let [a0, a1, a2, a3, a4, a5] = &lanes.a;
+            let [o0, o1, o2, o3, o4, o5, o6, o7, o8, o9] = &mut lanes.out;
+            let wo = Dirs {
+                x: &a0[..m],
+                y: &a1[..m],
+                z: &a2[..m],
+            };
+            if bsdf {
+                sampler
+                    .sample(
+                        SampleInput {
+                            wo,
+                            u1: &a3[..m],
+                            u2: &a4[..m],
+                            uc: Some(&a5[..m]),
+                        },
+                        SampleOutput {
+                            wi: DirsMut {
+                                x: &mut o0[..m],
+                                y: &mut o1[..m],
+                                z: &mut o2[..m],
+                            },
+                            f: RgbMut {
+                                r: &mut o3[..m],
+                                g: &mut o4[..m],
+                                b: &mut o5[..m],
+                            },
+                            pdf: &mut o6[..m],
+                            weight: RgbMut {
+                                r: &mut o7[..m],
+                                g: &mut o8[..m],
+                                b: &mut o9[..m],
+                            },
+                            valid: &mut lanes.valid[..m],
+                        },
+                    )
+                    .expect("equal lengths, uc given");
+            } else {
+                sampler
+                    .eval_pdf(
+                        wo,
+                        Dirs {
+                            x: &a3[..m],
+                            y: &a4[..m],
+                            z: &a5[..m],
+                        },
+                        EvalPdfOutput {
+                            f: RgbMut {
+                                r: &mut o3[..m],
+                                g: &mut o4[..m],
+                                b: &mut o5[..m],
+                            },
+                            pdf: &mut o6[..m],
+                        },
+                    )
+                    .expect("equal lengths");
+            }
+            let mut m = 0;
+            for &key in &lanes.keys[range.clone()] {
+                let di = (key & 0xffff_ffff) as usize;
+                let (pt, s) = (&pts[di / 2], di % 2);
+                if (pt.plan.slots[s] == Slot::Bsdf) != bsdf {
+                    continue;
+                }
+                let o = &lanes.out;
+                let d = &mut draws[di];
+                let rgb = |k: usize| {
+                    Rgb::new(
+                        f64::from(o[k][m]),
+                        f64::from(o[k + 1][m]),
+                        f64::from(o[k + 2][m]),
+                    )
+                };
+                if bsdf {
+                    d.ok = lanes.valid[m] == 1;
+                    d.dir = DVec3::new(f64::from(o[0][m]), f64::from(o[1][m]), f64::from(o[2][m]));
+                    d.f = rgb(7);
+                } else {
+                    d.ok = true;
+                    d.f = rgb(3);
+                }
+                d.pdf = f64::from(o[6][m]);
+                m += 1;
+            }
+        }
+    }
+}
