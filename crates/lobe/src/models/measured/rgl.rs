@@ -807,7 +807,12 @@ impl Rgl {
     /// with θ uniform in `[0, 89°]`, an `n × n` grid. The visible-normal warp
     /// is `f cos θi` over the half vector with a floor of 1% of its mean (so
     /// that the grid spends its points on the lobe); `jacobian` is 0, so
-    /// `rgb` holds `f cos θi` itself.
+    /// `rgb` holds `f cos θi` itself. The `luminance` table is, as in Dupuy
+    /// and Jakob's files, the luminance of the data per unit area of the
+    /// sample square (`lum(f cos θi)` times the density of `ω_i` per unit
+    /// of the square under the vndf warp), with a floor of 1% of its mean:
+    /// the two warps together then sample `lum(f cos θi)` (nearly flat
+    /// where the vndf warp already follows the lobe).
     #[must_use]
     pub fn write(
         f: impl Fn(DVec3, DVec3) -> Rgb + Sync,
@@ -857,13 +862,18 @@ impl Rgl {
             for y in 0..n {
                 for x in 0..n {
                     let s = [x as f32 / (n - 1) as f32, y as f32 / (n - 1) as f32];
-                    let (u_m, _) = warp.sample(s, &[]);
+                    let (u_m, v) = warp.sample(s, &[]);
                     let m = m_of(u_m);
                     let c = fcos(wo, m);
                     for ch in 0..3 {
                         rgb[ch * n * n + y * n + x] = c[ch] as f32;
                     }
-                    luminance[y * n + x] = lum(c) as f32;
+                    // What the vndf warp leaves to correct: lum(f cos θi)
+                    // times the density of ω_i per unit area of the sample
+                    // square, 4 (wo·m) |dω_m/du_m| / vndf(u_m).
+                    let jac = 2.0 * std::f64::consts::PI.powi(2) * f64::from(u_m[0]) * f64::from(u2theta(u_m[0])).sin();
+                    let per_s = 4.0 * wo.dot(m).max(0.0) * jac / f64::from(v).max(1e-30);
+                    luminance[y * n + x] = (lum(c) * per_s) as f32;
                 }
             }
             let mean = luminance.iter().map(|&v| f64::from(v)).sum::<f64>() / (n * n) as f64;
@@ -900,6 +910,73 @@ impl Rgl {
             ("luminance", Field::f32(&[1, n_theta, n, n], &luminance)),
             ("rgb", Field::f32(&[1, n_theta, 3, n, n], &rgb)),
         ])
+    }
+
+    /// Dupuy and Jakob's own sampling scheme (the `vndf` strategy of an RGL
+    /// material), as Mitsuba 3's `measured` plugin samples: the uniform
+    /// point `(u.y, u.x)` is warped by the file's `luminance` table into
+    /// the sample square, and from there by the visible-normal warp `vndf`
+    /// into the half vector's `u_m = (√(θm/(π/2)), (φm − φo + π)/(2π))`;
+    /// `wi` is `wo` mirrored about `m` (`None` below the horizon, or for
+    /// `wo` below it). Both warps are interpolated between the file's view
+    /// elevations, as the tables are when evaluating. There is no
+    /// defensive mixture: where the file's warps have density zero, so
+    /// does this strategy.
+    #[must_use]
+    pub fn sample_warps(&self, wo: DVec3, u: DVec2) -> Option<DVec3> {
+        if wo.z <= 0.0 {
+            return None;
+        }
+        let theta_o = elevation(wo);
+        let phi_o = wo.y.atan2(wo.x) as f32;
+        let params = [phi_o, theta_o];
+        let (s, _) = self.luminance.sample([u.y as f32, u.x as f32], &params);
+        let (u_m, _) = self.vndf.sample(s, &params);
+        let (t, p) = (f64::from(u2theta(u_m[0])), f64::from(u2phi(u_m[1])) + f64::from(phi_o));
+        let m = DVec3::new(t.sin() * p.cos(), t.sin() * p.sin(), t.cos());
+        let wi = crate::math::reflect(wo, m);
+        if wi.z <= 0.0 || !wi.is_finite() {
+            return None;
+        }
+        Some(wi.normalize())
+    }
+
+    /// The solid-angle density of [`Rgl::sample_warps`] at `wi` (both above
+    /// the horizon): with `m = (wo + wi)/‖wo + wi‖` and `s` the sample
+    /// square's point that the `vndf` warp takes to `u_m` (its inverse),
+    /// `luminance(s) · vndf(u_m) / (2π² u_m.x sin θm · 4 wo·m)`: the two
+    /// warps' densities, then `u_m → ω_m` and `ω_m → ω_i`. The first
+    /// Jacobian is kept above 1e-6, as Mitsuba does, at the pole.
+    #[must_use]
+    pub fn pdf_warps(&self, wo: DVec3, wi: DVec3) -> f64 {
+        if wo.z <= 0.0 || wi.z <= 0.0 {
+            return 0.0;
+        }
+        let sum = wo + wi;
+        let len = sum.length();
+        if !(len > 0.0) {
+            return 0.0;
+        }
+        let m = sum / len;
+        let om = wo.dot(m);
+        if !(om > 0.0) {
+            return 0.0;
+        }
+        let theta_o = elevation(wo);
+        let phi_o = wo.y.atan2(wo.x) as f32;
+        let theta_m = elevation(m);
+        let phi_m = m.y.atan2(m.x) as f32;
+        let mut u_m = [theta2u(theta_m), phi2u(phi_m - phi_o)];
+        u_m[1] -= u_m[1].floor();
+        let params = [phi_o, theta_o];
+        let (s, vndf_pdf) = self.vndf.invert(u_m, &params);
+        let lum_pdf = self.luminance.eval(s, &params);
+        let jac = (2.0 * std::f64::consts::PI.powi(2) * f64::from(u_m[0]) * f64::from(theta_m).sin())
+            .max(1e-6)
+            * 4.0
+            * om;
+        let p = f64::from(vndf_pdf) * f64::from(lum_pdf) / jac;
+        if p.is_finite() && p > 0.0 { p } else { 0.0 }
     }
 
     /// The view elevations of the table are interpolated; the grid point
