@@ -16,12 +16,10 @@
 //! `E = Σ_k cos θi Σ_c [ln(1 + f̂_c cos θi) − ln(1 + f_c cos θi)]² / (3 Σ_k cos θi)`
 //!
 //! (`f̂` the model, `f` the target, both without the cosine), minimised by
-//! Nelder-Mead over `(ln α, logit f0 | ln eta, ln k, logit kd)` from up to
-//! three starts (each refined once by a restart), the best kept; the search
-//! stops at `E < 1e-11` (an exact fit). A conductor fit starts from a
-//! rough Schlick fit (one start, one round to 1e-4: its alphas and kd, and
-//! the `k` that gives its `f0` at `eta = 0.3` and at `eta = 1.5`: two
-//! starts).
+//! Nelder-Mead over `(ln α, logit f0 | ln eta, ln k, logit kd)`: first on
+//! every 8th pair from up to three starts (each refined once by a
+//! restart; the starts stop early at an exact fit, `E < 1e-11`), then on
+//! every pair from the best of them.
 //!
 //! MERL's entries all have the half vector in the plane `φh = 0`, which
 //! says nothing about anisotropy: for an anisotropic fit, pair `k` is turned
@@ -108,7 +106,8 @@ pub struct Fit {
     pub kd: Rgb,
     /// The error `E` at the fit.
     pub error: f64,
-    /// Error evaluations spent.
+    /// Error evaluations spent, in evaluations over every pair (one over
+    /// the coarse subset counts 1/8).
     pub evaluations: usize,
     /// Pairs the error sums over.
     pub pairs: usize,
@@ -166,6 +165,17 @@ struct Target {
     pairs: Vec<(DVec3, DVec3)>,
     log_f: Vec<[f64; 3]>,
     weight: Vec<f64>,
+}
+
+impl Target {
+    /// Every `n`-th pair.
+    fn every(&self, n: usize) -> Target {
+        Target {
+            pairs: self.pairs.iter().copied().step_by(n).collect(),
+            log_f: self.log_f.iter().copied().step_by(n).collect(),
+            weight: self.weight.iter().copied().step_by(n).collect(),
+        }
+    }
 }
 
 fn target(m: &Material, turn: bool) -> Target {
@@ -255,6 +265,9 @@ fn start(o: FitOptions, alpha: f64, f0: f64, eta_k: (f64, f64), kd: f64) -> Vec<
     x.extend([logit(kd); 3]);
     x
 }
+
+/// The coarse search runs on every `COARSE`-th pair.
+const COARSE: usize = 8;
 
 /// Pairs per chunk of the error's sum.
 const CHUNK: usize = 2048;
@@ -392,11 +405,6 @@ pub fn fit_cook_torrance(target_material: &Material, distribution: Ndf) -> crate
 /// material; a measured one in practice). Errors: the Blinn-Phong NDF, a
 /// target that reflects nothing at the fitting pairs.
 pub fn fit(target_material: &Material, options: FitOptions) -> crate::error::Result<Fit> {
-    fit_from(target_material, options, false)
-}
-
-/// [`fit`]; `rough`: one start, one round (a conductor fit's first step).
-fn fit_from(target_material: &Material, options: FitOptions, rough: bool) -> crate::error::Result<Fit> {
     if options.distribution == Ndf::BlinnPhong {
         return Err(crate::Error::UnknownName {
             field: "distribution".into(),
@@ -404,79 +412,46 @@ fn fit_from(target_material: &Material, options: FitOptions, rough: bool) -> cra
             expected: "ggx, beckmann".into(),
         });
     }
-    let t = target(target_material, options.anisotropic);
-    if t.pairs.is_empty() {
+    let full = target(target_material, options.anisotropic);
+    if full.pairs.is_empty() {
         return Err(crate::Error::param(
             "material",
             "the target reflects nothing at any of the fitting pairs",
         ));
     }
-    let mut f = |x: &[f64]| error(&t, options, x);
-    let mut best: Option<(Vec<f64>, f64)> = None;
-    let mut evaluations = 0;
+    let coarse = full.every(COARSE);
+    let mut evaluations = 0.0;
     let dims = start(options, 0.3, 0.5, (1.0, 1.0), 0.3).len();
     let max_evals = 200 * dims + 100;
-    // (alpha, f0, (eta, k), kd): a rough plastic, a glossy metal, a matte
-    // one. A conductor starts from the Schlick fit instead: its alphas and
-    // kd, and per channel the k that gives its f0 with eta = 0.3, or 1.5.
-    let starts: Vec<Vec<f64>> = if options.fresnel == FresnelFit::Conductor {
-        let s = fit_from(
-            target_material,
-            FitOptions {
-                fresnel: FresnelFit::Schlick,
-                ..options
-            },
-            true,
-        )?;
-        evaluations += s.evaluations;
-        let Fresnel::Schlick { f0 } = s.fresnel else {
-            unreachable!("a Schlick fit")
-        };
-        [0.3, 1.5]
-            .into_iter()
-            .map(|eta: f64| {
-                let k = |f0: f64| {
-                    let f0 = f0.clamp(1e-3, 0.999);
-                    let k2 = (f0 * (eta + 1.0).powi(2) - (eta - 1.0).powi(2)) / (1.0 - f0);
-                    k2.max(1e-4).sqrt().ln()
-                };
-                let mut x = vec![s.alpha_u.ln()];
-                if options.anisotropic {
-                    x.push(s.alpha_v.ln());
-                }
-                x.extend([eta.ln(); 3]);
-                x.extend([k(f0.x), k(f0.y), k(f0.z)]);
-                x.extend([logit(s.kd.x), logit(s.kd.y), logit(s.kd.z)]);
-                x
-            })
-            .collect()
-    } else {
-        [(0.3, 0.5, 0.3), (0.05, 0.9, 0.05), (0.7, 0.1, 0.6)]
-            .into_iter()
-            .take(if rough { 1 } else { 3 })
-            .map(|(alpha, f0, kd)| start(options, alpha, f0, (1.0, 1.0), kd))
-            .collect()
-    };
-    for x0 in starts {
-        if rough {
-            let (x, v, e) = nelder_mead(&mut f, &x0, 0.5, 1e-4, 1e-9, max_evals);
-            evaluations += e;
-            best = Some((x, v));
-            break;
-        }
-        // Two rounds: restart from the best point with a fresh simplex.
-        let (x1, _, e1) = nelder_mead(&mut f, &x0, 0.5, 1e-6, 1e-9, max_evals);
-        let (x2, v2, e2) = nelder_mead(&mut f, &x1, 0.1, 1e-8, 1e-14, max_evals);
-        evaluations += e1 + e2;
-        if best.as_ref().is_none_or(|(_, v)| v2 < *v) {
-            best = Some((x2, v2));
-        }
-        // An exact fit: the other starts cannot do better.
-        if best.as_ref().is_some_and(|(_, v)| *v < EXACT) {
-            break;
+    // Coarse: the starts on every COARSE-th pair.
+    let mut best: Option<(Vec<f64>, f64)> = None;
+    {
+        let mut f = |x: &[f64]| error(&coarse, options, x);
+        // (alpha, f0, (eta, k), kd): a rough plastic, a glossy metal, a matte one.
+        for (alpha, f0, eta_k, kd) in [
+            (0.3, 0.5, (1.0, 2.0), 0.3),
+            (0.05, 0.9, (0.3, 3.0), 0.05),
+            (0.7, 0.1, (1.5, 0.5), 0.6),
+        ] {
+            let x0 = start(options, alpha, f0, eta_k, kd);
+            // Two rounds: restart from the best point with a fresh simplex.
+            let (x1, _, e1) = nelder_mead(&mut f, &x0, 0.5, 1e-6, 1e-9, max_evals);
+            let (x2, v2, e2) = nelder_mead(&mut f, &x1, 0.1, 1e-8, 1e-14, max_evals);
+            evaluations += (e1 + e2) as f64 / COARSE as f64;
+            if best.as_ref().is_none_or(|(_, v)| v2 < *v) {
+                best = Some((x2, v2));
+            }
+            // An exact fit: the other starts cannot do better.
+            if best.as_ref().is_some_and(|(_, v)| *v < EXACT) {
+                break;
+            }
         }
     }
-    let (x, e) = best.expect("two or three starts");
+    // Fine: every pair, from the coarse fit.
+    let (x0, _) = best.expect("three starts");
+    let mut f = |x: &[f64]| error(&full, options, x);
+    let (x, e, n) = nelder_mead(&mut f, &x0, 0.05, 1e-8, 1e-14, max_evals);
+    evaluations += n as f64;
     let (alpha_u, alpha_v, fresnel, kd) = params(options, &x);
     Ok(Fit {
         options,
@@ -485,8 +460,8 @@ fn fit_from(target_material: &Material, options: FitOptions, rough: bool) -> cra
         fresnel,
         kd,
         error: e,
-        evaluations,
-        pairs: t.pairs.len(),
+        evaluations: evaluations.round() as usize,
+        pairs: full.pairs.len(),
     })
 }
 
