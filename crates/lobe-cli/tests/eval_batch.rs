@@ -299,7 +299,11 @@ fn measured_tables_agree_with_the_f64_path() {
             if bad {
                 differ += 1;
                 if differ <= 3 {
-                    eprintln!("{format}: line {}: f64 {r} batch {b}", i + 1);
+                    eprintln!(
+                        "{format}: line {}: {}\n  f64 {r}\n  batch {b}",
+                        i + 1,
+                        input.lines().nth(i).unwrap_or("")
+                    );
                 }
             }
         }

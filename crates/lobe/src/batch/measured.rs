@@ -6,7 +6,7 @@
 //! discontinuous, so that an index computed in f32 would pick the
 //! neighbouring entry for inputs within f32 rounding of an entry's edge.
 //! The kernel therefore runs lane by lane, converting each lane's f32
-//! inputs to f64 and computing exactly as the scalar path does (the same
+//! inputs to f64 (renormalized) and computing exactly as the scalar path does (the same
 //! table code, [`crate::models::measured`]), over the `f32` tables that
 //! the material already holds; its outputs are the scalar path's numbers
 //! at the f32 inputs, rounded once to f32. The strategy is a const
@@ -138,9 +138,14 @@ fn eval_pdf_one<const S: u8, const MODE: u8>(d: &MeasuredData, wo: DVec3, wi: DV
     (f, pdf)
 }
 
+/// Lane `i` of a block of directions, in f64 and renormalized: an f32 unit
+/// vector's length is 1 only to 6e-8, which `wo + wi` in the retro-reflection
+/// direction at grazing views (`1 + wo·wi` ~ 1e-5) amplifies to 1e-3 of the
+/// pdf; the renormalized direction differs from the f64 one only by the
+/// rounding of its direction (3e-8).
 #[inline(always)]
 fn dvec3(x: [&[f32]; 3], i: usize) -> DVec3 {
-    DVec3::new(f64::from(x[0][i]), f64::from(x[1][i]), f64::from(x[2][i]))
+    DVec3::new(f64::from(x[0][i]), f64::from(x[1][i]), f64::from(x[2][i])).normalize_or_zero()
 }
 
 fn sample_loop<const S: u8>(d: &MeasuredData, inp: SampleIn<'_>, (out, valid): SampleOut<'_, '_>) {
@@ -279,7 +284,7 @@ mod tests {
     }
 
     /// Every level gives the same bits, and they are the scalar path's
-    /// numbers at the f32 inputs rounded to f32 (the same computation), for
+    /// numbers at the f32 inputs (renormalized in f64) rounded to f32 (the same computation), for
     /// MERL (nearest and linear) and RGL tables and every strategy.
     fn dirs(w: &[Vec<f32>; 3]) -> Dirs<'_> {
         Dirs { x: &w[0], y: &w[1], z: &w[2] }
@@ -320,7 +325,9 @@ mod tests {
             u1[k] = next();
             u2[k] = next();
         }
-        let d = |w: &[Vec<f32>; 3], k: usize| DVec3::new(w[0][k].into(), w[1][k].into(), w[2][k].into());
+        let d = |w: &[Vec<f32>; 3], k: usize| {
+            DVec3::new(w[0][k].into(), w[1][k].into(), w[2][k].into()).normalize_or_zero()
+        };
         for (name, m) in &cases {
             for s in m.strategies() {
                 let mut first: Option<(SampleBuffers, EvalPdfBuffers)> = None;
