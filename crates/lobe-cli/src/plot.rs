@@ -35,7 +35,9 @@ const MAX_RES: usize = 1024;
     long_about = "Draw figures of a material and a sampling strategy as PNG files in --out:\n  \
         polar      in the plane of incidence at --theta/--wo: f·cos θi / albedo (the ideal\n             \
         pdf) against the pdf of --strategy (without it, of every strategy) on the\n             \
-        same axes; --scale linear or log radius               -> polar.png\n  \
+        same axes; --scale linear or log radius               -> polar.png\n             \
+        with --fit (a measured material) or --against M: the material against\n             \
+        its Cook-Torrance fit, or M, at θo = 0°, 30°, 60°, 75° -> polar-fit.png\n  \
         histogram  the warp test: observed against expected sample counts over the\n             \
         projected hemisphere, with the chi-square p-value     -> histogram-<STRATEGY>.png\n  \
         weights    the sample weight f·cos θi/pdf over the projected hemisphere,\n             \
