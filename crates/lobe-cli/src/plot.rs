@@ -367,7 +367,11 @@ fn comparison(args: &PlotArgs, data: &Material) -> Result<Option<(Material, Stri
     eprintln!("fit: {} (error E = {:.3e})", fit.to_json(), fit.error);
     Ok(Some((
         fit.material()?,
-        format!("its fit ({}; E = {:.2e})", crate::fit::fit_label(&fit), fit.error),
+        format!(
+            "its fit ({}; E = {:.2e})",
+            crate::fit::fit_label(&fit),
+            fit.error
+        ),
     )))
 }
 
@@ -375,7 +379,13 @@ fn comparison(args: &PlotArgs, data: &Material) -> Result<Option<(Material, Stri
 /// (black) and `other` (red) in the plane of incidence, `wi` at its angle
 /// from the normal (up), the view in blue; one radius scale per panel
 /// (linear, or `--scale log`: four decades).
-fn fit_polar(path: &Path, title: &str, data: &Material, other: &Material, scale: figures::PolarScale) -> Result<()> {
+fn fit_polar(
+    path: &Path,
+    title: &str,
+    data: &Material,
+    other: &Material,
+    scale: figures::PolarScale,
+) -> Result<()> {
     use plotters::prelude::*;
     let e = |e: &dyn std::fmt::Display| anyhow!("{path:?}: {e}");
     figures::register_fonts()?;
@@ -385,10 +395,19 @@ fn fit_polar(path: &Path, title: &str, data: &Material, other: &Material, scale:
         let root = BitMapBackend::with_buffer(&mut buffer, (w, h)).into_drawing_area();
         root.fill(&WHITE).map_err(|x| e(&x))?;
         let root = root.titled(title, ("sans-serif", 20)).map_err(|x| e(&x))?;
-        for (panel, theta) in root.split_evenly((2, 2)).iter().zip([0.0, 30.0, 60.0, 75.0]) {
+        for (panel, theta) in root
+            .split_evenly((2, 2))
+            .iter()
+            .zip([0.0, 30.0, 60.0, 75.0])
+        {
             let d = lobe::fit::incidence_plane(data, theta, 720);
             let f = lobe::fit::incidence_plane(other, theta, 720);
-            let vmax = d.iter().chain(&f).map(|p| p.1).fold(0.0f64, f64::max).max(1e-12);
+            let vmax = d
+                .iter()
+                .chain(&f)
+                .map(|p| p.1)
+                .fold(0.0f64, f64::max)
+                .max(1e-12);
             let radius = |v: f64| match scale {
                 figures::PolarScale::Linear => (v / vmax).max(0.0),
                 figures::PolarScale::Log => {
@@ -410,7 +429,14 @@ fn fit_polar(path: &Path, title: &str, data: &Material, other: &Material, scale:
             };
             let mut chart = ChartBuilder::on(panel)
                 .caption(
-                    format!("θo = {theta}° (max {vmax:.3}{})", if scale == figures::PolarScale::Log { ", log radius" } else { "" }),
+                    format!(
+                        "θo = {theta}° (max {vmax:.3}{})",
+                        if scale == figures::PolarScale::Log {
+                            ", log radius"
+                        } else {
+                            ""
+                        }
+                    ),
                     ("sans-serif", 17),
                 )
                 .margin(8)
@@ -424,11 +450,15 @@ fn fit_polar(path: &Path, title: &str, data: &Material, other: &Material, scale:
                         (ring * a.cos(), ring * a.sin())
                     })
                     .collect();
-                chart.draw_series(LineSeries::new(arc, grey)).map_err(|x| e(&x))?;
+                chart
+                    .draw_series(LineSeries::new(arc, grey))
+                    .map_err(|x| e(&x))?;
             }
             for deg in [-60.0f64, -30.0, 0.0, 30.0, 60.0] {
                 let (s, c) = deg.to_radians().sin_cos();
-                chart.draw_series(LineSeries::new([(0.0, 0.0), (s, c)], grey)).map_err(|x| e(&x))?;
+                chart
+                    .draw_series(LineSeries::new([(0.0, 0.0), (s, c)], grey))
+                    .map_err(|x| e(&x))?;
             }
             chart
                 .draw_series(LineSeries::new([(-1.05, 0.0), (1.05, 0.0)], BLACK))
@@ -436,10 +466,15 @@ fn fit_polar(path: &Path, title: &str, data: &Material, other: &Material, scale:
             let (s, c) = theta.to_radians().sin_cos();
             let blue = RGBColor(40, 90, 200);
             chart
-                .draw_series(LineSeries::new([(0.0, 0.0), (1.05 * s, 1.05 * c)], blue.stroke_width(2)))
+                .draw_series(LineSeries::new(
+                    [(0.0, 0.0), (1.05 * s, 1.05 * c)],
+                    blue.stroke_width(2),
+                ))
                 .map_err(|x| e(&x))?
                 .label("view wo")
-                .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], blue.stroke_width(2)));
+                .legend(move |(x, y)| {
+                    PathElement::new([(x, y), (x + 20, y)], blue.stroke_width(2))
+                });
             chart
                 .draw_series(LineSeries::new(to_xy(&d), BLACK.stroke_width(3)))
                 .map_err(|x| e(&x))?

@@ -215,21 +215,20 @@ fn an_unbatched_material_is_a_clear_error() {
     );
 }
 
-/// Measured tables (issue 11): an RGL file and a MERL table that `lobe
-/// tabulate` writes, every strategy they have (RGL: uniform, cosine, brdf,
-/// vndf; MERL: no vndf), eval and sample lines, against the f64 path with
-/// the tolerances above. About 2 s (the MERL table is 35 MB, read by each
-/// of the three processes).
+/// Measured tables (issue 11): an RGL file that `lobe tabulate` writes,
+/// every strategy it has (uniform, cosine, brdf, vndf), eval and sample
+/// lines, against the f64 path with the tolerances above. About 4 s of CPU
+/// (each process builds the table's sampler). MERL tables run the same
+/// kernel (`lobe::batch` checks it bit for bit against the scalar path at
+/// the f32 inputs); here they would add 4 s (35 MB read and a sampler built
+/// per process; measured: worst 5.2e-7 relative, 7.6e-8 in wi).
 #[test]
 fn measured_tables_agree_with_the_f64_path() {
     let dir = std::env::temp_dir().join(format!("lobe-eval-batch-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let analytic = r#"{"type":"cook-torrance","distribution":"ggx","alpha":0.2,"kd":0.1,"fresnel":{"type":"schlick","f0":[0.9,0.6,0.3]}}"#;
     let mut rng = Pcg64::seed_from_u64(11);
-    for (format, name, extra) in [
-        ("rgl", "t.bsdf", &["--views", "6", "--grid", "24"][..]),
-        ("merl", "t.binary", &[][..]),
-    ] {
+    for (format, name, extra) in [("rgl", "t.bsdf", &["--views", "6", "--grid", "24"][..])] {
         let path = dir.join(name);
         let p = path.to_str().unwrap();
         let mut args = vec!["tabulate", "-m", analytic, "--format", format, "--out", p];

@@ -116,7 +116,13 @@ pub struct Fit {
 impl Fit {
     /// The fitted material.
     pub fn material(&self) -> crate::error::Result<Material> {
-        model(self.options.distribution, self.alpha_u, self.alpha_v, self.fresnel, self.kd)
+        model(
+            self.options.distribution,
+            self.alpha_u,
+            self.alpha_v,
+            self.fresnel,
+            self.kd,
+        )
     }
 
     /// `alpha` of an isotropic fit (`√(alpha_u alpha_v)` otherwise).
@@ -130,7 +136,10 @@ impl Fit {
     pub fn to_json(&self) -> String {
         let c = |v: Rgb| format!("[{:.6},{:.6},{:.6}]", v.x, v.y, v.z);
         let alpha = if self.options.anisotropic {
-            format!(r#""alpha_u":{:.6},"alpha_v":{:.6}"#, self.alpha_u, self.alpha_v)
+            format!(
+                r#""alpha_u":{:.6},"alpha_v":{:.6}"#,
+                self.alpha_u, self.alpha_v
+            )
         } else {
             format!(r#""alpha":{:.6}"#, self.alpha_u)
         };
@@ -236,7 +245,12 @@ fn params(o: FitOptions, x: &[f64]) -> (f64, f64, Fresnel, Rgb) {
     let (av, i) = if o.anisotropic { (a(x[1]), 2) } else { (au, 1) };
     let rgb = |f: &dyn Fn(f64) -> f64, j: usize| Rgb::new(f(x[j]), f(x[j + 1]), f(x[j + 2]));
     let (fresnel, i) = match o.fresnel {
-        FresnelFit::Schlick => (Fresnel::Schlick { f0: rgb(&sigmoid, i) }, i + 3),
+        FresnelFit::Schlick => (
+            Fresnel::Schlick {
+                f0: rgb(&sigmoid, i),
+            },
+            i + 3,
+        ),
         FresnelFit::Conductor => (
             Fresnel::Conductor {
                 eta: rgb(&|v: f64| v.exp().clamp(0.01, 20.0), i),
@@ -391,7 +405,10 @@ fn nelder_mead(
 /// Fit Cook-Torrance with `distribution` (GGX or Beckmann), a Schlick
 /// Fresnel term, one alpha and a Lambertian term to `target` (any
 /// material; a measured one in practice): [`fit`] with those options.
-pub fn fit_cook_torrance(target_material: &Material, distribution: Ndf) -> crate::error::Result<Fit> {
+pub fn fit_cook_torrance(
+    target_material: &Material,
+    distribution: Ndf,
+) -> crate::error::Result<Fit> {
     fit(
         target_material,
         FitOptions {

@@ -198,7 +198,11 @@ fn sample_loop<const S: u8>(d: &MeasuredData, inp: SampleIn<'_>, (out, valid): S
     }
 }
 
-fn eval_pdf_loop<const S: u8, const MODE: u8>(d: &MeasuredData, inp: EvalIn<'_>, out: EvalOut<'_, '_>) {
+fn eval_pdf_loop<const S: u8, const MODE: u8>(
+    d: &MeasuredData,
+    inp: EvalIn<'_>,
+    out: EvalOut<'_, '_>,
+) {
     let n = inp[0].len();
     for s in &inp {
         assert_eq!(s.len(), n);
@@ -211,6 +215,7 @@ fn eval_pdf_loop<const S: u8, const MODE: u8>(d: &MeasuredData, inp: EvalIn<'_>,
     if MODE != F_ONLY {
         assert_eq!(out[3].len(), n);
     }
+    #[allow(clippy::needless_range_loop)] // `i` indexes ten slices
     for i in 0..n {
         let wo = dvec3([inp[0], inp[1], inp[2]], i);
         let wi = dvec3([inp[3], inp[4], inp[5]], i);
@@ -260,9 +265,9 @@ pub(crate) fn eval_pdf_block(k: &MeasuredKernel, mode: u8, inp: EvalIn<'_>, out:
 #[cfg(test)]
 mod tests {
     use super::super::{BatchSampler, Dirs, EvalPdfBuffers, SampleBuffers, SampleInput, SimdLevel};
+    use crate::models::measured::Measured;
     use crate::models::measured::merl::Merl;
     use crate::models::measured::rgl::Rgl;
-    use crate::models::measured::Measured;
     use crate::{BsdfStrategy, Glossy, Material, Rgb};
     use glam::{DVec2, DVec3};
 
@@ -278,7 +283,11 @@ mod tests {
         Material::with_diffuse(Rgb::splat(0.1), Glossy::CookTorrance(lobe)).unwrap()
     }
 
-    fn measured(bytes: &[u8], name: &str, interp: Option<crate::models::measured::Interpolation>) -> Material {
+    fn measured(
+        bytes: &[u8],
+        name: &str,
+        interp: Option<crate::models::measured::Interpolation>,
+    ) -> Material {
         let lobe = Measured::from_bytes(bytes, std::path::Path::new(name), interp).unwrap();
         Material::with_diffuse(Rgb::ZERO, Glossy::Measured(lobe)).unwrap()
     }
@@ -287,7 +296,11 @@ mod tests {
     /// numbers at the f32 inputs (renormalized in f64) rounded to f32 (the same computation), for
     /// MERL (nearest and linear) and RGL tables and every strategy.
     fn dirs(w: &[Vec<f32>; 3]) -> Dirs<'_> {
-        Dirs { x: &w[0], y: &w[1], z: &w[2] }
+        Dirs {
+            x: &w[0],
+            y: &w[1],
+            z: &w[2],
+        }
     }
 
     #[test]
@@ -299,7 +312,11 @@ mod tests {
             ("merl-nearest", measured(&merl, "t.binary", None)),
             (
                 "merl-linear",
-                measured(&merl, "t.binary", Some(crate::models::measured::Interpolation::Linear)),
+                measured(
+                    &merl,
+                    "t.binary",
+                    Some(crate::models::measured::Interpolation::Linear),
+                ),
             ),
             ("rgl", measured(&rgl, "t.bsdf", None)),
         ];
@@ -307,7 +324,9 @@ mod tests {
         // Inputs in f32: views with grazing ones, uniforms.
         let mut state = 0x9e37_79b9_7f4a_7c15u64;
         let mut next = || {
-            state = state.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
+            state = state
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
             ((state >> 40) as f32) / (1u64 << 24) as f32
         };
         let mut wo = [vec![0f32; n], vec![0f32; n], vec![0f32; n]];
@@ -315,7 +334,11 @@ mod tests {
         let (mut u1, mut u2) = (vec![0f32; n], vec![0f32; n]);
         for k in 0..n {
             for w in [&mut wo, &mut wi] {
-                let z = if k % 10 == 0 { 1e-3 + 0.05 * next() } else { next() };
+                let z = if k % 10 == 0 {
+                    1e-3 + 0.05 * next()
+                } else {
+                    next()
+                };
                 let phi = std::f32::consts::TAU * next();
                 let s = (1.0 - z * z).max(0.0).sqrt();
                 w[0][k] = s * phi.cos();
@@ -335,8 +358,16 @@ mod tests {
                     let b = BatchSampler::with_level(m, s, level).unwrap();
                     assert!(!b.chooses_lobe());
                     let mut out = SampleBuffers::new(n);
-                    b.sample(SampleInput { wo: dirs(&wo), u1: &u1, u2: &u2, uc: None }, out.output())
-                        .unwrap();
+                    b.sample(
+                        SampleInput {
+                            wo: dirs(&wo),
+                            u1: &u1,
+                            u2: &u2,
+                            uc: None,
+                        },
+                        out.output(),
+                    )
+                    .unwrap();
                     let mut ep = EvalPdfBuffers::new(n);
                     b.eval_pdf(dirs(&wo), dirs(&wi), ep.output()).unwrap();
                     // eval and pdf alone: the same bits as eval_pdf.
@@ -350,8 +381,14 @@ mod tests {
                     match &first {
                         None => first = Some((out, ep)),
                         Some((o0, e0)) => {
-                            assert_eq!(&out, o0, "{name} {s} {level}: sample differs between levels");
-                            assert_eq!(&ep, e0, "{name} {s} {level}: eval_pdf differs between levels");
+                            assert_eq!(
+                                &out, o0,
+                                "{name} {s} {level}: sample differs between levels"
+                            );
+                            assert_eq!(
+                                &ep, e0,
+                                "{name} {s} {level}: eval_pdf differs between levels"
+                            );
                         }
                     }
                 }
@@ -365,13 +402,20 @@ mod tests {
                         Some(r) => {
                             valid += 1;
                             let want = [
-                                r.wi.x, r.wi.y, r.wi.z, r.f.x, r.f.y, r.f.z, r.pdf, r.weight.x, r.weight.y,
-                                r.weight.z,
+                                r.wi.x, r.wi.y, r.wi.z, r.f.x, r.f.y, r.f.z, r.pdf, r.weight.x,
+                                r.weight.y, r.weight.z,
                             ]
                             .map(|x| x as f32);
                             let got = [
-                                out.wi[0][k], out.wi[1][k], out.wi[2][k], out.f[0][k], out.f[1][k],
-                                out.f[2][k], out.pdf[k], out.weight[0][k], out.weight[1][k],
+                                out.wi[0][k],
+                                out.wi[1][k],
+                                out.wi[2][k],
+                                out.f[0][k],
+                                out.f[1][k],
+                                out.f[2][k],
+                                out.pdf[k],
+                                out.weight[0][k],
+                                out.weight[1][k],
                                 out.weight[2][k],
                             ];
                             assert_eq!(out.valid[k], 1, "{name} {s} #{k}");
@@ -380,7 +424,11 @@ mod tests {
                     }
                     let (f, p) = m.eval_pdf(s, o, d(&wi, k));
                     let got = [ep.f[0][k], ep.f[1][k], ep.f[2][k], ep.pdf[k]];
-                    assert_eq!(got, [f.x, f.y, f.z, p].map(|x| x as f32), "{name} {s} eval_pdf #{k}");
+                    assert_eq!(
+                        got,
+                        [f.x, f.y, f.z, p].map(|x| x as f32),
+                        "{name} {s} eval_pdf #{k}"
+                    );
                 }
                 assert!(valid > n / 2, "{name} {s}: {valid} valid samples of {n}");
             }

@@ -984,12 +984,13 @@ impl Rgl {
         }
         let sum = wo + wi;
         let len = sum.length();
-        if !(len > 0.0) {
+        // Also false for NaN.
+        if len.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
             return 0.0;
         }
         let m = sum / len;
         let om = wo.dot(m);
-        if !(om > 0.0) {
+        if om.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
             return 0.0;
         }
         let theta_o = elevation(wo);
@@ -1046,8 +1047,8 @@ mod tests {
         let m = Marginal2D::new(&data, w, h, vec![vec![0.0, 1.0], vec![0.0, 0.5, 1.5], vec![0.0, 1.0, 2.0]], false, false);
         for &(x, y, a, b) in &[(0.1, 0.2, 0.0, 0.0), (0.7, 0.9, 0.3, 1.2), (1.0, 0.5, 1.0, 0.5), (0.3, 0.0, 0.6, 2.0)] {
             let c = m.eval_channels([x, y], [a, b]);
-            for k in 0..3 {
-                assert_eq!(c[k].to_bits(), m.eval([x, y], &[a, b, k as f32]).to_bits(), "{x} {y} {a} {b} {k}");
+            for (k, v) in c.iter().enumerate() {
+                assert_eq!(v.to_bits(), m.eval([x, y], &[a, b, k as f32]).to_bits(), "{x} {y} {a} {b} {k}");
             }
         }
     }
