@@ -5,7 +5,9 @@ Writes RGL files of analytic materials with `lobe tabulate`, loads them in
 Mitsuba 3 (`scalar_rgb`), and compares Mitsuba's `eval` (f·cos θ of the
 light direction) with lobe's reading of the same file (`lobe eval`, f
 without the cosine, times cos θi) over random pairs of directions, and with
-the analytic material itself.
+the analytic material itself; and Mitsuba's sampling `pdf` (the file's
+luminance and visible-normal warps) with the pdf of lobe's `vndf` strategy
+of the same file.
 
 Usage: /work/venv-mitsuba/bin/python bench/mitsuba_measured_check.py [LOBE]
 (LOBE: the lobe binary, default target/release/lobe or target/debug/lobe).
@@ -45,11 +47,11 @@ def unit(theta, phi):
     return [math.sin(theta) * math.cos(phi), math.sin(theta) * math.sin(phi), math.cos(theta)]
 
 
-def lobe_eval(lobe, material, pairs):
+def lobe_eval(lobe, material, pairs, key="f"):
     text = "".join(json.dumps({"wo": wo, "wi": wi}) + "\n" for wo, wi in pairs)
     out = subprocess.run([lobe, "eval", "--material", material], input=text,
                          capture_output=True, text=True, check=True).stdout
-    return [json.loads(line)["f"] for line in out.splitlines() if line.strip()]
+    return [json.loads(line)[key] for line in out.splitlines() if line.strip()]
 
 
 def main():
@@ -70,16 +72,21 @@ def main():
         measured = json.dumps({"type": "measured", "path": path})
         f_lobe = lobe_eval(lobe, measured, pairs)
         f_model = lobe_eval(lobe, material, pairs)
+        # The pdf of lobe's `vndf` strategy of an RGL file is the file's own
+        # scheme (luminance and visible-normal warps), Mitsuba's `pdf`.
+        pdf_lobe = [p["vndf"] for p in lobe_eval(lobe, measured, pairs, "pdf")]
         ctx = mi.BSDFContext()
-        worst_abs = worst_rel = 0.0
+        worst_abs = worst_rel = worst_pdf = 0.0
         model_err = []
-        for (wo, wi), fl, fm in zip(pairs, f_lobe, f_model):
+        for (wo, wi), fl, fm, pl in zip(pairs, f_lobe, f_model, pdf_lobe):
             si = mi.SurfaceInteraction3f()
             si.wi = mi.Vector3f(*wo)  # Mitsuba's wi is the viewer (lobe's wo)
             si.n = mi.Normal3f(0, 0, 1)
             si.sh_frame = mi.Frame3f(si.n)
             v = bsdf.eval(ctx, si, mi.Vector3f(*wi))  # f cos θ of the light
             mits = [v[0], v[1], v[2]]
+            pm = bsdf.pdf(ctx, si, mi.Vector3f(*wi))
+            worst_pdf = max(worst_pdf, abs(pm - pl) / max(abs(pl), 1e-3))
             lob = [c * wi[2] for c in fl]
             mod = [c * wi[2] for c in fm]
             for a, b, m in zip(mits, lob, mod):
@@ -87,12 +94,13 @@ def main():
                 worst_rel = max(worst_rel, abs(a - b) / max(abs(b), 1e-3))
                 model_err.append(abs(a - m) / max(abs(m), 1e-3))
         model_err.sort()
-        worst_all = max(worst_all, worst_rel)
+        worst_all = max(worst_all, worst_rel, worst_pdf)
         print(f"{name:>13}: Mitsuba vs lobe (same file): worst |Δ(f cos)| {worst_abs:.3e}, "
-              f"worst relative {worst_rel:.3e}; file vs analytic model: median relative "
+              f"worst relative {worst_rel:.3e}, sampling pdf (lobe's vndf) worst relative "
+              f"{worst_pdf:.3e}; file vs analytic model: median relative "
               f"{model_err[len(model_err) // 2]:.3e}, 99th percentile "
               f"{model_err[int(0.99 * len(model_err))]:.3e}")
-    print(f"worst relative difference Mitsuba vs lobe over all materials: {worst_all:.3e}")
+    print(f"worst relative difference Mitsuba vs lobe over all materials (f cos and pdf): {worst_all:.3e}")
     return 0 if worst_all < 1e-3 else 1
 
 

@@ -9,7 +9,9 @@ use lobe::models::measured::Measured;
 #[command(
     about = "Fit Cook-Torrance + Lambert to a measured BRDF file (MERL or RGL)",
     long_about = "Fit Cook-Torrance (GGX or Beckmann, Smith height-correlated shadowing, \
-                  Schlick Fresnel with an RGB f0) plus a Lambertian kd to a measured BRDF \
+                  Schlick Fresnel with an RGB f0, or with --fresnel conductor a conductor's \
+                  RGB eta and k; one alpha, or with --anisotropic alpha_u and alpha_v) plus a \
+                  Lambertian kd to a measured BRDF \
                   file, minimising the cosine-weighted log-space L2 error over the table's \
                   entries\n\n  \
                   E = Σ cos θi Σ_c [ln(1 + f̂_c cos θi) − ln(1 + f_c cos θi)]² / (3 Σ cos θi)\n\n\
@@ -18,7 +20,8 @@ use lobe::models::measured::Measured;
                   --material accepts it and the error E (with --json: one JSON object).",
     after_help = "Examples:\n  \
                   lobe fit gold.binary --model cook-torrance\n  \
-                  lobe fit paint.bsdf --model cook-torrance --distribution beckmann --json"
+                  lobe fit paint.bsdf --model cook-torrance --distribution beckmann --json\n  \
+                  lobe fit gold.binary --fresnel conductor --anisotropic"
 )]
 pub struct FitArgs {
     /// The measured file (MERL .binary or RGL .bsdf, recognised by content).
@@ -29,6 +32,14 @@ pub struct FitArgs {
     /// The normal distribution.
     #[arg(long, default_value = "ggx", value_parser = ["ggx", "beckmann"])]
     distribution: String,
+    /// The Fresnel term: `schlick` (an RGB f0) or `conductor` (an RGB eta and k).
+    #[arg(long, default_value = "schlick", value_parser = ["schlick", "conductor"])]
+    fresnel: String,
+    /// Fit alpha_u and alpha_v (the pairs are turned about the normal to
+    /// cover every azimuth; MERL and RGL tables are isotropic, so their
+    /// two alphas come out nearly equal).
+    #[arg(long)]
+    anisotropic: bool,
     /// Print one JSON object: {"material": ..., "error": E, ...}.
     #[arg(long)]
     json: bool,
@@ -49,8 +60,16 @@ pub fn run(args: &FitArgs) -> Result<()> {
     } else {
         Ndf::Ggx
     };
+    let options = lobe::fit::FitOptions {
+        distribution: ndf,
+        fresnel: args.fresnel.parse()?,
+        anisotropic: args.anisotropic,
+    };
     let t0 = std::time::Instant::now();
-    let fit = lobe::fit::fit_cook_torrance(&m, ndf)?;
+    let pb = spinner("fitting");
+    let fit = lobe::fit::fit(&m, options);
+    pb.finish_and_clear();
+    let fit = fit?;
     let seconds = t0.elapsed().as_secs_f64();
     if args.json {
         println!(
@@ -70,19 +89,41 @@ pub fn run(args: &FitArgs) -> Result<()> {
     if let Some(path) = &args.plot {
         let fitted = fit.material()?;
         let title = format!(
-            "{} against its fit ({}, α {:.3}; E = {:.2e})",
+            "{} against its fit ({}; E = {:.2e})",
             args.file.file_name().map_or_else(
                 || args.file.display().to_string(),
                 |n| n.to_string_lossy().into_owned()
             ),
-            fit.distribution.name(),
-            fit.alpha,
+            fit_label(&fit),
             fit.error
         );
         draw(path, &title, &m, &fitted)?;
         eprintln!("wrote {}", path.display());
     }
     Ok(())
+}
+
+/// A spinner on stderr while a fit runs (hidden when stderr is not a
+/// terminal, as indicatif does).
+pub fn spinner(message: &str) -> indicatif::ProgressBar {
+    let pb = indicatif::ProgressBar::new_spinner();
+    pb.set_message(message.to_string());
+    pb.enable_steady_tick(std::time::Duration::from_millis(120));
+    pb
+}
+
+/// `ggx, α 0.123, schlick` (or `α 0.1/0.3` and `conductor`).
+pub fn fit_label(fit: &lobe::fit::Fit) -> String {
+    let alpha = if fit.options.anisotropic {
+        format!("α {:.3}/{:.3}", fit.alpha_u, fit.alpha_v)
+    } else {
+        format!("α {:.3}", fit.alpha_u)
+    };
+    format!(
+        "{}, {alpha}, {}",
+        fit.options.distribution.name(),
+        fit.options.fresnel.name()
+    )
 }
 
 /// Four panels, one per view: the data and the fit, `lum(f cos θi)` over

@@ -35,7 +35,9 @@ const MAX_RES: usize = 1024;
     long_about = "Draw figures of a material and a sampling strategy as PNG files in --out:\n  \
         polar      in the plane of incidence at --theta/--wo: f·cos θi / albedo (the ideal\n             \
         pdf) against the pdf of --strategy (without it, of every strategy) on the\n             \
-        same axes; --scale linear or log radius               -> polar.png\n  \
+        same axes; --scale linear or log radius               -> polar.png\n             \
+        with --fit (a measured material) or --against M: the material against\n             \
+        its Cook-Torrance fit, or M, at θo = 0°, 30°, 60°, 75° -> polar-fit.png\n  \
         histogram  the warp test: observed against expected sample counts over the\n             \
         projected hemisphere, with the chi-square p-value     -> histogram-<STRATEGY>.png\n  \
         weights    the sample weight f·cos θi/pdf over the projected hemisphere,\n             \
@@ -79,6 +81,17 @@ pub struct PlotArgs {
     /// largest value), one scale for every curve
     #[arg(long, default_value = "linear")]
     pub scale: String,
+    /// Polar: also fit Cook-Torrance (GGX or Beckmann, as `lobe fit` does,
+    /// Schlick Fresnel) to the material (a measured one, in practice) and
+    /// draw the fit against the data, f·cos θi in the plane of incidence
+    /// at θo = 0°, 30°, 60° and 75°                   -> polar-fit.png
+    #[arg(long, value_name = "ggx|beckmann", num_args = 0..=1, default_missing_value = "ggx",
+          value_parser = ["ggx", "beckmann"])]
+    pub fit: Option<String>,
+    /// Polar: draw this material (JSON, @FILE; e.g. the one `lobe fit`
+    /// printed) against --material, as --fit does, without fitting
+    #[arg(long, value_name = "JSON|@FILE", conflicts_with = "fit")]
+    pub against: Option<String>,
 }
 
 #[derive(Clone, Copy, PartialEq, Eq)]
@@ -103,6 +116,9 @@ pub fn run(args: &PlotArgs) -> Result<()> {
         .map_err(|e| anyhow!("--scale {}: {e}", args.scale))?;
     let material = load_material(&args.material)?;
     let wo = args.view.wo()?;
+    if (args.fit.is_some() || args.against.is_some()) && !kinds.contains(&Kind::Polar) {
+        bail!("--fit and --against draw polar figures: use --kind polar or all");
+    }
     let needs_strategy = kinds.iter().any(|&k| k != Kind::Polar);
     let strategy = match (&args.strategy, needs_strategy) {
         (Some(s), _) => {
@@ -157,6 +173,12 @@ pub fn run(args: &PlotArgs) -> Result<()> {
                 let title = format!("{label}, {view}: f·cos θi ÷ albedo against {what}");
                 figures::polar_plot(&path, &title, &curves, scale)?;
                 println!("{}", path.display());
+                if let Some((other, what)) = comparison(args, &material)? {
+                    let path = args.out.join("polar-fit.png");
+                    let title = format!("{label} (black) against {what} (red): f·cos θi");
+                    fit_polar(&path, &title, &material, &other, scale)?;
+                    println!("{}", path.display());
+                }
             }
             Kind::Histogram => {
                 let s = strategy.expect("checked above");
@@ -314,4 +336,170 @@ fn histogram(
         args.res,
         result.p_value,
     )
+}
+
+/// The material `--fit` fits or `--against` names, and how to call it.
+fn comparison(args: &PlotArgs, data: &Material) -> Result<Option<(Material, String)>> {
+    if let Some(spec) = &args.against {
+        let m = load_material(spec).context("--against")?;
+        let label = material_label(spec, &m);
+        return Ok(Some((m, label)));
+    }
+    let Some(dist) = &args.fit else {
+        return Ok(None);
+    };
+    let options = lobe::fit::FitOptions {
+        distribution: if dist == "beckmann" {
+            lobe::Ndf::Beckmann
+        } else {
+            lobe::Ndf::Ggx
+        },
+        ..lobe::fit::FitOptions::default()
+    };
+    let pb = if args.quiet {
+        indicatif::ProgressBar::hidden()
+    } else {
+        crate::fit::spinner("fitting")
+    };
+    let fit = lobe::fit::fit(data, options);
+    pb.finish_and_clear();
+    let fit = fit.context("--fit")?;
+    eprintln!("fit: {} (error E = {:.3e})", fit.to_json(), fit.error);
+    Ok(Some((
+        fit.material()?,
+        format!(
+            "its fit ({}; E = {:.2e})",
+            crate::fit::fit_label(&fit),
+            fit.error
+        ),
+    )))
+}
+
+/// Four polar panels (θo = 0°, 30°, 60°, 75°): `lum(f·cos θi)` of `data`
+/// (black) and `other` (red) in the plane of incidence, `wi` at its angle
+/// from the normal (up), the view in blue; one radius scale per panel
+/// (linear, or `--scale log`: four decades).
+fn fit_polar(
+    path: &Path,
+    title: &str,
+    data: &Material,
+    other: &Material,
+    scale: figures::PolarScale,
+) -> Result<()> {
+    use plotters::prelude::*;
+    let e = |e: &dyn std::fmt::Display| anyhow!("{path:?}: {e}");
+    figures::register_fonts()?;
+    let (w, h) = (1200u32, 760u32);
+    let mut buffer = vec![0u8; (w * h * 3) as usize];
+    {
+        let root = BitMapBackend::with_buffer(&mut buffer, (w, h)).into_drawing_area();
+        root.fill(&WHITE).map_err(|x| e(&x))?;
+        let root = root.titled(title, ("sans-serif", 20)).map_err(|x| e(&x))?;
+        for (panel, theta) in root
+            .split_evenly((2, 2))
+            .iter()
+            .zip([0.0, 30.0, 60.0, 75.0])
+        {
+            let d = lobe::fit::incidence_plane(data, theta, 720);
+            let f = lobe::fit::incidence_plane(other, theta, 720);
+            let vmax = d
+                .iter()
+                .chain(&f)
+                .map(|p| p.1)
+                .fold(0.0f64, f64::max)
+                .max(1e-12);
+            let radius = |v: f64| match scale {
+                figures::PolarScale::Linear => (v / vmax).max(0.0),
+                figures::PolarScale::Log => {
+                    if v > 0.0 {
+                        (1.0 + (v / vmax).log10() / figures::POLAR_DECADES).max(0.0)
+                    } else {
+                        0.0
+                    }
+                }
+            };
+            let to_xy = |pts: &[(f64, f64)]| -> Vec<(f64, f64)> {
+                pts.iter()
+                    .map(|&(a, v)| {
+                        let (s, c) = a.to_radians().sin_cos();
+                        let r = radius(v);
+                        (r * s, r * c)
+                    })
+                    .collect()
+            };
+            let mut chart = ChartBuilder::on(panel)
+                .caption(
+                    format!(
+                        "θo = {theta}° (max {vmax:.3}{})",
+                        if scale == figures::PolarScale::Log {
+                            ", log radius"
+                        } else {
+                            ""
+                        }
+                    ),
+                    ("sans-serif", 17),
+                )
+                .margin(8)
+                .build_cartesian_2d(-1.35f64..1.35f64, -0.04f64..1.08f64)
+                .map_err(|x| e(&x))?;
+            let grey = RGBColor(200, 200, 200);
+            for ring in [0.25, 0.5, 0.75, 1.0] {
+                let arc: Vec<(f64, f64)> = (0..=90)
+                    .map(|i| {
+                        let a = std::f64::consts::PI * f64::from(i) / 90.0;
+                        (ring * a.cos(), ring * a.sin())
+                    })
+                    .collect();
+                chart
+                    .draw_series(LineSeries::new(arc, grey))
+                    .map_err(|x| e(&x))?;
+            }
+            for deg in [-60.0f64, -30.0, 0.0, 30.0, 60.0] {
+                let (s, c) = deg.to_radians().sin_cos();
+                chart
+                    .draw_series(LineSeries::new([(0.0, 0.0), (s, c)], grey))
+                    .map_err(|x| e(&x))?;
+            }
+            chart
+                .draw_series(LineSeries::new([(-1.05, 0.0), (1.05, 0.0)], BLACK))
+                .map_err(|x| e(&x))?;
+            let (s, c) = theta.to_radians().sin_cos();
+            let blue = RGBColor(40, 90, 200);
+            chart
+                .draw_series(LineSeries::new(
+                    [(0.0, 0.0), (1.05 * s, 1.05 * c)],
+                    blue.stroke_width(2),
+                ))
+                .map_err(|x| e(&x))?
+                .label("view wo")
+                .legend(move |(x, y)| {
+                    PathElement::new([(x, y), (x + 20, y)], blue.stroke_width(2))
+                });
+            chart
+                .draw_series(LineSeries::new(to_xy(&d), BLACK.stroke_width(3)))
+                .map_err(|x| e(&x))?
+                .label("data")
+                .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], BLACK.stroke_width(3)));
+            let red = RGBColor(220, 50, 30);
+            chart
+                .draw_series(LineSeries::new(to_xy(&f), red.stroke_width(2)))
+                .map_err(|x| e(&x))?
+                .label("fit")
+                .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], red.stroke_width(2)));
+            chart
+                .configure_series_labels()
+                .position(SeriesLabelPosition::UpperLeft)
+                .border_style(BLACK)
+                .background_style(WHITE)
+                .label_font(("sans-serif", 14))
+                .draw()
+                .map_err(|x| e(&x))?;
+        }
+        root.present().map_err(|x| e(&x))?;
+    }
+    image::RgbImage::from_raw(w, h, buffer)
+        .ok_or_else(|| anyhow!("image buffer"))?
+        .save(path)
+        .with_context(|| format!("--out {}", path.display()))?;
+    Ok(())
 }

@@ -280,3 +280,53 @@ fn polar_refuses_a_bad_scale_or_strategy() {
     }
     assert!(!dir.join("polar.png").exists());
 }
+
+/// `--against` (and `--fit`, which fits first) draws a second material
+/// against `--material` in four polar panels: polar-fit.png, with the data
+/// in black and the other material in red.
+#[test]
+fn polar_draws_a_material_against_another() {
+    let dir = fresh_dir("plot-against");
+    let d = dir.to_str().unwrap();
+    let other = r#"{"type":"cook-torrance","alpha":0.5,"kd":0.2}"#;
+    let out = lobe(&[
+        "plot",
+        "--kind",
+        "polar",
+        "-m",
+        GGX,
+        "--against",
+        other,
+        "--out",
+        d,
+        "-q",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let lines = stdout_lines(&out);
+    assert_eq!(lines.len(), 2, "{lines:?}");
+    assert!(lines[1].ends_with("polar-fit.png"), "{lines:?}");
+    let path = Path::new(&lines[1]);
+    check_png(path, (1200, 760));
+    let img = image::open(path).unwrap().to_rgb8();
+    let count = |f: &dyn Fn([u8; 3]) -> bool| img.pixels().filter(|p| f(p.0)).count();
+    let red = count(&|[r, g, b]| r > 180 && g < 90 && b < 80);
+    let black = count(&|[r, g, b]| r < 40 && g < 40 && b < 40);
+    assert!(
+        red > 1000 && black > 1000,
+        "red {red}, black {black} pixels"
+    );
+    // Only with a polar figure.
+    let out = lobe(&[
+        "plot", "--kind", "weights", "-m", GGX, "-s", "vndf", "--fit", "--out", d,
+    ]);
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("--fit and --against draw polar figures"),
+        "{err}"
+    );
+}

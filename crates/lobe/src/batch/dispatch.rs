@@ -23,6 +23,8 @@ pub(crate) enum Kernel {
     /// Cook-Torrance with distribution `ndf` and strategy `strat` (the
     /// kernel's const parameters).
     CookTorrance { ndf: u8, strat: u8, p: CtParams },
+    /// A measured table (per lane, the same at every level: `super::measured`).
+    Measured(super::measured::MeasuredKernel),
 }
 
 /// Which outputs `eval_pdf_block` writes: `f` and the pdf, `f` only, the pdf only.
@@ -287,6 +289,7 @@ macro_rules! instances {
                 (BECKMANN, COSINE) => $block::<L, BECKMANN, COSINE $($extra)*>($l, p, $inp, $out),
                 _ => unreachable!("BatchSampler::new builds only these"),
             },
+            Kernel::Measured(_) => unreachable!("run before the level's dispatch"),
         }
     };
 }
@@ -331,6 +334,9 @@ fn eval_pdf_avx512(l: Avx512, k: &Kernel, mode: u8, inp: EvalIn<'_>, out: EvalOu
 
 /// Run `sample` over a block (lengths already checked equal).
 pub(crate) fn sample(b: Backend, k: &Kernel, inp: SampleIn<'_>, out: SampleOut<'_, '_>) {
+    if let Kernel::Measured(m) = k {
+        return super::measured::sample_block(m, inp, out);
+    }
     match b {
         Backend::Scalar(l) => sample_level(l, k, inp, out),
         // SAFETY: an `Avx2` token exists only if the CPU has AVX2 and FMA.
@@ -346,6 +352,9 @@ pub(crate) fn sample(b: Backend, k: &Kernel, inp: SampleIn<'_>, out: SampleOut<'
 /// Run `eval_pdf` over a block (lengths already checked equal), writing
 /// the outputs `mode` names ([`BOTH`], [`F_ONLY`], [`PDF_ONLY`]).
 pub(crate) fn eval_pdf(b: Backend, k: &Kernel, mode: u8, inp: EvalIn<'_>, out: EvalOut<'_, '_>) {
+    if let Kernel::Measured(m) = k {
+        return super::measured::eval_pdf_block(m, mode, inp, out);
+    }
     match b {
         Backend::Scalar(l) => eval_pdf_level(l, k, mode, inp, out),
         // SAFETY: an `Avx2` token exists only if the CPU has AVX2 and FMA.

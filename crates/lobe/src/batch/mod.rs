@@ -39,7 +39,12 @@
 //!   scalar path's probability (`Material::glossy_probability`), the pdf is
 //!   the mixture, `f` the sum ([`BatchSampler::chooses_lobe`]; `uc = None`
 //!   there is [`BatchError::MissingUc`]);
-//! * the **Lambertian** material (`uniform`, `cosine`, `brdf`).
+//! * the **Lambertian** material (`uniform`, `cosine`, `brdf`);
+//! * **measured** materials (MERL and RGL tables: `uniform`, `cosine`,
+//!   `brdf`, and `vndf` for RGL files), lane by lane in f64 over the f32
+//!   tables (see `batch/measured.rs`: a table lookup, discontinuous for
+//!   MERL's nearest entry, is not an f32 computation): the scalar path's
+//!   numbers at the f32 inputs, rounded once, the same at every level.
 //!
 //! Not yet (the scalar path, [`crate::Material`], serves them;
 //! [`BatchSampler::new`] returns [`BatchError::Unsupported`]): the Phong
@@ -140,6 +145,7 @@ mod dispatch;
 mod kernel;
 mod lanes;
 mod math;
+mod measured;
 #[cfg(test)]
 mod tests;
 
@@ -479,6 +485,7 @@ impl BatchSampler {
     pub fn chooses_lobe(&self) -> bool {
         match self.kernel {
             Kernel::CookTorrance { p, .. } => p.two_lobes,
+            Kernel::Measured(_) => false,
         }
     }
 
@@ -691,10 +698,16 @@ fn kernel_for(m: &Material, strategy: BsdfStrategy) -> Result<Kernel, BatchError
                 },
             });
         }
+        Glossy::Measured(lobe) if kd == Rgb::ZERO => {
+            return match measured::MeasuredKernel::new(lobe, strategy) {
+                Some(k) => Ok(Kernel::Measured(k)),
+                None => unsupported(format!("strategy `{strategy}` of a measured table")),
+            };
+        }
         #[allow(unreachable_patterns)]
         _ => {
             return unsupported(format!(
-                "model `{}` (batched so far: cook-torrance, lambert)",
+                "model `{}` (batched so far: cook-torrance, lambert, measured)",
                 m.model_name()
             ));
         }

@@ -22,7 +22,12 @@
 //! Strategies: `uniform`, `cosine`, and `brdf`, the tabulated sampler of
 //! [`sampler`] (half-vector cells weighted by `lum(f) cos θi` and the
 //! half-vector Jacobian, 10% cosine sampling), built from the table when it
-//! is loaded, with an exact pdf.
+//! is loaded, with an exact pdf; `brdf` is this same sampler for MERL and
+//! RGL files alike. RGL files also have `vndf`: Dupuy and Jakob's own
+//! scheme, the file's luminance warp then its visible-normal warp
+//! ([`rgl::Rgl::sample_warps`], as Mitsuba 3 samples), with its exact pdf
+//! ([`rgl::Rgl::pdf_warps`]); a MERL table has no such warps and refuses
+//! `vndf`.
 
 use super::{Bxdf, ModelInfo, Param, Range, Value};
 use crate::math::Rgb;
@@ -282,13 +287,19 @@ impl Bxdf for Measured {
     }
 
     #[inline]
-    fn sample(&self, _strategy: BsdfStrategy, wo: DVec3, u: DVec2) -> Option<DVec3> {
-        self.data.sampler.sample(wo, u)
+    fn sample(&self, strategy: BsdfStrategy, wo: DVec3, u: DVec2) -> Option<DVec3> {
+        match (strategy, &self.data.table) {
+            (BsdfStrategy::Vndf, Table::Rgl(r)) => r.sample_warps(wo, u),
+            _ => self.data.sampler.sample(wo, u),
+        }
     }
 
     #[inline]
-    fn pdf(&self, _strategy: BsdfStrategy, wo: DVec3, wi: DVec3) -> f64 {
-        self.data.sampler.pdf(wo, wi)
+    fn pdf(&self, strategy: BsdfStrategy, wo: DVec3, wi: DVec3) -> f64 {
+        match (strategy, &self.data.table) {
+            (BsdfStrategy::Vndf, Table::Rgl(r)) => r.pdf_warps(wo, wi),
+            _ => self.data.sampler.pdf(wo, wi),
+        }
     }
 
     fn albedo_hint(&self, wo: DVec3) -> f64 {
@@ -296,10 +307,15 @@ impl Bxdf for Measured {
     }
 
     fn supports(&self, strategy: BsdfStrategy) -> Result<(), String> {
-        match strategy {
-            BsdfStrategy::Uniform | BsdfStrategy::Cosine | BsdfStrategy::Brdf => Ok(()),
+        match (strategy, &self.data.table) {
+            (BsdfStrategy::Uniform | BsdfStrategy::Cosine | BsdfStrategy::Brdf, _)
+            | (BsdfStrategy::Vndf, Table::Rgl(_)) => Ok(()),
+            (BsdfStrategy::Vndf, Table::Merl(_)) => Err(
+                "a MERL table has no visible-normal warp (RGL files do); use uniform, cosine or brdf (its tabulated sampler)"
+                    .into(),
+            ),
             _ => Err(
-                "a measured table has no microfacet model; use uniform, cosine or brdf (its tabulated sampler)"
+                "a measured table has no microfacet model; use uniform, cosine, brdf (its tabulated sampler) or, for RGL files, vndf (the file's own warps)"
                     .into(),
             ),
         }

@@ -384,23 +384,31 @@ impl Marginal2D {
     }
 
     /// `table[offset + i0]` interpolated across the parameters (`size` the
-    /// length of one slice of `table`).
+    /// length of one slice of `table`): the sum over the corners of the
+    /// parameters' cell of weight × value, corners of weight 0 skipped
+    /// (plain products and sums: `f32::mul_add` is a library call on CPUs
+    /// the binary is not compiled for, and this is the hot loop of every
+    /// RGL lookup).
+    #[inline]
     fn lookup(&self, table: &[f32], i0: usize, size: usize, wts: &Weights) -> f32 {
-        self.lookup_dim(table, self.params.len(), i0, size, wts)
-    }
-
-    fn lookup_dim(&self, table: &[f32], dim: usize, i0: usize, size: usize, wts: &Weights) -> f32 {
-        if dim == 0 {
-            return table.get(i0).copied().unwrap_or(0.0);
+        let d = self.params.len();
+        let mut acc = 0.0f32;
+        for corner in 0..(1usize << d) {
+            let mut w = 1.0f32;
+            let mut i = i0;
+            for dim in 0..d {
+                if corner >> dim & 1 == 1 {
+                    w *= wts.w[dim].1;
+                    i += self.strides[dim] * size;
+                } else {
+                    w *= wts.w[dim].0;
+                }
+            }
+            if w != 0.0 {
+                acc += w * table.get(i).copied().unwrap_or(0.0);
+            }
         }
-        let (w0, w1) = wts.w[dim - 1];
-        let v0 = self.lookup_dim(table, dim - 1, i0, size, wts);
-        if w1 == 0.0 {
-            return v0 * w0;
-        }
-        let i1 = i0 + self.strides[dim - 1] * size;
-        let v1 = self.lookup_dim(table, dim - 1, i1, size, wts);
-        v0.mul_add(w0, v1 * w1)
+        acc
     }
 
     /// The density (or the interpolated value, unnormalised) at `pos`.
@@ -415,6 +423,33 @@ impl Marginal2D {
         let v01 = self.lookup(&self.data, i + self.w, n, &wts);
         let v11 = self.lookup(&self.data, i + self.w + 1, n, &wts);
         (1.0 - fx) * (1.0 - fy) * v00 + fx * (1.0 - fy) * v10 + (1.0 - fx) * fy * v01 + fx * fy * v11
+    }
+
+    /// `[eval(pos, [p0, p1, k]) for k in 0, 1, 2]` for a table whose third
+    /// parameter is the channel `[0, 1, 2]`, the same bits, with the
+    /// weights and the cell found once.
+    #[must_use]
+    pub fn eval_channels(&self, pos: [f32; 2], param: [f32; 2]) -> [f32; 3] {
+        debug_assert!(self.params.len() == 3 && self.params[2] == [0.0, 1.0, 2.0]);
+        let mut wts = self.weights(&[param[0], param[1], 0.0]);
+        let base = wts.offset;
+        let (fx, fy, x, y) = self.cell(pos);
+        let n = self.w * self.h;
+        let mut out = [0f32; 3];
+        for (k, o) in out.iter_mut().enumerate() {
+            // Channel k: the slice k of the third parameter, weight 1 (as
+            // `weights` gives for the integral parameter k).
+            wts.offset = base + self.strides[2] * k;
+            wts.w[2] = if k == 0 { (1.0, 0.0) } else { (0.0, 1.0) };
+            let off = if k == 0 { wts.offset } else { wts.offset - self.strides[2] };
+            let i = off * n + y * self.w + x;
+            let v00 = self.lookup(&self.data, i, n, &wts);
+            let v10 = self.lookup(&self.data, i + 1, n, &wts);
+            let v01 = self.lookup(&self.data, i + self.w, n, &wts);
+            let v11 = self.lookup(&self.data, i + self.w + 1, n, &wts);
+            *o = (1.0 - fx) * (1.0 - fy) * v00 + fx * (1.0 - fy) * v10 + (1.0 - fx) * fy * v01 + fx * fy * v11;
+        }
+        out
     }
 
     /// The fraction within and the index of the grid cell holding `pos`.
@@ -515,19 +550,17 @@ impl Marginal2D {
     }
 }
 
-/// The position in a segment of a piecewise-linear density `v0 → v1` whose
-/// cdf is `sample` (times the width).
+/// The position `x ∈ [0, 1]` in a segment of a piecewise-linear density
+/// `v0 → v1` whose cdf is `sample` (times the width): the root of
+/// `v0 x + (v1 − v0) x²/2 = t/2`, `t = 2 sample / width`, written as
+/// `t / (v0 + √(v0² + t (v1 − v0)))`, which has no cancellation (Mitsuba's
+/// `(v0 − √(v0² + t (v1 − v0)))/(v0 − v1)` is the same number, but in f32
+/// its difference of nearly equal terms amplified a 1-ulp change of the
+/// view's elevation into 2e-5 of the sampled direction).
 fn sample_segment(sample: f32, inv_width: f32, v0: f32, v1: f32) -> f32 {
-    let non_const = (v0 - v1).abs() > 1e-4 * (v0 + v1);
-    let divisor = if non_const { v0 - v1 } else { v0 + v1 };
-    let mut s = sample * 2.0 * inv_width;
-    if non_const {
-        s = v0 - (v0 * v0 + s * (v1 - v0)).max(0.0).sqrt();
-    }
-    if divisor != 0.0 {
-        s /= divisor;
-    }
-    s
+    let t = sample * 2.0 * inv_width;
+    let d = v0 + (v0 * v0 + t * (v1 - v0)).max(0.0).sqrt();
+    if d > 0.0 { t / d } else { 0.0 }
 }
 
 fn invert_segment(sample: f32, width: f32, v0: f32, v1: f32) -> f32 {
@@ -791,10 +824,7 @@ impl Rgl {
         u_m[1] -= u_m[1].floor();
         let params = [phi_o, theta_o];
         let (s, _) = self.vndf.invert(u_m, &params);
-        let mut c = [0f32; 3];
-        for (k, v) in c.iter_mut().enumerate() {
-            *v = self.rgb.eval(s, &[phi_o, theta_o, k as f32]);
-        }
+        let c = self.rgb.eval_channels(s, [phi_o, theta_o]);
         let scale = if self.jacobian {
             self.ndf.eval(u_m, &[]) / (4.0 * self.sigma.eval(u_wo, &[]))
         } else {
@@ -807,7 +837,12 @@ impl Rgl {
     /// with θ uniform in `[0, 89°]`, an `n × n` grid. The visible-normal warp
     /// is `f cos θi` over the half vector with a floor of 1% of its mean (so
     /// that the grid spends its points on the lobe); `jacobian` is 0, so
-    /// `rgb` holds `f cos θi` itself.
+    /// `rgb` holds `f cos θi` itself. The `luminance` table is, as in Dupuy
+    /// and Jakob's files, the luminance of the data per unit area of the
+    /// sample square (`lum(f cos θi)` times the density of `ω_i` per unit
+    /// of the square under the vndf warp), with a floor of 1% of its mean:
+    /// the two warps together then sample `lum(f cos θi)` (nearly flat
+    /// where the vndf warp already follows the lobe).
     #[must_use]
     pub fn write(
         f: impl Fn(DVec3, DVec3) -> Rgb + Sync,
@@ -857,13 +892,18 @@ impl Rgl {
             for y in 0..n {
                 for x in 0..n {
                     let s = [x as f32 / (n - 1) as f32, y as f32 / (n - 1) as f32];
-                    let (u_m, _) = warp.sample(s, &[]);
+                    let (u_m, v) = warp.sample(s, &[]);
                     let m = m_of(u_m);
                     let c = fcos(wo, m);
                     for ch in 0..3 {
                         rgb[ch * n * n + y * n + x] = c[ch] as f32;
                     }
-                    luminance[y * n + x] = lum(c) as f32;
+                    // What the vndf warp leaves to correct: lum(f cos θi)
+                    // times the density of ω_i per unit area of the sample
+                    // square, 4 (wo·m) |dω_m/du_m| / vndf(u_m).
+                    let jac = 2.0 * std::f64::consts::PI.powi(2) * f64::from(u_m[0]) * f64::from(u2theta(u_m[0])).sin();
+                    let per_s = 4.0 * wo.dot(m).max(0.0) * jac / f64::from(v).max(1e-30);
+                    luminance[y * n + x] = (lum(c) * per_s) as f32;
                 }
             }
             let mean = luminance.iter().map(|&v| f64::from(v)).sum::<f64>() / (n * n) as f64;
@@ -902,6 +942,74 @@ impl Rgl {
         ])
     }
 
+    /// Dupuy and Jakob's own sampling scheme (the `vndf` strategy of an RGL
+    /// material), as Mitsuba 3's `measured` plugin samples: the uniform
+    /// point `(u.y, u.x)` is warped by the file's `luminance` table into
+    /// the sample square, and from there by the visible-normal warp `vndf`
+    /// into the half vector's `u_m = (√(θm/(π/2)), (φm − φo + π)/(2π))`;
+    /// `wi` is `wo` mirrored about `m` (`None` below the horizon, or for
+    /// `wo` below it). Both warps are interpolated between the file's view
+    /// elevations, as the tables are when evaluating. There is no
+    /// defensive mixture: where the file's warps have density zero, so
+    /// does this strategy.
+    #[must_use]
+    pub fn sample_warps(&self, wo: DVec3, u: DVec2) -> Option<DVec3> {
+        if wo.z <= 0.0 {
+            return None;
+        }
+        let theta_o = elevation(wo);
+        let phi_o = wo.y.atan2(wo.x) as f32;
+        let params = [phi_o, theta_o];
+        let (s, _) = self.luminance.sample([u.y as f32, u.x as f32], &params);
+        let (u_m, _) = self.vndf.sample(s, &params);
+        let (t, p) = (f64::from(u2theta(u_m[0])), f64::from(u2phi(u_m[1])) + f64::from(phi_o));
+        let m = DVec3::new(t.sin() * p.cos(), t.sin() * p.sin(), t.cos());
+        let wi = crate::math::reflect(wo, m);
+        if wi.z <= 0.0 || !wi.is_finite() {
+            return None;
+        }
+        Some(wi.normalize())
+    }
+
+    /// The solid-angle density of [`Rgl::sample_warps`] at `wi` (both above
+    /// the horizon): with `m = (wo + wi)/‖wo + wi‖` and `s` the sample
+    /// square's point that the `vndf` warp takes to `u_m` (its inverse),
+    /// `luminance(s) · vndf(u_m) / (2π² u_m.x sin θm · 4 wo·m)`: the two
+    /// warps' densities, then `u_m → ω_m` and `ω_m → ω_i`. The first
+    /// Jacobian is kept above 1e-6, as Mitsuba does, at the pole.
+    #[must_use]
+    pub fn pdf_warps(&self, wo: DVec3, wi: DVec3) -> f64 {
+        if wo.z <= 0.0 || wi.z <= 0.0 {
+            return 0.0;
+        }
+        let sum = wo + wi;
+        let len = sum.length();
+        // Also false for NaN.
+        if len.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
+            return 0.0;
+        }
+        let m = sum / len;
+        let om = wo.dot(m);
+        if om.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
+            return 0.0;
+        }
+        let theta_o = elevation(wo);
+        let phi_o = wo.y.atan2(wo.x) as f32;
+        let theta_m = elevation(m);
+        let phi_m = m.y.atan2(m.x) as f32;
+        let mut u_m = [theta2u(theta_m), phi2u(phi_m - phi_o)];
+        u_m[1] -= u_m[1].floor();
+        let params = [phi_o, theta_o];
+        let (s, vndf_pdf) = self.vndf.invert(u_m, &params);
+        let lum_pdf = self.luminance.eval(s, &params);
+        let jac = (2.0 * std::f64::consts::PI.powi(2) * f64::from(u_m[0]) * f64::from(theta_m).sin())
+            .max(1e-6)
+            * 4.0
+            * om;
+        let p = f64::from(vndf_pdf) * f64::from(lum_pdf) / jac;
+        if p.is_finite() && p > 0.0 { p } else { 0.0 }
+    }
+
     /// The view elevations of the table are interpolated; the grid point
     /// `s` of the sample square maps to the half vector `vndf.sample(s)`.
     #[must_use]
@@ -929,6 +1037,19 @@ mod tests {
             assert!((u[0] - a).abs() < 1e-4 && (u[1] - b).abs() < 1e-4, "{u:?} vs {a} {b}");
             assert!((pdf - pdf2).abs() < 1e-4 * pdf, "{pdf} {pdf2}");
             assert!((m.eval(x, &[p]) - pdf).abs() < 1e-4 * pdf);
+        }
+    }
+
+    #[test]
+    fn eval_channels_is_eval_per_channel() {
+        let (w, h) = (4, 3);
+        let data: Vec<f32> = (0..2 * 3 * 3 * w * h).map(|i| 0.1 + ((i * 13) % 17) as f32).collect();
+        let m = Marginal2D::new(&data, w, h, vec![vec![0.0, 1.0], vec![0.0, 0.5, 1.5], vec![0.0, 1.0, 2.0]], false, false);
+        for &(x, y, a, b) in &[(0.1, 0.2, 0.0, 0.0), (0.7, 0.9, 0.3, 1.2), (1.0, 0.5, 1.0, 0.5), (0.3, 0.0, 0.6, 2.0)] {
+            let c = m.eval_channels([x, y], [a, b]);
+            for (k, v) in c.iter().enumerate() {
+                assert_eq!(v.to_bits(), m.eval([x, y], &[a, b, k as f32]).to_bits(), "{x} {y} {a} {b} {k}");
+            }
         }
     }
 
