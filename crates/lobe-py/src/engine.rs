@@ -614,38 +614,75 @@ fn stream_copy<T: Copy>(dst: &mut [T], src: &[T]) {
     assert_eq!(dst.len(), src.len());
     #[cfg(target_arch = "x86_64")]
     {
-        use std::arch::x86_64::{__m128i, _mm_loadu_si128, _mm_sfence, _mm_stream_si128};
         let size = std::mem::size_of_val(dst);
-        let base = dst.as_mut_ptr().cast::<u8>();
-        let head = base.align_offset(16).min(size);
-        let body = (size - head) / 16;
-        if body < 4 {
-            dst.copy_from_slice(src);
+        let (d, s) = (dst.as_mut_ptr().cast::<u8>(), src.as_ptr().cast::<u8>());
+        if size >= 256 {
+            // SAFETY: `dst` and `src` are `size` bytes each and do not
+            // overlap (`&mut` and `&`); `T: Copy` has no drop glue and a
+            // byte copy of a `T` at the same offset is that `T`; AVX2 is
+            // checked before its entry point is called.
+            unsafe {
+                if is_x86_feature_detected!("avx2") {
+                    stream_bytes_avx2(d, s, size);
+                } else {
+                    stream_bytes_sse2(d, s, size);
+                }
+            }
             return;
         }
-        let sb = src.as_ptr().cast::<u8>();
-        // SAFETY: `dst` and `src` are `size` bytes each and do not overlap
-        // (`&mut` and `&`); every access below is within them; `T: Copy`
-        // has no drop glue and any byte copy of it is a valid `T` (both
-        // slices hold `T`s at the same offsets); the streaming stores are
-        // to 16-byte-aligned addresses (`head` is the alignment offset);
-        // SSE2 is part of the x86-64 baseline.
-        unsafe {
-            std::ptr::copy_nonoverlapping(sb, base, head);
-            for k in 0..body {
-                let o = head + 16 * k;
-                let v = _mm_loadu_si128(sb.add(o).cast::<__m128i>());
-                _mm_stream_si128(base.add(o).cast::<__m128i>(), v);
-            }
-            let done = head + 16 * body;
-            std::ptr::copy_nonoverlapping(sb.add(done), base.add(done), size - done);
-            // Order the streaming stores before anything this thread does
-            // next (rayon's join then publishes them to the caller).
-            _mm_sfence();
-        }
     }
-    #[cfg(not(target_arch = "x86_64"))]
     dst.copy_from_slice(src);
+}
+
+/// Copies `size` bytes from `s` to `d` with 16-byte streaming stores
+/// between an unaligned head and tail, then a store fence.
+///
+/// # Safety
+/// `d` and `s` valid for `size` bytes, not overlapping.
+#[cfg(target_arch = "x86_64")]
+unsafe fn stream_bytes_sse2(d: *mut u8, s: *const u8, size: usize) {
+    use std::arch::x86_64::{__m128i, _mm_loadu_si128, _mm_sfence, _mm_stream_si128};
+    let head = d.align_offset(16).min(size);
+    let body = (size - head) / 16;
+    // SAFETY: within the `size` bytes (caller); stores 16-byte aligned.
+    unsafe {
+        std::ptr::copy_nonoverlapping(s, d, head);
+        for k in 0..body {
+            let o = head + 16 * k;
+            _mm_stream_si128(d.add(o).cast::<__m128i>(), _mm_loadu_si128(s.add(o).cast()));
+        }
+        let done = head + 16 * body;
+        std::ptr::copy_nonoverlapping(s.add(done), d.add(done), size - done);
+        // Order the streaming stores before anything this thread does next
+        // (rayon's join then publishes them to the caller).
+        _mm_sfence();
+    }
+}
+
+/// [`stream_bytes_sse2`] with 32-byte streaming stores.
+///
+/// # Safety
+/// As [`stream_bytes_sse2`], on a CPU with AVX2.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn stream_bytes_avx2(d: *mut u8, s: *const u8, size: usize) {
+    use std::arch::x86_64::{__m256i, _mm_sfence, _mm256_loadu_si256, _mm256_stream_si256};
+    let head = d.align_offset(32).min(size);
+    let body = (size - head) / 32;
+    // SAFETY: within the `size` bytes (caller); stores 32-byte aligned.
+    unsafe {
+        std::ptr::copy_nonoverlapping(s, d, head);
+        for k in 0..body {
+            let o = head + 32 * k;
+            _mm256_stream_si256(
+                d.add(o).cast::<__m256i>(),
+                _mm256_loadu_si256(s.add(o).cast()),
+            );
+        }
+        let done = head + 32 * body;
+        std::ptr::copy_nonoverlapping(s.add(done), d.add(done), size - done);
+        _mm_sfence();
+    }
 }
 
 /// One block of sample outputs.
@@ -1266,7 +1303,7 @@ mod tests {
         let src: Vec<f32> = (0..200).map(|i| i as f32 * 0.5 - 7.0).collect();
         let mask: Vec<u32> = (0..200).map(|i| if i % 3 == 0 { 0 } else { !0 }).collect();
         for off in 0..5 {
-            for len in [0, 1, 3, 4, 15, 16, 17, 63, 64, 65, 150] {
+            for len in [0, 1, 3, 4, 15, 16, 17, 63, 64, 65, 150, 190] {
                 let s = &src[off..off + len];
                 let mut a = vec![9.0f32; len + 8];
                 stream_copy(&mut a[off..off + len], s);
@@ -1279,6 +1316,17 @@ mod tests {
                     assert_eq!(x, want, "offset {off}, length {len}, index {k}");
                 }
                 assert!(b[..off].iter().chain(&b[off + len..]).all(|&x| x == 9.0));
+                #[cfg(target_arch = "x86_64")]
+                {
+                    // The SSE2 path too (the AVX2 one runs where the CPU has it).
+                    let mut e = vec![9.0f32; len + 8];
+                    // SAFETY: both ranges hold `4 len` bytes and do not overlap.
+                    unsafe {
+                        stream_bytes_sse2(e[off..].as_mut_ptr().cast(), s.as_ptr().cast(), 4 * len);
+                    }
+                    assert_eq!(&e[off..off + len], s);
+                    assert!(e[..off].iter().chain(&e[off + len..]).all(|&x| x == 9.0));
+                }
                 let bytes: Vec<u8> = (0..len as u8).collect();
                 let mut c = vec![7u8; len + 8];
                 stream_copy(&mut c[off..off + len], &bytes);
