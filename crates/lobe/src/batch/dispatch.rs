@@ -407,6 +407,9 @@ pub(crate) enum MathFn {
     ErfcExp,
     ErfinvU,
     ErfinvURefined,
+    Expm1,
+    /// `(1 − x)ⁿ`, `n` given by its bits.
+    Pow1m(u32),
 }
 
 /// `f` over slices at `level` (the second output only for `ErfcExp`).
@@ -423,6 +426,8 @@ pub(crate) fn math_slice(level: SimdLevel, f: MathFn, x: &[f32], a: &mut [f32], 
             MathFn::ErfcExp => math::erfc_exp(l, x),
             MathFn::ErfinvU => (math::erfinv_u(l, x), z),
             MathFn::ErfinvURefined => (math::erfinv_u_refined(l, x), z),
+            MathFn::Expm1 => (math::expm1(l, x), z),
+            MathFn::Pow1m(n) => (math::pow_1m(l, x, l.splat(f32::from_bits(n))), z),
         }
     }
     #[inline(always)]
