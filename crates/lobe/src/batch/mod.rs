@@ -479,6 +479,7 @@ impl BatchSampler {
     pub fn chooses_lobe(&self) -> bool {
         match self.kernel {
             Kernel::CookTorrance { p, .. } => p.two_lobes,
+            Kernel::Lecture { p, .. } => p.two_lobes,
         }
     }
 
@@ -691,6 +692,24 @@ fn kernel_for(m: &Material, strategy: BsdfStrategy) -> Result<Kernel, BatchError
                 },
             });
         }
+        Glossy::Phong(lobe) => {
+            return lecture_kernel(m, strategy, kernel::phong::PHONG, lobe.ks, lobe.exponent, {
+                if lobe.normalized {
+                    (lobe.exponent + 2.0) * crate::math::INV_TWO_PI
+                } else {
+                    1.0
+                }
+            });
+        }
+        Glossy::BlinnPhong(lobe) => {
+            return lecture_kernel(m, strategy, kernel::phong::BLINN, lobe.ks, lobe.exponent, {
+                if lobe.normalized {
+                    crate::models::blinn_phong::normalization(lobe.exponent)
+                } else {
+                    1.0
+                }
+            });
+        }
         #[allow(unreachable_patterns)]
         _ => {
             return unsupported(format!(
@@ -708,23 +727,15 @@ fn kernel_for(m: &Material, strategy: BsdfStrategy) -> Result<Kernel, BatchError
     let ndf = match microfacet.ndf() {
         Ndf::Ggx => kernel::GGX,
         Ndf::Beckmann => kernel::BECKMANN,
-        other => {
-            return unsupported(format!(
-                "distribution `{}` (batched so far: ggx, beckmann)",
-                other.name()
-            ));
-        }
+        Ndf::BlinnPhong => kernel::BLINN_PHONG,
     };
     let strat = match strategy {
         BsdfStrategy::Vndf => kernel::VNDF,
         BsdfStrategy::Brdf => kernel::BRDF,
         BsdfStrategy::Uniform => kernel::UNIFORM,
         BsdfStrategy::Cosine => kernel::COSINE,
-        other => {
-            return unsupported(format!(
-                "strategy `{other}` (batched so far: vndf, brdf, uniform, cosine)"
-            ));
-        }
+        BsdfStrategy::SphericalCaps => kernel::CAPS,
+        BsdfStrategy::BoundedVndf => kernel::BOUNDED,
     };
     // Defensive: `check` accepted the strategy, so the lobe supports it.
     debug_assert!(m.glossy.supports(strategy).is_ok());
@@ -775,4 +786,51 @@ fn kernel_for(m: &Material, strategy: BsdfStrategy) -> Result<Kernel, BatchError
             two_lobes: m.chooses_lobe(strategy),
         },
     })
+}
+
+/// The kernel of a Phong (`model = PHONG`) or Blinn-Phong material with
+/// specular colour `ks`, exponent `n` and normalization `norm` (`f = ks ·
+/// norm · cosⁿ`); strategies brdf, uniform, cosine (`m.check` accepted it).
+fn lecture_kernel(
+    m: &Material,
+    strategy: BsdfStrategy,
+    model: u8,
+    ks: Rgb,
+    n: f64,
+    norm: f64,
+) -> Result<Kernel, BatchError> {
+    let strat = match strategy {
+        BsdfStrategy::Brdf => kernel::BRDF,
+        BsdfStrategy::Uniform => kernel::UNIFORM,
+        BsdfStrategy::Cosine => kernel::COSINE,
+        other => {
+            return Err(BatchError::Unsupported {
+                reason: format!("strategy `{other}` for model `{}`", m.model_name()),
+            });
+        }
+    };
+    let c3 = |c: Rgb| [c.x as f32, c.y as f32, c.z as f32];
+    let pdf_k = (n + 1.0) * crate::math::INV_TWO_PI;
+    let ks_norm = ks * norm;
+    if ks_norm.max_element() > f64::from(f32::MAX) / 1e3 {
+        return Err(BatchError::Unsupported {
+            reason: format!(
+                "ks × normalization = {} is beyond f32's range",
+                ks_norm.max_element()
+            ),
+        });
+    }
+    let kd = m.diffuse.albedo;
+    let p = kernel::phong::LectureParams {
+        n: n as f32,
+        inv_m: (1.0 / (n + 1.0)) as f32,
+        pdf_k: pdf_k as f32,
+        ks_norm: c3(ks_norm),
+        ks_w: c3(ks_norm / pdf_k),
+        kd_pi: c3(kd * crate::math::INV_PI),
+        // Constant for these models (their albedo hint ignores wo).
+        p_glossy: m.glossy_probability(glam::DVec3::Z) as f32,
+        two_lobes: m.chooses_lobe(strategy),
+    };
+    Ok(Kernel::Lecture { model, strat, p })
 }
