@@ -193,6 +193,10 @@ pub(super) struct Worst {
     bad: Vec<String>,
     valid: usize,
     count: usize,
+    /// Give the scalar path `wo` normalized in f64 (the lecture models,
+    /// whose scalar samplers take the f32 view's length, `1 ± 1.2e-7`, as
+    /// 1: see `grid::lecture_allowance`).
+    pub(super) unit_wo: bool,
 }
 
 /// The largest relative change of the scalar `(f, pdf, weight)` at `wi`
@@ -245,7 +249,11 @@ pub(super) fn compare_samples(
     }
     for i in 0..inp.u1.len() {
         w.count += 1;
-        let wo = inp.wo_at(i);
+        let wo = if w.unit_wo {
+            inp.wo_at(i).normalize()
+        } else {
+            inp.wo_at(i)
+        };
         let u = DVec2::new(inp.u1[i].into(), inp.u2[i].into());
         let scalar = sp.sample(wo, inp.uc[i].into(), u);
         let valid = out.valid[i] == 1;

@@ -185,12 +185,13 @@ fn groups(rng: &mut impl Rng, random: usize) -> Vec<(String, Vec<Material>, Bsdf
 }
 
 /// Phong and Blinn-Phong samples at large exponents: `f` and `pdf` of a
-/// sample are `cosⁿ` of an angle that an f32 view direction fixes only to
-/// about `1.2e-7` (its length is `1 ± 1.2e-7`, and both paths build their
-/// frames as if it were 1), so both paths' values are defined only to
-/// `expm1(n · 2.4e-7)` relative (6e-3 at `n = 10⁵`; the eval path, on the
-/// same inputs, agrees to 2e-5). A difference within that allowance (plus
-/// 1e-4) is counted, not failed.
+/// sample are `cosⁿ` of an angle that f32 directions fix only to about
+/// `1.2e-7` (their length is `1 ± 1.2e-7`: the view's, which both paths'
+/// frames take as 1, and the sampled `wi`'s, which the tangent moves of
+/// `explained_change` do not cover), so the values are defined only to
+/// `expm1(n · 2.4e-7)` relative (2.4e-2 at `n = 10⁵`; the eval path, on the
+/// same f32 inputs, agrees with the f64 path to 2e-5). A difference within
+/// that allowance (plus 1e-4) is counted, not failed.
 fn lecture_allowance(w: &mut Worst, exempt: &mut usize) {
     let field = |b: &str, key: &str| -> Option<f64> {
         let rest = b.split(key).nth(1)?;
@@ -239,10 +240,13 @@ fn grid_sample_matches_scalar() {
             }
         }
         let mut reference: Option<Vec<Vec<u32>>> = None;
-        let lecture_brdf = (name == "phong" || name == "blinn-phong") && s == BsdfStrategy::Brdf;
+        let lecture = name == "phong" || name == "blinn-phong";
         for level in levels("grid_sample_matches_scalar") {
             let mut lecture_exempt = 0usize;
-            let mut w = Worst::default();
+            let mut w = Worst {
+                unit_wo: lecture,
+                ..Worst::default()
+            };
             let mut all_bits = Vec::new();
             let mut out = SampleBuffers::new(n);
             for (m, inp) in mats.iter().zip(&sets) {
@@ -250,7 +254,7 @@ fn grid_sample_matches_scalar() {
                 b.sample(inp.input(), out.output()).unwrap();
                 compare_samples(m, s, inp, &out, &mut w);
                 all_bits.push(bits(&out));
-                if lecture_brdf {
+                if lecture {
                     lecture_allowance(&mut w, &mut lecture_exempt);
                 }
             }
@@ -277,9 +281,9 @@ fn grid_sample_matches_scalar() {
                 w.beyond_rel
             );
             eprintln!("grid_sample_matches_scalar {line}");
-            if lecture_brdf {
+            if lecture {
                 eprintln!(
-                    "grid_sample_matches_scalar {name} {s} {level}: {lecture_exempt} values within the allowance of the view's length (exponents ≥ 10³)"
+                    "grid_sample_matches_scalar {name} {s} {level}: {lecture_exempt} values beyond 1e-4 within the allowance of the directions' f32 length"
                 );
             }
             if name == "beckmann" && s == BsdfStrategy::Vndf {
