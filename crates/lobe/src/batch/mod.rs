@@ -128,9 +128,9 @@
 //!   within 7.4e-5 except 12 values in 6·10⁴ (at `n ≥ 10⁵`) within that
 //!   allowance;
 //! * chi-square of the batch samples against the batch pdf passes for caps
-//!   and bounded VNDF (two alphas, three views), the Blinn-Phong NDF's
-//!   brdf, Phong `n = 20` and Blinn-Phong `n = 300`, alone and with a
-//!   diffuse term.
+//!   and bounded VNDF and the Blinn-Phong NDF's brdf (alpha 0.1 × 0.5),
+//!   Phong `n = 20` alone and with a diffuse term, Blinn-Phong `n = 60`, at
+//!   60° and 89° (also at 0° and alpha 0.3 in a longer run).
 //!
 //! ## Cost per sample
 //!
@@ -149,6 +149,56 @@
 //! (`LOBE_SIMD=avx2 lobe bench --strategy vndf --samples 262144 --reps
 //! 1`): 480 instructions per vector of 8 GGX vndf samples, 70 per vector
 //! of `eval_pdf`.
+//!
+//! Every model × strategy, measured in one run per level on one thread
+//! (`LOBE_SIMD=avx512|avx2 lobe bench --material M --samples 4194304
+//! --reps 3`, every strategy of `M`; AMD EPYC Zen 4, 2 cores shared with
+//! other builds, so ±20%), in M samples/s of sample + eval_pdf, against
+//! the arithmetic of the kernel (operations per sample counted in the
+//! source, sample + eval_pdf, `+ − × ÷ √` and fused multiply-adds counted
+//! once each, compares and selects not; the polynomials counted as `exp`
+//! 20, `log` 17, `expm1` 28, `sincos` 16, `pow_cos` 80) and the rate that
+//! makes (G operations/s at avx512); the scalar f64 path in the same run:
+//!
+//! | material | strategy | ops/sample | avx512 | avx2 | scalar f64 | Gop/s avx512 |
+//! |---|---|---:|---:|---:|---:|---:|
+//! | lambert | uniform | 36 | 327 | 235 | 24 | 12 |
+//! | lambert | cosine | 43 | 310 | 195 | 21 | 13 |
+//! | lambert | brdf | 43 | 247 | 192 | 18 | 11 |
+//! | phong n=100 | uniform | 285 | 126 | 51 | 12 | 36 |
+//! | phong n=100 | cosine | 290 | 91 | 49 | 11 | 26 |
+//! | phong n=100 | brdf | 266 | 142 | 75 | 8 | 38 |
+//! | blinn-phong n=100 | uniform | 230 | 126 | 54 | 10 | 29 |
+//! | blinn-phong n=100 | cosine | 235 | 112 | 56 | 9 | 26 |
+//! | blinn-phong n=100 | brdf | 230 | 135 | 66 | 5 | 31 |
+//! | ggx α=0.2 | uniform | 135 | 187 | 134 | 10 | 25 |
+//! | ggx α=0.2 | cosine | 140 | 175 | 123 | 10 | 25 |
+//! | ggx α=0.2 | brdf | 125 | 180 | 119 | 8 | 22 |
+//! | ggx α=0.2 | vndf | 150 | 110 | 89 | 5 | 17 |
+//! | ggx α=0.2 | spherical-caps | 140 | 181 | 86 | 7 | 25 |
+//! | ggx α=0.2 | bounded-vndf | 170 | 142 | 94 | 7 | 24 |
+//! | ggx α=0.2, kd=0.3 | vndf | 220 | 120 | 76 | 5 | 26 |
+//! | ggx α=0.2, kd=0.3 | spherical-caps | 210 | 140 | 83 | 5 | 29 |
+//! | ggx α=0.2, kd=0.3 | bounded-vndf | 240 | 130 | 79 | 6 | 31 |
+//! | beckmann α=0.2 | uniform | 310 | 83 | 28 | 4 | 26 |
+//! | beckmann α=0.2 | brdf | 325 | 83 | 36 | 3 | 27 |
+//! | beckmann α=0.2 | vndf | 585 | 35 | 20 | 1.5 | 21 |
+//! | blinn-phong NDF α=0.2 | uniform | 465 | 67 | 34 | 3 | 31 |
+//! | blinn-phong NDF α=0.2 | cosine | 470 | 62 | 33 | 3 | 29 |
+//! | blinn-phong NDF α=0.2 | brdf | 530 | 57 | 28 | 3 | 30 |
+//!
+//! Every kernel runs at 20 to 40 G operations/s at avx512 (11 to 13 for
+//! Lambert, whose few operations leave the time to the loads, stores and
+//! the `eval_pdf` pass over memory), i.e. at about the same fraction of
+//! the core's throughput: the cost of a model × strategy is its arithmetic.
+//! The caps and Heitz's construction (vndf) draw the same visible normals
+//! with about the same arithmetic; their figures here (181 and 110 M/s at
+//! avx512, 86 and 89 at avx2) are not a ratio to quote from this shared
+//! machine.
+//! The heaviest are the Blinn-Phong NDF (its `cos^e` is a `pow_cos`, and
+//! its Smith term is Beckmann's, `erfc` and `exp` twice) and Beckmann vndf
+//! (the Newton inversion). `cargo bench -p lobe --bench batch` times the
+//! same work per material (blocks of 4096, criterion).
 //!
 //! The portable level uses `f32::mul_add` for bit-identical results: on an
 //! x86-64 CPU without FMA that is a library call, and the portable level
