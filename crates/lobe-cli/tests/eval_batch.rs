@@ -194,7 +194,18 @@ fn batch_agrees_with_the_f64_path_for_every_model_and_strategy() {
                 }
             } else {
                 check_rel(&b["pdf"], &r["pdf"]);
-                check_rel(&b["weight"], &r["weight"]);
+                // The weight carries cos θi: an f32 wi whose z is off by
+                // |Δz| moves it by |Δz|/z relative (Beckmann vndf's wi is
+                // good to ~1e-6 at grazing views, module doc of lobe::batch).
+                let dz = (nums(&b["wi"])[2] - nums(&r["wi"])[2]).abs() / nums(&r["wi"])[2];
+                for (x, y) in nums(&b["weight"]).into_iter().zip(nums(&r["weight"])) {
+                    if !close_rel(x, y, 1e-4 + 2.0 * dz) {
+                        bad = true;
+                    }
+                    if y.abs() > 1e-30 {
+                        worst_rel = worst_rel.max(((x - y).abs() / y.abs() - 2.0 * dz).max(0.0));
+                    }
+                }
                 for (x, y) in nums(&b["wi"]).into_iter().zip(nums(&r["wi"])) {
                     worst_abs = worst_abs.max((x - y).abs());
                     if (x - y).abs() > 1e-5 {
@@ -231,8 +242,9 @@ fn an_unbatched_material_is_a_clear_error() {
         "{\"wo\":[0,0,1],\"u\":[0.5,0.5],\"strategy\":\"brdf\"}\n",
     );
     assert_eq!(code, Some(1));
+    // (After the warning that this material reflects more than it receives.)
     assert!(
-        err.starts_with("lobe: error: stdin line 1: --batch, strategy `brdf`: ")
+        err.contains("lobe: error: stdin line 1: --batch, strategy `brdf`: ")
             && err.contains("f32"),
         "{err}"
     );

@@ -895,7 +895,7 @@ fn lecture_kernel(
     if ks_norm.max_element() > f64::from(f32::MAX) / 1e3 {
         return Err(BatchError::Unsupported {
             reason: format!(
-                "ks × normalization = {} is beyond f32's range",
+                "ks × normalization = {:e} is beyond f32's range",
                 ks_norm.max_element()
             ),
         });
