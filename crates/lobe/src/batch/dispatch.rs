@@ -8,7 +8,10 @@
 //! the block size, on where the block was cut, or on the thread.
 
 use super::SimdLevel;
-use super::kernel::{self, BECKMANN, BRDF, COSINE, CtParams, GGX, Sampled, UNIFORM, VNDF};
+use super::kernel::phong::{BLINN, LectureParams, PHONG};
+use super::kernel::{
+    self, BECKMANN, BLINN_PHONG, BOUNDED, BRDF, CAPS, COSINE, CtParams, GGX, Sampled, UNIFORM, VNDF,
+};
 #[cfg(target_arch = "x86_64")]
 use super::lanes::{Avx2, Avx512};
 use super::lanes::{Lanes, Scalar};
@@ -25,6 +28,88 @@ pub(crate) enum Kernel {
     CookTorrance { ndf: u8, strat: u8, p: CtParams },
     /// A measured table (per lane, the same at every level: `super::measured`).
     Measured(super::measured::MeasuredKernel),
+    /// Phong or Blinn-Phong (`model`: `PHONG`, `BLINN`) with strategy `strat`.
+    Lecture {
+        model: u8,
+        strat: u8,
+        p: LectureParams,
+    },
+}
+
+/// A kernel's parameters, as the block loops run them: one vector of
+/// `sample` and of `eval_pdf` for the instance `<A, B>` (the kernel's const
+/// parameters: distribution or model, and strategy).
+pub(crate) trait VecKernel {
+    /// Whether `uc` chooses between two lobes (read from the inputs).
+    fn two_lobes(&self) -> bool;
+    fn sample<L: Lanes, const A: u8, const B: u8>(
+        &self,
+        l: L,
+        wo: [L::F; 3],
+        u1: L::F,
+        u2: L::F,
+        uc: L::F,
+    ) -> Sampled<L>;
+    fn eval_pdf<L: Lanes, const A: u8, const B: u8>(
+        &self,
+        l: L,
+        wo: [L::F; 3],
+        wi: [L::F; 3],
+    ) -> ([L::F; 3], L::F);
+}
+
+impl VecKernel for CtParams {
+    #[inline(always)]
+    fn two_lobes(&self) -> bool {
+        self.two_lobes
+    }
+    #[inline(always)]
+    fn sample<L: Lanes, const A: u8, const B: u8>(
+        &self,
+        l: L,
+        wo: [L::F; 3],
+        u1: L::F,
+        u2: L::F,
+        uc: L::F,
+    ) -> Sampled<L> {
+        kernel::sample::<L, A, B>(l, self, wo, u1, u2, uc)
+    }
+    #[inline(always)]
+    fn eval_pdf<L: Lanes, const A: u8, const B: u8>(
+        &self,
+        l: L,
+        wo: [L::F; 3],
+        wi: [L::F; 3],
+    ) -> ([L::F; 3], L::F) {
+        kernel::eval_pdf::<L, A, B>(l, self, wo, wi)
+    }
+}
+
+impl VecKernel for LectureParams {
+    #[inline(always)]
+    fn two_lobes(&self) -> bool {
+        self.two_lobes
+    }
+    #[inline(always)]
+    fn sample<L: Lanes, const A: u8, const B: u8>(
+        &self,
+        l: L,
+        wo: [L::F; 3],
+        u1: L::F,
+        u2: L::F,
+        uc: L::F,
+    ) -> Sampled<L> {
+        kernel::phong::sample::<L, A, B>(l, self, wo, u1, u2, uc)
+    }
+    #[inline(always)]
+    fn eval_pdf<L: Lanes, const A: u8, const B: u8>(
+        &self,
+        l: L,
+        wo: [L::F; 3],
+        wi: [L::F; 3],
+    ) -> ([L::F; 3], L::F) {
+        kernel::phong::eval_pdf::<L, A, B>(l, self, wo, wi)
+    }
 }
 
 /// Which outputs `eval_pdf_block` writes: `f` and the pdf, `f` only, the pdf only.
@@ -108,16 +193,15 @@ fn store_sampled<L: Lanes>(
 #[inline(always)]
 fn run_sample<L: Lanes, const NDF: u8, const STRAT: u8>(
     l: L,
-    p: &CtParams,
+    p: &impl VecKernel,
     x: [&[f32]; 6],
 ) -> Sampled<L> {
-    kernel::sample::<L, NDF, STRAT>(
+    p.sample::<L, NDF, STRAT>(
         l,
-        p,
         [l.load(x[0]), l.load(x[1]), l.load(x[2])],
         l.load(x[3]),
         l.load(x[4]),
-        if p.two_lobes {
+        if p.two_lobes() {
             l.load(x[5])
         } else {
             l.splat(0.5)
@@ -129,14 +213,14 @@ fn run_sample<L: Lanes, const NDF: u8, const STRAT: u8>(
 #[inline(always)]
 fn run_eval_pdf<L: Lanes, const NDF: u8, const STRAT: u8, const MODE: u8>(
     l: L,
-    p: &CtParams,
+    p: &impl VecKernel,
     x: [&[f32]; 6],
     out: &mut [&mut [f32]; 4],
     k: usize,
 ) {
     let wo = [l.load(x[0]), l.load(x[1]), l.load(x[2])];
     let wi = [l.load(x[3]), l.load(x[4]), l.load(x[5])];
-    let (f, pdf) = kernel::eval_pdf::<L, NDF, STRAT>(l, p, wo, wi);
+    let (f, pdf) = p.eval_pdf::<L, NDF, STRAT>(l, wo, wi);
     if MODE != PDF_ONLY {
         l.store(f[0], &mut out[0][k..]);
         l.store(f[1], &mut out[1][k..]);
@@ -150,7 +234,7 @@ fn run_eval_pdf<L: Lanes, const NDF: u8, const STRAT: u8, const MODE: u8>(
 #[inline(always)]
 fn sample_block<L: Lanes, const NDF: u8, const STRAT: u8>(
     l: L,
-    p: &CtParams,
+    p: &impl VecKernel,
     inp: SampleIn<'_>,
     (out, valid): SampleOut<'_, '_>,
 ) {
@@ -211,7 +295,7 @@ fn sample_block<L: Lanes, const NDF: u8, const STRAT: u8>(
 #[inline(always)]
 fn eval_pdf_block<L: Lanes, const NDF: u8, const STRAT: u8, const MODE: u8>(
     l: L,
-    p: &CtParams,
+    p: &impl VecKernel,
     inp: EvalIn<'_>,
     out: EvalOut<'_, '_>,
 ) {
@@ -287,6 +371,20 @@ macro_rules! instances {
                 (BECKMANN, BRDF) => $block::<L, BECKMANN, BRDF $($extra)*>($l, p, $inp, $out),
                 (BECKMANN, UNIFORM) => $block::<L, BECKMANN, UNIFORM $($extra)*>($l, p, $inp, $out),
                 (BECKMANN, COSINE) => $block::<L, BECKMANN, COSINE $($extra)*>($l, p, $inp, $out),
+                (GGX, CAPS) => $block::<L, GGX, CAPS $($extra)*>($l, p, $inp, $out),
+                (GGX, BOUNDED) => $block::<L, GGX, BOUNDED $($extra)*>($l, p, $inp, $out),
+                (BLINN_PHONG, BRDF) => $block::<L, BLINN_PHONG, BRDF $($extra)*>($l, p, $inp, $out),
+                (BLINN_PHONG, UNIFORM) => $block::<L, BLINN_PHONG, UNIFORM $($extra)*>($l, p, $inp, $out),
+                (BLINN_PHONG, COSINE) => $block::<L, BLINN_PHONG, COSINE $($extra)*>($l, p, $inp, $out),
+                _ => unreachable!("BatchSampler::new builds only these"),
+            },
+            Kernel::Lecture { model, strat, p } => match (*model, *strat) {
+                (PHONG, BRDF) => $block::<L, PHONG, BRDF $($extra)*>($l, p, $inp, $out),
+                (PHONG, UNIFORM) => $block::<L, PHONG, UNIFORM $($extra)*>($l, p, $inp, $out),
+                (PHONG, COSINE) => $block::<L, PHONG, COSINE $($extra)*>($l, p, $inp, $out),
+                (BLINN, BRDF) => $block::<L, BLINN, BRDF $($extra)*>($l, p, $inp, $out),
+                (BLINN, UNIFORM) => $block::<L, BLINN, UNIFORM $($extra)*>($l, p, $inp, $out),
+                (BLINN, COSINE) => $block::<L, BLINN, COSINE $($extra)*>($l, p, $inp, $out),
                 _ => unreachable!("BatchSampler::new builds only these"),
             },
             Kernel::Measured(_) => unreachable!("run before the level's dispatch"),
@@ -416,6 +514,11 @@ pub(crate) enum MathFn {
     ErfcExp,
     ErfinvU,
     ErfinvURefined,
+    Expm1,
+    /// `(1 − x)ⁿ`, `n` given by its bits.
+    Pow1m(u32),
+    /// `xⁿ` by `pow_cos(1 − x, x, n)`, `n` given by its bits.
+    PowCos(u32),
 }
 
 /// `f` over slices at `level` (the second output only for `ErfcExp`).
@@ -432,6 +535,12 @@ pub(crate) fn math_slice(level: SimdLevel, f: MathFn, x: &[f32], a: &mut [f32], 
             MathFn::ErfcExp => math::erfc_exp(l, x),
             MathFn::ErfinvU => (math::erfinv_u(l, x), z),
             MathFn::ErfinvURefined => (math::erfinv_u_refined(l, x), z),
+            MathFn::Expm1 => (math::expm1(l, x), z),
+            MathFn::Pow1m(n) => (math::pow_1m(l, x, l.splat(f32::from_bits(n))), z),
+            MathFn::PowCos(n) => (
+                math::pow_cos(l, l.splat(1.0) - x, x, l.splat(f32::from_bits(n))),
+                z,
+            ),
         }
     }
     #[inline(always)]

@@ -46,6 +46,22 @@ pub(crate) const BRDF: u8 = 1;
 pub(crate) const UNIFORM: u8 = 2;
 /// `STRAT`: cosine-weighted hemisphere.
 pub(crate) const COSINE: u8 = 3;
+/// `NDF`: the Blinn-Phong NDF (`blinn_ndf`).
+pub(crate) const BLINN_PHONG: u8 = 2;
+/// `STRAT`: GGX visible normals by spherical caps (`caps`).
+pub(crate) const CAPS: u8 = 4;
+/// `STRAT`: GGX bounded VNDF (`caps`).
+pub(crate) const BOUNDED: u8 = 5;
+
+// Kernels in files of their own, children of this module (they share its
+// helpers): the spherical caps and bounded VNDF, the Blinn-Phong NDF, the
+// Phong and Blinn-Phong models.
+#[path = "blinn_ndf.rs"]
+mod blinn_ndf;
+#[path = "caps.rs"]
+mod caps;
+#[path = "phong.rs"]
+pub(crate) mod phong;
 
 const INV_SQRT_PI: f32 = 0.5 * std::f32::consts::FRAC_2_SQRT_PI;
 const TWO_INV_SQRT_PI: f32 = std::f32::consts::FRAC_2_SQRT_PI;
@@ -368,6 +384,11 @@ fn eval_at<L: Lanes, const NDF: u8, const STRAT: u8>(
         let q = hh * inv_z2;
         l.splat(p.inv_pi_axay) * exp(l, -(sxy * inv_z2)) * (q * q)
     };
+    let d = if NDF == BLINN_PHONG {
+        blinn_ndf::d(l, p, h, hh)
+    } else {
+        d
+    };
     let ksf = ks_fresnel(l, &p.fresnel, cos_oh);
     if NDF == GGX && p.shadow == Shadow::Correlated && (STRAT == VNDF || STRAT == BRDF) {
         // The fast path: height-correlated Smith without cancellation.
@@ -662,6 +683,9 @@ pub(crate) fn sample<L: Lanes, const NDF: u8, const STRAT: u8>(
     u2: L::F,
     uc: L::F,
 ) -> Sampled<L> {
+    if STRAT == CAPS || STRAT == BOUNDED {
+        return caps::sample::<L, STRAT>(l, p, wo, u1, u2, uc);
+    }
     let zero = l.splat(0.0);
     let one = l.splat(1.0);
     let (ax, ay) = (l.splat(p.ax), l.splat(p.ay));
@@ -694,6 +718,11 @@ pub(crate) fn sample<L: Lanes, const NDF: u8, const STRAT: u8>(
             let n = [-(ax * r * cos), -(ay * r * sin), one];
             let inv = one / l.sqrt(dot(l, n, n));
             [n[0] * inv, n[1] * inv, inv]
+        };
+        let m = if STRAT == BRDF && NDF == BLINN_PHONG {
+            blinn_ndf::sample_normal(l, p, u1, u2)
+        } else {
+            m
         };
         let om = dot(l, wo, m);
         let two_om = om + om;
@@ -817,6 +846,13 @@ pub(crate) fn eval_pdf<L: Lanes, const NDF: u8, const STRAT: u8>(
     wo: V3<L>,
     wi: V3<L>,
 ) -> (V3<L>, L::F) {
+    // The caps draw the visible normals: vndf's f and pdf.
+    if STRAT == CAPS {
+        return eval_pdf::<L, NDF, VNDF>(l, p, wo, wi);
+    }
+    if STRAT == BOUNDED {
+        return caps::eval_pdf_bounded(l, p, wo, wi);
+    }
     let zero = l.splat(0.0);
     let e = eval::<L, NDF, STRAT>(l, p, wo, wi);
     let f_ok = e.ok & l.is_finite(e.f[0]) & l.is_finite(e.f[1]) & l.is_finite(e.f[2]);

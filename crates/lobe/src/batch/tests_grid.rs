@@ -47,6 +47,54 @@ fn batched() -> Vec<(Ndf, BsdfStrategy)> {
             v.push((ndf, s));
         }
     }
+    v.extend(later_pairs());
+    v
+}
+
+/// The pairs added after the first step: GGX's spherical caps and bounded
+/// VNDF, the Blinn-Phong NDF's strategies (tested on fewer random
+/// materials, to keep the cost down).
+fn later_pairs() -> [(Ndf, BsdfStrategy); 5] {
+    [
+        (Ndf::Ggx, BsdfStrategy::SphericalCaps),
+        (Ndf::Ggx, BsdfStrategy::BoundedVndf),
+        (Ndf::BlinnPhong, BsdfStrategy::Brdf),
+        (Ndf::BlinnPhong, BsdfStrategy::Uniform),
+        (Ndf::BlinnPhong, BsdfStrategy::Cosine),
+    ]
+}
+
+/// Phong (`blinn = false`) or Blinn-Phong materials: both forms at
+/// exponents 0 to 10⁷, with and without a diffuse term, then random ones
+/// (exponent log-uniform in [0.1, 10⁷]).
+fn lecture_materials(rng: &mut impl Rng, blinn: bool, random: usize) -> Vec<Material> {
+    use crate::models::{BlinnPhong, Phong};
+    let lobe = |ks: Rgb, n: f64, normalized: bool| {
+        if blinn {
+            Glossy::BlinnPhong(BlinnPhong::new(ks, n, normalized).unwrap())
+        } else {
+            Glossy::Phong(Phong::new(ks, n, normalized).unwrap())
+        }
+    };
+    let mut v = Vec::new();
+    for (i, n) in [0.0, 1.0, 20.0, 1e3, 1e5, 1e7].into_iter().enumerate() {
+        for normalized in [false, true] {
+            let ks = [Rgb::new(0.9, 0.5, 0.2), Rgb::ONE][i % 2];
+            for kd in [Rgb::ZERO, Rgb::new(0.5, 0.3, 0.1)] {
+                v.push(Material::with_diffuse(kd, lobe(ks, n, normalized)).unwrap());
+            }
+        }
+    }
+    for _ in 0..random {
+        let n = 10f64.powf(rng.random_range(-1.0..7.0));
+        let ks = Rgb::new(rng.random(), rng.random(), rng.random());
+        let kd = if rng.random::<bool>() {
+            Rgb::ZERO
+        } else {
+            Rgb::new(rng.random(), rng.random(), rng.random()) * 0.5
+        };
+        v.push(Material::with_diffuse(kd, lobe(ks, n, rng.random())).unwrap());
+    }
     v
 }
 
@@ -97,8 +145,30 @@ fn grid_materials(rng: &mut impl Rng, ndf: Ndf, random: usize) -> Vec<Material> 
 /// and the Lambertian material's strategies.
 fn groups(rng: &mut impl Rng, random: usize) -> Vec<(String, Vec<Material>, BsdfStrategy)> {
     let mut v = Vec::new();
+    let later = later_pairs();
     for (ndf, s) in batched() {
-        v.push((ndf.name().to_string(), grid_materials(rng, ndf, random), s));
+        let r = if later.contains(&(ndf, s)) {
+            random / 4
+        } else {
+            random
+        };
+        let name = if ndf == Ndf::BlinnPhong {
+            "blinn-phong-ndf"
+        } else {
+            ndf.name()
+        };
+        v.push((name.to_string(), grid_materials(rng, ndf, r), s));
+    }
+    for blinn in [false, true] {
+        let mats = lecture_materials(rng, blinn, random / 4);
+        let name = if blinn { "blinn-phong" } else { "phong" };
+        for s in [
+            BsdfStrategy::Brdf,
+            BsdfStrategy::Uniform,
+            BsdfStrategy::Cosine,
+        ] {
+            v.push((name.to_string(), mats.clone(), s));
+        }
     }
     let lambert = vec![
         Material::lambert(Rgb::new(0.9, 0.5, 0.1)).unwrap(),
@@ -114,6 +184,27 @@ fn groups(rng: &mut impl Rng, random: usize) -> Vec<(String, Vec<Material>, Bsdf
     v
 }
 
+/// Phong and Blinn-Phong samples at large exponents: `f` and `pdf` of a
+/// sample are `cosⁿ` of an angle that f32 directions fix only to about
+/// `1.2e-7` (their length is `1 ± 1.2e-7`: the view's, which both paths'
+/// frames take as 1, and the sampled `wi`'s, which the tangent moves of
+/// `explained_change` do not cover), so the values are defined only to
+/// `expm1(n · 2.4e-7)` relative (2.4e-2 at `n = 10⁵`; the eval path, on the
+/// same f32 inputs, agrees with the f64 path to 2e-5). A difference within
+/// that allowance (plus 1e-4) is counted, not failed.
+fn lecture_allowance(w: &mut Worst, exempt: &mut usize) {
+    let field = |b: &str, key: &str| -> Option<f64> {
+        let rest = b.split(key).nth(1)?;
+        rest.split([',', ' ', ')']).next()?.parse().ok()
+    };
+    let before = w.bad.len();
+    w.bad.retain(|b| match (field(b, "exponent: "), field(b, ", rel ")) {
+        (Some(n), Some(r)) => r > REL + (n * 2.4e-7).exp_m1(),
+        _ => true,
+    });
+    *exempt += before - w.bad.len();
+}
+
 /// Samples of every batched pair, every shadowing × Fresnel, iso and
 /// aniso, at every level, against the scalar path. Cost: about 15 s of
 /// CPU in release.
@@ -124,6 +215,18 @@ fn grid_sample_matches_scalar() {
     let mut summary = Vec::new();
     for (name, mats, s) in groups(&mut rng, 16) {
         let mut sets: Vec<Inputs> = mats.iter().map(|_| inputs(&mut rng, n)).collect();
+        if (name == "phong" || name == "blinn-phong") && s == BsdfStrategy::Brdf {
+            // u1 = 0 draws cos θ = 0 about the lobe's axis, where the
+            // scalar path's recomputed cos is rounding noise around 0 and
+            // its pdf (noise)ⁿ: valid or not by chance. Tested without it.
+            for inp in &mut sets {
+                for u in &mut inp.u1 {
+                    if *u == 0.0 {
+                        *u = f32::EPSILON / 2.0;
+                    }
+                }
+            }
+        }
         if name == "beckmann" && s == BsdfStrategy::Vndf {
             // u1 = 0 is clamped to 1e-12 by both paths, deep in the tail of
             // the slope CDF, where the f32 inversion is good to 1.2e-4 in wi
@@ -137,8 +240,13 @@ fn grid_sample_matches_scalar() {
             }
         }
         let mut reference: Option<Vec<Vec<u32>>> = None;
+        let lecture = name == "phong" || name == "blinn-phong";
         for level in levels("grid_sample_matches_scalar") {
-            let mut w = Worst::default();
+            let mut lecture_exempt = 0usize;
+            let mut w = Worst {
+                unit_wo: lecture,
+                ..Worst::default()
+            };
             let mut all_bits = Vec::new();
             let mut out = SampleBuffers::new(n);
             for (m, inp) in mats.iter().zip(&sets) {
@@ -146,6 +254,9 @@ fn grid_sample_matches_scalar() {
                 b.sample(inp.input(), out.output()).unwrap();
                 compare_samples(m, s, inp, &out, &mut w);
                 all_bits.push(bits(&out));
+                if lecture {
+                    lecture_allowance(&mut w, &mut lecture_exempt);
+                }
             }
             match &reference {
                 None => reference = Some(all_bits),
@@ -170,6 +281,11 @@ fn grid_sample_matches_scalar() {
                 w.beyond_rel
             );
             eprintln!("grid_sample_matches_scalar {line}");
+            if lecture {
+                eprintln!(
+                    "grid_sample_matches_scalar {name} {s} {level}: {lecture_exempt} values beyond 1e-4 within the allowance of the directions' f32 length"
+                );
+            }
             if name == "beckmann" && s == BsdfStrategy::Vndf {
                 let steps = super::super::kernel::STEPS.with(|c| c.replace(0));
                 let calls = super::super::kernel::STEPS_CALLS.with(|c| c.replace(0));
@@ -183,8 +299,14 @@ fn grid_sample_matches_scalar() {
             // Beckmann vndf: wi within 1e-4 (not 1e-5) where the slope CDF is
             // inverted within 6e-8 of 1 at grazing views (measured: 10 samples
             // in 8e4, |Δwi| ≤ 7.3e-5; see the module doc).
+            let caps = matches!(s, BsdfStrategy::SphericalCaps | BsdfStrategy::BoundedVndf);
             let wi_ok = if name == "beckmann" && s == BsdfStrategy::Vndf {
                 w.wi_abs < 1e-4
+            } else if caps {
+                // The caps' point near −wh (the rim, u2 → 1, at grazing
+                // views) makes `point + wh` cancel in f32: |Δwi| up to
+                // 1.4e-5 there (measured: 1 sample in 6·10⁴; module doc).
+                w.wi_abs < 2e-5
             } else {
                 w.wi_bad.is_empty()
             };
@@ -301,6 +423,9 @@ fn grid_eval_pdf_matches_scalar() {
                     }
                     for c in 0..3 {
                         f_rel = f_rel.max(rel_err(fb[c].into(), f[c]));
+                        if rel_err(fb[c].into(), f[c]) > 1e-3 && std::env::var("DBG").is_ok() {
+                            eprintln!("DBG {level} {m:?} {s} wo {o} wi {i}: f {} vs {}", fb[c], f[c]);
+                        }
                     }
                     pdf_rel = pdf_rel.max(rel_err(pb.into(), pdf));
                 }
@@ -360,8 +485,16 @@ fn grid_chi2_batch_pdf() {
     // Every Cook-Torrance pair at two alphas, two-lobe mixtures and the
     // Lambertian material.
     let mut mats: Vec<(String, Material, BsdfStrategy)> = Vec::new();
+    // The later pairs' uniform and cosine are the hemisphere warps of the
+    // pairs above, with the same pdfs: not repeated.
+    let later = later_pairs();
     for (ndf, s) in cases {
-        for &(ax, ay) in &alphas {
+        if later.contains(&(ndf, s)) && matches!(s, BsdfStrategy::Uniform | BsdfStrategy::Cosine) {
+            continue;
+        }
+        // The later pairs at the anisotropic alpha only (test cost).
+        let first = if later.contains(&(ndf, s)) { 1 } else { 0 };
+        for &(ax, ay) in &alphas[first..] {
             let m = ct(
                 ndf,
                 ax,
@@ -397,12 +530,32 @@ fn grid_chi2_batch_pdf() {
     ] {
         mats.push(("lambert".into(), Material::lambert(Rgb::ONE).unwrap(), s));
     }
+    // The lecture models' lobes, alone and with a diffuse term (brdf: the
+    // uniform and cosine warps are those above).
+    {
+        use crate::models::{BlinnPhong, Phong};
+        let phong = Glossy::Phong(Phong::new(Rgb::ONE, 20.0, true).unwrap());
+        let blinn = Glossy::BlinnPhong(BlinnPhong::new(Rgb::ONE, 60.0, true).unwrap());
+        for (name, g, kd) in [
+            ("phong n=20", phong, Rgb::ZERO),
+            ("phong n=20", phong, Rgb::new(0.5, 0.3, 0.2)),
+            ("blinn-phong n=60", blinn, Rgb::ZERO),
+        ] {
+            let m = Material::with_diffuse(kd, g).unwrap();
+            mats.push((format!("{name} kd={}", kd.x), m, BsdfStrategy::Brdf));
+        }
+    }
+    // The cases added after the first step at 60° and 89° only (test cost).
     let alpha = sidak(0.01, mats.len() * views.len());
     let _ = alphas;
     for (name, m, s) in mats {
         {
             let b = BatchSampler::with_level(&m, s, level).unwrap();
-            for &theta in &views {
+            let later_case = name.starts_with("phong")
+                || name.starts_with("blinn-phong n")
+                || matches!(s, BsdfStrategy::SphericalCaps | BsdfStrategy::BoundedVndf)
+                || name.starts_with("blinn-phong α");
+            for &theta in &views[if later_case { 1 } else { 0 }..] {
                 let wo = crate::frame::wo_from_theta(theta, 0.3f64.to_degrees());
                 let wo32 = [wo.x as f32, wo.y as f32, wo.z as f32];
                 let (wox, woy, woz) = (vec![wo32[0]; n], vec![wo32[1]; n], vec![wo32[2]; n]);
@@ -502,12 +655,12 @@ fn grid_every_supported_combination_builds() {
     }
     let _ = Lambert::new(Rgb::ONE);
     // What the batch path does not have yet (the module doc says so).
-    let not_yet = |m: &Material, s: BsdfStrategy| {
-        let other_model = !matches!(m.glossy, Glossy::CookTorrance(_) | Glossy::None);
-        let ndf_bp =
-            matches!(m.glossy, Glossy::CookTorrance(c) if c.microfacet.ndf() == Ndf::BlinnPhong);
-        let caps = matches!(s, BsdfStrategy::SphericalCaps | BsdfStrategy::BoundedVndf);
-        other_model || ndf_bp || caps
+    // Only the measured model (not in this walk: it needs a data file).
+    let not_yet = |m: &Material, _s: BsdfStrategy| {
+        !matches!(
+            m.glossy,
+            Glossy::CookTorrance(_) | Glossy::None | Glossy::Phong(_) | Glossy::BlinnPhong(_)
+        )
     };
     let mut wrong = Vec::new();
     let (mut built, mut missing) = (0usize, Vec::new());
@@ -549,5 +702,6 @@ fn grid_every_supported_combination_builds() {
         eprintln!("  not yet batched: {line}");
     }
     assert!(wrong.is_empty(), "{}", wrong.join("\n"));
+    assert!(missing.is_empty(), "{}", missing.join("\n"));
     assert!(built > 0);
 }
