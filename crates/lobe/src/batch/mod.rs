@@ -51,10 +51,10 @@
 //!   numbers at the f32 inputs, rounded once, the same at every level.
 //!
 //! Not yet (the scalar path, [`crate::Material`], serves it;
-//! [`BatchSampler::new`] returns [`BatchError::Unsupported`]): the measured
-//! model. The test `grid_every_supported_combination_builds` walks every
-//! combination of the analytic models the scalar path has and checks that
-//! none is refused. (A lecture-form `ks` whose `ks · K` is beyond f32's
+//! [`BatchSampler::new`] returns [`BatchError::Unsupported`]): a measured
+//! table with a diffuse term (`kd > 0`). The test
+//! `grid_every_supported_combination_builds` walks every combination of the
+//! analytic models the scalar path has and checks that none is refused. (A lecture-form `ks` whose `ks · K` is beyond f32's
 //! range is refused with that reason.)
 //!
 //! Beckmann's visible slopes are drawn as the scalar path draws them (Heitz
