@@ -21,8 +21,8 @@
 use super::super::lanes::Lanes;
 use super::super::math::sincos_turns;
 use super::{
-    BOUNDED, CtParams, Eval, GGX, INV_PI, Sampled, Shadow, V3, VNDF, cosine_hemisphere,
-    dot, eval_at, eval_h, finish, glossy_probability, select3, stretched_len,
+    BOUNDED, CtParams, Eval, GGX, INV_PI, Sampled, Shadow, V3, VNDF, cosine_hemisphere, dot,
+    eval_at, eval_h, finish, glossy_probability, select3, stretched_len,
 };
 
 /// The visible normal of the caps (`STRAT = CAPS`) or of the bounded VNDF.
@@ -55,7 +55,11 @@ fn cap_normal<L: Lanes, const STRAT: u8>(
     let sin_t = l.sqrt(l.max(u2 * opb * l.mul_add(omu, opb, one_m_b), zero));
     let hz = l.mul_add(omu, opb, d);
     let h = [l.mul_add(sin_t, c, wh[0]), l.mul_add(sin_t, s, wh[1]), hz];
-    let n = [ax * h[0], ay * h[1], l.max(h[2], l.splat(f32::MIN_POSITIVE))];
+    let n = [
+        ax * h[0],
+        ay * h[1],
+        l.max(h[2], l.splat(f32::MIN_POSITIVE)),
+    ];
     let inv = one / l.sqrt(dot(l, n, n));
     [n[0] * inv, n[1] * inv, n[2] * inv]
 }

@@ -627,7 +627,10 @@ mod accuracy {
         eprintln!(
             "math_errors pow_1m: max rel / (1 + |n ln(1 − t)|) {worst:.3e}, max rel {worst_abs:.3e}"
         );
-        assert!(worst < 2.5e-7 && worst_abs < 2.5e-5, "pow_1m {worst} {worst_abs}");
+        assert!(
+            worst < 2.5e-7 && worst_abs < 2.5e-5,
+            "pow_1m {worst} {worst_abs}"
+        );
         let (y, _) = run(MathFn::Pow1m(3f32.to_bits()), &[1.0, 0.0]);
         assert_eq!(y, [0.0, 1.0]);
         // cⁿ from c (t = 1 − c, exact where the t branch is taken).

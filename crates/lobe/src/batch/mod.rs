@@ -54,8 +54,9 @@
 //! [`BatchSampler::new`] returns [`BatchError::Unsupported`]): a measured
 //! table with a diffuse term (`kd > 0`). The test
 //! `grid_every_supported_combination_builds` walks every combination of the
-//! analytic models the scalar path has and checks that none is refused. (A lecture-form `ks` whose `ks · K` is beyond f32's
-//! range is refused with that reason.)
+//! analytic models the scalar path has and checks that none is refused. (A
+//! lecture-form `ks` whose `ks · K` is beyond f32's range is refused with
+//! that reason.)
 //!
 //! Beckmann's visible slopes are drawn as the scalar path draws them (Heitz
 //! and d'Eon 2014: the slope CDF inverted by Newton's method inside a

@@ -136,11 +136,7 @@ fn eval_cn<L: Lanes, const MODEL: u8, const STRAT: u8>(
         _ => {
             let pg = l.splat(p.pdf_k) * cp;
             let pg = if MODEL == BLINN {
-                l.select(
-                    l.gt(cos_oh, zero),
-                    pg / (l.splat(4.0) * cos_oh),
-                    zero,
-                )
+                l.select(l.gt(cos_oh, zero), pg / (l.splat(4.0) * cos_oh), zero)
             } else {
                 pg
             };

@@ -198,10 +198,11 @@ fn lecture_allowance(w: &mut Worst, exempt: &mut usize) {
         rest.split([',', ' ', ')']).next()?.parse().ok()
     };
     let before = w.bad.len();
-    w.bad.retain(|b| match (field(b, "exponent: "), field(b, ", rel ")) {
-        (Some(n), Some(r)) => r > REL + (n * 2.4e-7).exp_m1(),
-        _ => true,
-    });
+    w.bad
+        .retain(|b| match (field(b, "exponent: "), field(b, ", rel ")) {
+            (Some(n), Some(r)) => r > REL + (n * 2.4e-7).exp_m1(),
+            _ => true,
+        });
     *exempt += before - w.bad.len();
 }
 
@@ -424,7 +425,10 @@ fn grid_eval_pdf_matches_scalar() {
                     for c in 0..3 {
                         f_rel = f_rel.max(rel_err(fb[c].into(), f[c]));
                         if rel_err(fb[c].into(), f[c]) > 1e-3 && std::env::var("DBG").is_ok() {
-                            eprintln!("DBG {level} {m:?} {s} wo {o} wi {i}: f {} vs {}", fb[c], f[c]);
+                            eprintln!(
+                                "DBG {level} {m:?} {s} wo {o} wi {i}: f {} vs {}",
+                                fb[c], f[c]
+                            );
                         }
                     }
                     pdf_rel = pdf_rel.max(rel_err(pb.into(), pdf));
