@@ -21,8 +21,8 @@
 use super::super::lanes::Lanes;
 use super::super::math::sincos_turns;
 use super::{
-    BOUNDED, CtParams, Eval, GGX, INV_PI, Sampled, Shadow, V3, VNDF, cosine_hemisphere, dot,
-    eval_at, eval_h, finish, glossy_probability, select3, stretched_len,
+    BOUNDED, CtParams, Eval, GGX, INV_PI, Sampled, Shadow, V3, VNDF, dot, eval_at, eval_h, finish,
+    glossy_probability, reflect_or_diffuse, select3, stretched_len,
 };
 
 /// The visible normal of the caps (`STRAT = CAPS`) or of the bounded VNDF.
@@ -157,47 +157,14 @@ pub(super) fn sample<L: Lanes, const STRAT: u8>(
     u2: L::F,
     uc: L::F,
 ) -> Sampled<L> {
-    let zero = l.splat(0.0);
-    let one = l.splat(1.0);
     let m = cap_normal::<L, STRAT>(l, p, wo, u1, u2);
-    let om = dot(l, wo, m);
-    let two_om = om + om;
-    let wi = [
-        l.mul_add(two_om, m[0], -wo[0]),
-        l.mul_add(two_om, m[1], -wo[1]),
-        l.mul_add(two_om, m[2], -wo[2]),
-    ];
-    let valid = l.gt(wo[2], zero) & l.gt(om, zero);
+    let r = reflect_or_diffuse(l, p, wo, m, u1, u2, uc);
     if p.two_lobes {
-        // As `super::sample`: uc < P takes the lobe's direction, else a
-        // cosine-weighted one; the drawn normal is the half vector where
-        // the lobe drew.
-        let wd = cosine_hemisphere(l, u1, u2);
-        let choose = l.lt(uc, glossy_probability(l, p, wo));
-        let wi = [
-            l.select(choose, wi[0], wd[0]),
-            l.select(choose, wi[1], wd[1]),
-            l.select(choose, wi[2], wd[2]),
-        ];
-        let valid = l.select_mask(choose, valid, l.gt(wo[2], zero)) & l.gt(wi[2], zero);
-        let hd = [wo[0] + wi[0], wo[1] + wi[1], wo[2] + wi[2]];
-        let h = [
-            l.select(choose, m[0], hd[0]),
-            l.select(choose, m[1], hd[1]),
-            l.select(choose, m[2], hd[2]),
-        ];
-        let hh = l.select(choose, one, dot(l, hd, hd));
-        let oh = l.select(choose, om, dot(l, wo, hd));
-        let ih = if p.shadow == Shadow::VCavity {
-            l.select(choose, om, dot(l, wi, hd))
-        } else {
-            oh
-        };
-        let e = eval_h_caps::<L, STRAT>(l, p, wo, wi, h, hh, oh, ih);
-        return finish(l, valid, wi, e.f, e.pdf, e.weight);
+        let e = eval_h_caps::<L, STRAT>(l, p, wo, r.wi, r.h, r.hh, r.oh, r.ih);
+        return finish(l, r.valid, r.wi, e.f, e.pdf, e.weight);
     }
-    let e = eval_at_caps::<L, STRAT>(l, p, wo, wi, m, one, om, om);
-    finish(l, valid & e.ok, wi, e.f, e.pdf, e.weight)
+    let e = eval_at_caps::<L, STRAT>(l, p, wo, r.wi, r.h, r.hh, r.oh, r.ih);
+    finish(l, r.valid & e.ok, r.wi, e.f, e.pdf, e.weight)
 }
 
 /// `(f, pdf)` of `eval_pdf` for the bounded VNDF (the caps' is vndf's).

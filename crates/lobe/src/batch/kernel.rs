@@ -724,44 +724,14 @@ pub(crate) fn sample<L: Lanes, const NDF: u8, const STRAT: u8>(
         } else {
             m
         };
-        let om = dot(l, wo, m);
-        let two_om = om + om;
-        wi = [
-            l.mul_add(two_om, m[0], -wo[0]),
-            l.mul_add(two_om, m[1], -wo[1]),
-            l.mul_add(two_om, m[2], -wo[2]),
-        ];
-        valid = valid & l.gt(om, zero);
+        let r = reflect_or_diffuse(l, p, wo, m, u1, u2, uc);
+        wi = r.wi;
         if p.two_lobes {
-            // uc < P: the glossy lobe's direction, else a cosine-weighted
-            // one; then f and the mixture pdf at it, as `Material::sample`.
-            let wd = cosine_hemisphere(l, u1, u2);
-            let choose = l.lt(uc, glossy_probability(l, p, wo));
-            let wi = [
-                l.select(choose, wi[0], wd[0]),
-                l.select(choose, wi[1], wd[1]),
-                l.select(choose, wi[2], wd[2]),
-            ];
-            let valid = l.select_mask(choose, valid, l.gt(wo[2], zero)) & l.gt(wi[2], zero);
-            // The half vector: the drawn normal where the glossy lobe drew
-            // (accurate where wo + wi is mostly rounding), else wo + wi.
-            let hd = [wo[0] + wi[0], wo[1] + wi[1], wo[2] + wi[2]];
-            let h = [
-                l.select(choose, m[0], hd[0]),
-                l.select(choose, m[1], hd[1]),
-                l.select(choose, m[2], hd[2]),
-            ];
-            let hh = l.select(choose, one, dot(l, hd, hd));
-            let oh = l.select(choose, om, dot(l, wo, hd));
-            let ih = if p.shadow == Shadow::VCavity {
-                l.select(choose, om, dot(l, wi, hd))
-            } else {
-                oh
-            };
-            let e = eval_h::<L, NDF, STRAT>(l, p, wo, wi, h, hh, oh, ih);
-            return finish(l, valid, wi, e.f, e.pdf, e.weight);
+            let e = eval_h::<L, NDF, STRAT>(l, p, wo, wi, r.h, r.hh, r.oh, r.ih);
+            return finish(l, r.valid, wi, e.f, e.pdf, e.weight);
         }
-        e = eval_at::<L, NDF, STRAT>(l, p, wo, wi, m, one, om, om);
+        valid = r.valid;
+        e = eval_at::<L, NDF, STRAT>(l, p, wo, wi, r.h, r.hh, r.oh, r.ih);
         valid = valid & e.ok;
     } else {
         wi = if STRAT == UNIFORM {
@@ -778,6 +748,86 @@ pub(crate) fn sample<L: Lanes, const NDF: u8, const STRAT: u8>(
         return finish(l, valid & l.gt(wi[2], zero), wi, f, e.pdf, weight);
     }
     finish(l, valid, wi, e.f, e.pdf, e.weight)
+}
+
+/// `wo` reflected about a drawn microfacet normal, with what `f` and the
+/// pdf are evaluated at: for one lobe, the normal itself as the half vector
+/// (`|h| = 1`, `wo·h = wi·h = wo·m`); where `uc` chooses between the lobe
+/// and the diffuse term (`p.two_lobes`), as `Material::sample` does: `uc <
+/// P` keeps the reflection, else a cosine-weighted direction with `h = wo +
+/// wi` (the drawn normal stays the half vector where the lobe drew: accurate
+/// where `wo + wi` is mostly rounding).
+pub(crate) struct Reflected<L: Lanes> {
+    /// `wo` above the horizon and the direction a sample (`wo·m > 0` for
+    /// the lobe's, `wi.z > 0` for the diffuse term's).
+    pub valid: L::M,
+    pub wi: V3<L>,
+    pub h: V3<L>,
+    pub hh: L::F,
+    pub oh: L::F,
+    pub ih: L::F,
+}
+
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn reflect_or_diffuse<L: Lanes>(
+    l: L,
+    p: &CtParams,
+    wo: V3<L>,
+    m: V3<L>,
+    u1: L::F,
+    u2: L::F,
+    uc: L::F,
+) -> Reflected<L> {
+    let zero = l.splat(0.0);
+    let one = l.splat(1.0);
+    let om = dot(l, wo, m);
+    let two_om = om + om;
+    let wi = [
+        l.mul_add(two_om, m[0], -wo[0]),
+        l.mul_add(two_om, m[1], -wo[1]),
+        l.mul_add(two_om, m[2], -wo[2]),
+    ];
+    let valid = l.gt(wo[2], zero) & l.gt(om, zero);
+    if !p.two_lobes {
+        return Reflected {
+            valid,
+            wi,
+            h: m,
+            hh: one,
+            oh: om,
+            ih: om,
+        };
+    }
+    let wd = cosine_hemisphere(l, u1, u2);
+    let choose = l.lt(uc, glossy_probability(l, p, wo));
+    let wi = [
+        l.select(choose, wi[0], wd[0]),
+        l.select(choose, wi[1], wd[1]),
+        l.select(choose, wi[2], wd[2]),
+    ];
+    let valid = l.select_mask(choose, valid, l.gt(wo[2], zero)) & l.gt(wi[2], zero);
+    let hd = [wo[0] + wi[0], wo[1] + wi[1], wo[2] + wi[2]];
+    let h = [
+        l.select(choose, m[0], hd[0]),
+        l.select(choose, m[1], hd[1]),
+        l.select(choose, m[2], hd[2]),
+    ];
+    let hh = l.select(choose, one, dot(l, hd, hd));
+    let oh = l.select(choose, om, dot(l, wo, hd));
+    let ih = if p.shadow == Shadow::VCavity {
+        l.select(choose, om, dot(l, wi, hd))
+    } else {
+        oh
+    };
+    Reflected {
+        valid,
+        wi,
+        h,
+        hh,
+        oh,
+        ih,
+    }
 }
 
 /// The sample where `valid`, its pdf positive and everything finite; zeros

@@ -351,6 +351,9 @@ pub enum BatchError {
     /// A material or strategy the batch path does not have (yet); the
     /// scalar path serves it.
     Unsupported { reason: String },
+    /// A strategy the material does not have at all (the scalar path
+    /// refuses it too: `Material::check`).
+    Inapplicable { reason: String },
     /// A `LOBE_SIMD` level that is unknown or that this CPU lacks.
     Level { level: String, reason: String },
     /// `uc` is `None` where the material has two lobes for `uc` to choose
@@ -375,6 +378,7 @@ impl std::fmt::Display for BatchError {
                     "not in the batch path: {reason} (the scalar path has it)"
                 )
             }
+            BatchError::Inapplicable { reason } => f.write_str(reason),
             BatchError::Level { level, reason } => write!(f, "SIMD level `{level}`: {reason}"),
             BatchError::MissingUc => write!(
                 f,
@@ -743,7 +747,9 @@ fn check_pairs(
 fn kernel_for(m: &Material, strategy: BsdfStrategy) -> Result<Kernel, BatchError> {
     let unsupported = |reason: String| Err(BatchError::Unsupported { reason });
     if let Err(e) = m.check(strategy) {
-        return unsupported(e.to_string());
+        return Err(BatchError::Inapplicable {
+            reason: e.to_string(),
+        });
     }
     let c3 = |c: Rgb| [c.x as f32, c.y as f32, c.z as f32];
     let kd = m.diffuse.albedo;

@@ -673,7 +673,7 @@ fn batch_errors_name_the_slice_and_the_unsupported() {
     // What the first step does not batch: a clear error, the scalar path has it.
     let unsupported =
         |m: &Material, s: BsdfStrategy| match BatchSampler::with_level(m, s, SimdLevel::Scalar) {
-            Err(BatchError::Unsupported { reason }) => reason,
+            Err(BatchError::Inapplicable { reason }) => reason,
             other => panic!("{other:?}"),
         };
     assert!(BatchSampler::with_level(&m, BsdfStrategy::SphericalCaps, SimdLevel::Scalar).is_ok());
