@@ -86,7 +86,11 @@ def test_agrees_with_the_scalar_reference(desc):
 def test_batched_and_out():
     m = lobe.load_dict(GGX)
     assert m.batched("vndf") and m.batched("brdf")
-    assert not lobe.load_dict({"type": "phong"}).batched("brdf")
+    # Every analytic model is batched (only a measured table with a diffuse
+    # term, which load_dict cannot build, runs on the scalar path).
+    assert lobe.load_dict({"type": "phong", "kd": 0.2}).batched("brdf")
+    with pytest.raises(ValueError):
+        lobe.load_dict({"type": "phong"}).batched("vndf")
     wo, u = hemisphere(10000)
     s = m.sample(wo, u)
     t = m.sample(wo, u[::-1].copy())

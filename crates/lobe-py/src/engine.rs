@@ -1414,7 +1414,24 @@ mod tests {
 
     #[test]
     fn scalar_fallback_for_what_the_kernels_lack() {
-        let m = Material::load(r#"{"type":"phong","exponent":20,"kd":0.3}"#).unwrap();
+        // The kernels cover every analytic model; a measured table with a
+        // diffuse term is what they lack.
+        let g = Material::load(r#"{"type":"cook-torrance","alpha":0.3}"#).unwrap();
+        let dir = std::env::temp_dir().join(format!("lobe-py-engine-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("t.bsdf");
+        std::fs::write(
+            &path,
+            lobe::models::measured::rgl::Rgl::write(|o, i| g.eval(o, i), 4, 8, "t"),
+        )
+        .unwrap();
+        let table = Material::load(&format!(
+            r#"{{"type":"measured","path":{:?}}}"#,
+            path.display().to_string()
+        ))
+        .unwrap();
+        let m = Material::with_diffuse(lobe::Rgb::splat(0.3), table.glossy).unwrap();
+        assert!(BatchSampler::new(&m, BsdfStrategy::Brdf).is_err());
         let e = Engine::new(&m, BsdfStrategy::Brdf, false).unwrap();
         assert!(e.batch.is_none());
         let n = 1000;
@@ -1440,6 +1457,6 @@ mod tests {
                 assert_eq!(s.pdf[i], r.pdf as f32);
             }
         }
-        assert!(Engine::new(&m, BsdfStrategy::Vndf, false).is_err());
+        assert!(Engine::new(&m, BsdfStrategy::SphericalCaps, false).is_err());
     }
 }
