@@ -11,6 +11,9 @@ The array calls run on lobe's batch SIMD kernels where they cover the
 material and strategy (``Material.batched``) and on the scalar f64 path
 otherwise, with the GIL released and the work split over threads in fixed
 blocks (the results do not depend on the thread count, ``set_threads``).
+The memory of large result arrays that died is kept for the next call of
+the same size (``set_cache_limit``, ``cache_info``, ``clear_cache``), so
+that fresh results cost no page faults.
 
 >>> import lobe, numpy as np
 >>> m = lobe.load_dict({"type": "cook-torrance", "distribution": "ggx", "alpha": 0.2})
@@ -32,7 +35,17 @@ from typing import Any, Sequence
 import numpy as np
 
 from . import _lobe
-from ._lobe import Material, SampleResult, get_threads, set_threads, sidak, simd_level
+from ._lobe import (
+    Material,
+    SampleResult,
+    cache_info,
+    clear_cache,
+    get_threads,
+    set_cache_limit,
+    set_threads,
+    sidak,
+    simd_level,
+)
 
 __all__ = [
     "Material",
@@ -43,6 +56,9 @@ __all__ = [
     "set_threads",
     "get_threads",
     "simd_level",
+    "set_cache_limit",
+    "cache_info",
+    "clear_cache",
     "sidak",
     "chi2",
 ]

@@ -83,6 +83,35 @@ def test_agrees_with_the_scalar_reference(desc):
         assert np.allclose(m.eval(wo, r.wi), fr, rtol=1e-4, atol=1e-6)
 
 
+def test_result_memory_is_reused_only_after_the_array_dies():
+    lobe.clear_cache()
+    assert lobe.cache_info() == (1 << 30, 0)
+    m = lobe.load_dict(GGX)
+    n = 1 << 17  # wi and weight: 1.5 MB each, kept; pdf (0.5 MB) is not
+    wo, u = hemisphere(n)
+    a = m.sample(wo, u)
+    a_wi = a.wi.copy()
+    b = m.sample(wo, u[::-1].copy())
+    b_wi, b_w, ptr = b.wi.copy(), b.weight.copy(), b.wi.ctypes.data
+    assert not np.shares_memory(a.wi, b.wi) and np.array_equal(a.wi, a_wi)
+    del b
+    assert lobe.cache_info()[1] == 2 * 3 * n * 4
+    # The next result of that size takes the memory back (wi or weight),
+    # overwrites every value, and leaves the live result alone.
+    c = m.sample(wo, u[::-1].copy())
+    assert ptr in (c.wi.ctypes.data, c.weight.ctypes.data)
+    assert np.array_equal(c.wi, b_wi) and np.array_equal(c.weight, b_w)
+    assert np.array_equal(a.wi, a_wi)
+    f, p = m.eval_pdf(wo, c.wi)
+    del c
+    f2, p2 = m.eval_pdf(wo, b_wi)
+    assert np.array_equal(f, f2) and np.array_equal(p, p2)
+    lobe.set_cache_limit(0)
+    del f, f2
+    assert lobe.cache_info() == (0, 0)
+    lobe.set_cache_limit(1 << 30)
+
+
 def test_batched_and_out():
     m = lobe.load_dict(GGX)
     assert m.batched("vndf") and m.batched("brdf")

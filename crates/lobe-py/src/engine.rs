@@ -545,6 +545,13 @@ fn zeros<T: Copy + Default>(n: usize) -> Vec<T> {
     v
 }
 
+/// Memory for `n` outputs: a kept buffer of a previous result (see
+/// [`crate::pool`]; it holds old values, and every caller here writes all
+/// of them), else [`zeros`].
+fn fresh<T: crate::pool::Element>(n: usize) -> Vec<T> {
+    crate::pool::take(n).unwrap_or_else(|| zeros(n))
+}
+
 /// Splits three component vectors of length `n` (Fortran order `3n`) into
 /// per-block mutable slices.
 fn split3<T>(v: &mut [T], n: usize) -> Vec<[&mut [T]; 3]> {
@@ -735,13 +742,13 @@ fn sample_blocks<'a, T>(out: SampleSlices<'a, T>) -> Vec<SampleBlock<'a, T>> {
         .collect()
 }
 
-fn new_sample_out<T: Copy + Default>(n: usize) -> SampleOut<T> {
+fn new_sample_out<T: crate::pool::Element>(n: usize) -> SampleOut<T> {
     SampleOut {
         n,
-        wi: zeros(3 * n),
-        pdf: zeros(n),
-        weight: zeros(3 * n),
-        valid: zeros(n),
+        wi: fresh(3 * n),
+        pdf: fresh(n),
+        weight: fresh(3 * n),
+        valid: fresh(n),
     }
 }
 
@@ -871,7 +878,7 @@ pub fn sample32_into(
 }
 
 /// [`sample32`] on the scalar f64 path, outputs in `T`.
-pub fn sample_scalar<T: Real>(
+pub fn sample_scalar<T: Real + crate::pool::Element>(
     e: &Engine<'_>,
     wo: &In2<'_>,
     u: &In2<'_>,
@@ -989,16 +996,16 @@ fn eval_blocks<'a, T>(out: EvalSlices<'a, T>) -> Vec<EvalBlock<'a, T>> {
         .collect()
 }
 
-fn new_eval_out<T: Copy + Default>(n: usize, want: Want) -> EvalPdfOut<T> {
+fn new_eval_out<T: crate::pool::Element>(n: usize, want: Want) -> EvalPdfOut<T> {
     EvalPdfOut {
         n,
         f: if want != Want::Pdf {
-            zeros(3 * n)
+            fresh(3 * n)
         } else {
             Vec::new()
         },
         pdf: if want != Want::Eval {
-            zeros(n)
+            fresh(n)
         } else {
             Vec::new()
         },
@@ -1105,7 +1112,7 @@ pub fn eval_pdf32_into(
 }
 
 /// [`eval_pdf32`] on the scalar f64 path, outputs in `T`.
-pub fn eval_pdf_scalar<T: Real>(
+pub fn eval_pdf_scalar<T: Real + crate::pool::Element>(
     e: &Engine<'_>,
     wo: &In2<'_>,
     wi: &In2<'_>,

@@ -13,5 +13,6 @@ pub mod chi2;
 pub mod engine;
 pub mod estimate;
 pub mod mitsuba;
+pub mod pool;
 #[cfg(feature = "python")]
 mod py;

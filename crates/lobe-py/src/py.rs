@@ -2,6 +2,7 @@
 //! arrays out; the GIL released while the kernels run.
 
 use crate::engine::{self, BadInput, Engine, In1, In2, Want};
+use crate::pool;
 use glam::DVec3;
 use lobe::{BsdfStrategy, Material};
 use ndarray::{Array1, Array2, Ix1, Ix2, ShapeBuilder};
@@ -181,20 +182,64 @@ fn f32_or_64<'py>(
     cols: usize,
     v32: Option<Vec<f32>>,
     v64: Option<Vec<f64>>,
-) -> Bound<'py, PyAny> {
+) -> PyResult<Bound<'py, PyAny>> {
     match (v32, v64) {
-        (Some(v), _) if cols == 1 => Array1::from_vec(v).into_pyarray(py).into_any(),
-        (Some(v), _) => Array2::from_shape_vec((n, cols).f(), v)
-            .expect("n × cols")
-            .into_pyarray(py)
-            .into_any(),
-        (None, Some(v)) if cols == 1 => Array1::from_vec(v).into_pyarray(py).into_any(),
-        (None, Some(v)) => Array2::from_shape_vec((n, cols).f(), v)
-            .expect("n × cols")
-            .into_pyarray(py)
-            .into_any(),
+        (Some(v), _) => result_array(py, v, n, cols),
+        (None, Some(v)) => result_array(py, v, n, cols),
         (None, None) => unreachable!("one of the two"),
     }
+}
+
+/// Owner of a large result array's memory: when the array dies, its buffer
+/// goes back to `crate::pool` for the next call of the same size.
+#[pyclass(module = "lobe", name = "_Memory", frozen)]
+struct Memory {
+    buf: pool::Buffer,
+}
+
+impl Drop for Memory {
+    fn drop(&mut self) {
+        match std::mem::replace(&mut self.buf, pool::Buffer::U8(Vec::new())) {
+            pool::Buffer::F32(v) => pool::give(v),
+            pool::Buffer::F64(v) => pool::give(v),
+            pool::Buffer::U8(v) => pool::give(v),
+        }
+    }
+}
+
+/// `v` as an `(n,)` array (`cols == 1`) or an `(n, cols)` Fortran-ordered
+/// one, without a copy; large ones own their memory through [`Memory`].
+fn result_array<'py, T: pool::Element + numpy::Element>(
+    py: Python<'py>,
+    v: Vec<T>,
+    n: usize,
+    cols: usize,
+) -> PyResult<Bound<'py, PyAny>> {
+    debug_assert_eq!(v.len(), n * cols);
+    if std::mem::size_of_val(v.as_slice()) < pool::MIN_BYTES {
+        return Ok(if cols == 1 {
+            Array1::from_vec(v).into_pyarray(py).into_any()
+        } else {
+            Array2::from_shape_vec((n, cols).f(), v)
+                .expect("n × cols")
+                .into_pyarray(py)
+                .into_any()
+        });
+    }
+    let (ptr, len) = (v.as_ptr(), v.len());
+    let owner = Bound::new(py, Memory { buf: T::wrap(v) })?.into_any();
+    // SAFETY: the vector's heap memory is neither freed nor moved while
+    // `owner` lives (it only gives the vector back to the pool when it is
+    // dropped), and NumPy keeps `owner` alive as the array's base.
+    let data = unsafe { std::slice::from_raw_parts(ptr, len) };
+    Ok(unsafe {
+        if cols == 1 {
+            numpy::PyArray1::borrow_from_array(&ndarray::ArrayView1::from(data), owner).into_any()
+        } else {
+            let a = ndarray::ArrayView2::from_shape((n, cols).f(), data).expect("n × cols");
+            numpy::PyArray2::borrow_from_array(&a, owner).into_any()
+        }
+    })
 }
 
 /// A material: a Lambertian term plus at most one glossy lobe (see
@@ -292,9 +337,14 @@ impl PyMaterial {
             let r = py
                 .detach(|| in_pool(|| engine::eval_pdf_scalar::<f64>(&e, &v_wo, &v_wi, want)))
                 .map_err(bad)?;
+            let engine::EvalPdfOut { f, pdf, .. } = r;
             (
-                (want != Want::Pdf).then(|| f32_or_64(py, n, 3, None, Some(r.f.clone()))),
-                (want != Want::Eval).then(|| f32_or_64(py, n, 1, None, Some(r.pdf.clone()))),
+                (want != Want::Pdf)
+                    .then(|| f32_or_64(py, n, 3, None, Some(f)))
+                    .transpose()?,
+                (want != Want::Eval)
+                    .then(|| f32_or_64(py, n, 1, None, Some(pdf)))
+                    .transpose()?,
             )
         } else {
             let r = py
@@ -302,8 +352,12 @@ impl PyMaterial {
                 .map_err(bad)?;
             let engine::EvalPdfOut { f, pdf, .. } = r;
             (
-                (want != Want::Pdf).then(|| f32_or_64(py, n, 3, Some(f), None)),
-                (want != Want::Eval).then(|| f32_or_64(py, n, 1, Some(pdf), None)),
+                (want != Want::Pdf)
+                    .then(|| f32_or_64(py, n, 3, Some(f), None))
+                    .transpose()?,
+                (want != Want::Eval)
+                    .then(|| f32_or_64(py, n, 1, Some(pdf), None))
+                    .transpose()?,
             )
         };
         Ok((f, p))
@@ -497,7 +551,8 @@ impl PyMaterial {
         }
         // The kernels' 0/1 bytes, seen as NumPy bools without a copy.
         let out = |wi, weight, pdf, valid: Vec<u8>| -> PyResult<Py<SampleResult>> {
-            let raw = Array1::from_vec(valid).into_pyarray(py);
+            let n = valid.len();
+            let raw = result_array(py, valid, n, 1)?;
             let r = SampleResult {
                 wi,
                 weight,
@@ -512,9 +567,9 @@ impl PyMaterial {
                 .detach(|| in_pool(|| engine::sample_scalar::<f64>(&e, &v_wo, &v_u, v_uc.as_ref())))
                 .map_err(bad)?;
             out(
-                f32_or_64(py, n, 3, None, Some(r.wi)).unbind(),
-                f32_or_64(py, n, 3, None, Some(r.weight)).unbind(),
-                f32_or_64(py, n, 1, None, Some(r.pdf)).unbind(),
+                f32_or_64(py, n, 3, None, Some(r.wi))?.unbind(),
+                f32_or_64(py, n, 3, None, Some(r.weight))?.unbind(),
+                f32_or_64(py, n, 1, None, Some(r.pdf))?.unbind(),
                 r.valid,
             )
         } else {
@@ -522,9 +577,9 @@ impl PyMaterial {
                 .detach(|| in_pool(|| engine::sample32(&e, &v_wo, &v_u, v_uc.as_ref())))
                 .map_err(bad)?;
             out(
-                f32_or_64(py, n, 3, Some(r.wi), None).unbind(),
-                f32_or_64(py, n, 3, Some(r.weight), None).unbind(),
-                f32_or_64(py, n, 1, Some(r.pdf), None).unbind(),
+                f32_or_64(py, n, 3, Some(r.wi), None)?.unbind(),
+                f32_or_64(py, n, 3, Some(r.weight), None)?.unbind(),
+                f32_or_64(py, n, 1, Some(r.pdf), None)?.unbind(),
                 r.valid,
             )
         }
@@ -616,6 +671,35 @@ fn set_threads(n: Option<usize>) -> PyResult<()> {
 fn get_threads() -> usize {
     let pool = POOL.read().map(|p| p.clone()).unwrap_or(None);
     pool.map_or_else(rayon::current_num_threads, |p| p.current_num_threads())
+}
+
+/// Set the most memory (in bytes) kept for reuse from result arrays that
+/// died (default 1 GiB; 0 keeps none). The array calls take a kept buffer
+/// of the right size instead of new memory, whose first touch costs page
+/// faults: a loop over fresh results then runs about as fast as with
+/// `out=`. Only arrays of at least 1 MiB are kept. Results do not depend on
+/// it.
+///
+/// >>> import lobe
+/// >>> lobe.set_cache_limit(0); lobe.cache_info()
+/// (0, 0)
+/// >>> lobe.set_cache_limit(1 << 30)
+#[pyfunction]
+fn set_cache_limit(nbytes: usize) {
+    pool::set_limit(nbytes);
+}
+
+/// `(limit, kept)`: the most bytes kept for reuse and the bytes kept now
+/// (see `set_cache_limit`).
+#[pyfunction]
+fn cache_info() -> (usize, usize) {
+    pool::limit()
+}
+
+/// Free the memory kept for reuse (see `set_cache_limit`).
+#[pyfunction]
+fn clear_cache() {
+    pool::clear();
 }
 
 /// The SIMD level of the batch kernels (`avx512`, `avx2`, `scalar`).
@@ -814,6 +898,9 @@ fn _lobe(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(set_threads, m)?)?;
     m.add_function(wrap_pyfunction!(get_threads, m)?)?;
     m.add_function(wrap_pyfunction!(simd_level, m)?)?;
+    m.add_function(wrap_pyfunction!(set_cache_limit, m)?)?;
+    m.add_function(wrap_pyfunction!(cache_info, m)?)?;
+    m.add_function(wrap_pyfunction!(clear_cache, m)?)?;
     m.add_function(wrap_pyfunction!(_estimate_json, m)?)?;
     m.add_function(wrap_pyfunction!(_render, m)?)?;
     m.add_function(wrap_pyfunction!(_json_to_toml, m)?)?;

@@ -12,15 +12,22 @@ use glam::DVec2;
 use lobe::BsdfStrategy;
 use lobe::stats::chi2::{Chi2Config, chi2_test, sidak, success_probability};
 
+/// Every (case, strategy, θo) of `cases`, in parallel (each is independent
+/// and deterministic; the failures are listed in the grid's order).
 fn run(cases: Vec<Case>) {
+    use rayon::prelude::*;
     let alpha = sidak(0.01, common::grid_size());
     let cfg = Chi2Config::default();
-    let mut failures = Vec::new();
-    let mut count = 0;
-    for c in &cases {
-        let m = c.material;
-        for (s, theta) in plan(&m) {
-            count += 1;
+    let jobs: Vec<(&Case, BsdfStrategy, f64)> = cases
+        .iter()
+        .flat_map(|c| plan(&c.material).into_iter().map(move |(s, t)| (c, s, t)))
+        .collect();
+    let count = jobs.len();
+    let failures: Vec<String> = jobs
+        .par_iter()
+        .flat_map_iter(|&(c, s, theta)| {
+            let mut failures = Vec::new();
+            let m = c.material;
             let wo = common::wo(theta);
             let t0 = std::time::Instant::now();
             let r = chi2_test(
@@ -66,8 +73,9 @@ fn run(cases: Vec<Case>) {
                     c.json, r.pdf_integral, kept
                 ));
             }
-        }
-    }
+            failures
+        })
+        .collect();
     assert!(
         failures.is_empty(),
         "{} of {count} tests failed:\n{}",
