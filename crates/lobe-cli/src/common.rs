@@ -7,7 +7,7 @@ use glam::DVec3;
 use indicatif::{ProgressBar, ProgressStyle};
 use lobe::estimator::ShadingPoint;
 use lobe::progress::Progress;
-use lobe::{Frame, Light, Rgb};
+use lobe::{Frame, Light};
 use std::path::{Path, PathBuf};
 
 /// `--theta DEG` or `--wo x,y,z`: the view direction in the local frame.
@@ -49,24 +49,7 @@ pub fn theta_to_wo(theta: f64) -> Result<DVec3> {
 
 /// Parse `x,y,z` into a non-zero finite vector.
 pub fn parse_vec3(flag: &str, s: &str) -> Result<DVec3> {
-    let parts: Vec<&str> = s.split(',').map(str::trim).collect();
-    if parts.len() != 3 {
-        bail!("{flag} {s}: expected three numbers x,y,z");
-    }
-    let mut v = [0.0; 3];
-    for (slot, p) in v.iter_mut().zip(&parts) {
-        *slot = p
-            .parse::<f64>()
-            .map_err(|_| anyhow!("{flag} {s}: `{p}` is not a number"))?;
-        if !slot.is_finite() {
-            bail!("{flag} {s}: `{p}` is not a finite number");
-        }
-    }
-    let v = DVec3::from_array(v);
-    if v.length_squared() == 0.0 {
-        bail!("{flag} {s}: the zero vector has no direction");
-    }
-    Ok(v)
+    lobe_render::light_spec::parse_vec3(flag, s).map_err(|e| anyhow!(e))
 }
 
 /// `--light`, `--normal`, `--tangent`: incident light at the shading point.
@@ -122,96 +105,16 @@ impl LightArgs {
     }
 }
 
-/// Parse a light description (see [`LightArgs`]); an analytic light's
-/// direction is taken to the local `frame`.
+/// Parse a light description (see [`LightArgs`] and
+/// [`lobe_render::light_spec`]); an analytic light's direction is taken to
+/// the local `frame`. Warnings of loading a map are printed.
 pub fn parse_light(spec: &str, frame: &Frame) -> Result<Light> {
-    let mut parts = spec.split(':');
-    let kind = parts.next().unwrap_or_default();
-    let number = |what: &str, s: &str| -> Result<f64> {
-        let v: f64 = s
-            .parse()
-            .map_err(|_| anyhow!("--light {spec}: {what} `{s}` is not a number"))?;
-        if !v.is_finite() || v < 0.0 {
-            bail!("--light {spec}: {what} must be a finite number >= 0");
-        }
-        Ok(v)
-    };
-    match kind {
-        "constant" => {
-            let v = parts.next().map_or(Ok(1.0), |s| number("value", s))?;
-            if parts.next().is_some() {
-                bail!("--light {spec}: expected constant[:VALUE]");
-            }
-            Ok(Light::Constant(Rgb::splat(v)))
-        }
-        "beam" => {
-            let k = parts.next().map_or(Ok(8.0), |s| number("exponent K", s))?;
-            let d = parts.next().map_or(Ok(DVec3::new(0.0, 1.0, 0.5)), |s| {
-                parse_vec3("--light direction", s)
-            })?;
-            let v = parts.next().map_or(Ok(1.0), |s| number("value", s))?;
-            if parts.next().is_some() {
-                bail!("--light {spec}: expected beam[:K[:X,Y,Z[:VALUE]]]");
-            }
-            Ok(Light::Beam {
-                dir: frame.to_local(d.normalize()),
-                exponent: k,
-                radiance: Rgb::splat(v),
-            })
-        }
-        "sky" if spec != "sky" => {
-            // `sky:ELEVATION[:AZIMUTH]`: the built-in sky with its sun elsewhere.
-            let (w, h, _, default_azimuth) = lobe_render::envmap_io::SKY;
-            let elevation = parts
-                .next()
-                .map_or(Ok(lobe_render::envmap_io::SKY.2), |s| {
-                    number("sun elevation", s)
-                })?;
-            let azimuth = match parts.next() {
-                None => default_azimuth,
-                Some(s) => s
-                    .parse::<f64>()
-                    .ok()
-                    .filter(|a| a.is_finite())
-                    .ok_or_else(|| {
-                        anyhow!(
-                            "--light {spec}: sun azimuth `{s}` is not a finite number of degrees"
-                        )
-                    })?,
-            };
-            if parts.next().is_some() || elevation > 90.0 {
-                bail!(
-                    "--light {spec}: expected sky[:ELEVATION[:AZIMUTH]], the sun's elevation in [0, 90] degrees above the horizon and its azimuth in degrees (0 is -Z)"
-                );
-            }
-            Ok(Light::Env(std::sync::Arc::new(lobe::envmap::EnvMap::sky(
-                w, h, elevation, azimuth,
-            ))))
-        }
-        _ if spec == "sky" || is_envmap_path(spec) => {
-            let loaded = lobe_render::load_envmap_checked(std::path::Path::new(spec), 1.0, 0.0)?;
-            for w in &loaded.warnings {
-                eprintln!("lobe: warning: {w}");
-            }
-            Ok(Light::Env(std::sync::Arc::new(loaded.map)))
-        }
-        "lobe" => bail!(
-            "--light {spec}: the analytic light `lobe` is now called `beam` (beam[:K[:X,Y,Z[:VALUE]]])"
-        ),
-        _ => bail!(
-            "--light {spec}: unknown light `{kind}`, expected constant[:VALUE], beam[:K[:X,Y,Z[:VALUE]]], sky[:ELEVATION[:AZIMUTH]], or an environment map FILE.hdr / FILE.exr (any case)"
-        ),
+    let parsed =
+        lobe_render::light_spec::parse_light("--light", spec, frame).map_err(|e| anyhow!(e))?;
+    for w in &parsed.warnings {
+        eprintln!("lobe: warning: {w}");
     }
-}
-
-/// Whether `spec` names an environment map file: `.hdr`, `.pic` or `.exr`,
-/// in any case.
-#[must_use]
-pub fn is_envmap_path(spec: &str) -> bool {
-    Path::new(spec)
-        .extension()
-        .and_then(|e| e.to_str())
-        .is_some_and(|e| ["hdr", "pic", "exr"].contains(&e.to_ascii_lowercase().as_str()))
+    Ok(parsed.light)
 }
 
 /// Parse a count: digits (`65536`, `65_536`), a power `B^E` (`2^20`) or

@@ -1,14 +1,13 @@
 //! `lobe.estimate`: the table that `lobe estimate --json` prints, from the
 //! same library call ([`lobe::experiment::table::run_table_with`]), with the
-//! CLI's light and strategy syntax (re-stated here: the CLI's parsers live
-//! in the binary crate, which a library cannot depend on).
+//! CLI's light syntax ([`lobe_render::light_spec`]) and strategy names.
 
 use glam::DVec3;
 use lobe::estimator::{ShadingPoint, Strategy};
 use lobe::experiment::table::{TableOptions, TableSettings, run_table_with};
 use lobe::progress::SystemClock;
 use lobe::sequence::Sequence;
-use lobe::{BsdfStrategy, Frame, Light, Material, Rgb};
+use lobe::{BsdfStrategy, Frame, Light, Material};
 
 /// The settings of one call, as `lobe estimate`'s flags.
 #[derive(Debug, Clone)]
@@ -30,108 +29,11 @@ pub struct EstimateArgs {
     pub mis_samples: (u32, u32),
 }
 
-fn is_envmap_path(spec: &str) -> bool {
-    std::path::Path::new(spec)
-        .extension()
-        .and_then(|e| e.to_str())
-        .is_some_and(|e| ["hdr", "pic", "exr"].contains(&e.to_ascii_lowercase().as_str()))
-}
-
-fn vec3(what: &str, spec: &str, s: &str) -> Result<DVec3, String> {
-    let parts: Vec<&str> = s.split(',').map(str::trim).collect();
-    if parts.len() != 3 {
-        return Err(format!(
-            "light {spec}: {what}: expected three numbers x,y,z"
-        ));
-    }
-    let mut v = [0.0; 3];
-    for (slot, p) in v.iter_mut().zip(&parts) {
-        *slot = p
-            .parse::<f64>()
-            .ok()
-            .filter(|x| x.is_finite())
-            .ok_or_else(|| format!("light {spec}: {what}: `{p}` is not a finite number"))?;
-    }
-    let v = DVec3::from_array(v);
-    if v.length_squared() == 0.0 {
-        return Err(format!(
-            "light {spec}: {what}: the zero vector has no direction"
-        ));
-    }
-    Ok(v)
-}
-
-/// A light in the CLI's syntax: `constant[:VALUE]`, `beam[:K[:X,Y,Z[:VALUE]]]`
-/// (world direction, taken to the local frame by `frame`), `sky[:ELEVATION[:AZIMUTH]]`,
-/// or an environment map file (`.hdr`, `.exr`).
+/// A light in the CLI's syntax ([`lobe_render::light_spec`]): `constant[:VALUE]`,
+/// `beam[:K[:X,Y,Z[:VALUE]]]` (world direction, taken to the local frame by
+/// `frame`), `sky[:ELEVATION[:AZIMUTH]]`, or an environment map file.
 pub fn parse_light(spec: &str, frame: &Frame) -> Result<Light, String> {
-    let mut parts = spec.split(':');
-    let kind = parts.next().unwrap_or_default();
-    let number = |what: &str, s: &str| -> Result<f64, String> {
-        let v: f64 = s
-            .parse()
-            .map_err(|_| format!("light {spec}: {what} `{s}` is not a number"))?;
-        if !v.is_finite() || v < 0.0 {
-            return Err(format!("light {spec}: {what} must be a finite number >= 0"));
-        }
-        Ok(v)
-    };
-    match kind {
-        "constant" => {
-            let v = parts.next().map_or(Ok(1.0), |s| number("value", s))?;
-            if parts.next().is_some() {
-                return Err(format!("light {spec}: expected constant[:VALUE]"));
-            }
-            Ok(Light::Constant(Rgb::splat(v)))
-        }
-        "beam" => {
-            let k = parts.next().map_or(Ok(8.0), |s| number("exponent K", s))?;
-            let d = parts.next().map_or(Ok(DVec3::new(0.0, 1.0, 0.5)), |s| {
-                vec3("direction", spec, s)
-            })?;
-            let v = parts.next().map_or(Ok(1.0), |s| number("value", s))?;
-            if parts.next().is_some() {
-                return Err(format!("light {spec}: expected beam[:K[:X,Y,Z[:VALUE]]]"));
-            }
-            Ok(Light::Beam {
-                dir: frame.to_local(d.normalize()),
-                exponent: k,
-                radiance: Rgb::splat(v),
-            })
-        }
-        "sky" if spec != "sky" => {
-            let (w, h, default_elevation, default_azimuth) = lobe_render::envmap_io::SKY;
-            let elevation = parts
-                .next()
-                .map_or(Ok(default_elevation), |s| number("sun elevation", s))?;
-            let azimuth = match parts.next() {
-                None => default_azimuth,
-                Some(s) => s
-                    .parse::<f64>()
-                    .ok()
-                    .filter(|a| a.is_finite())
-                    .ok_or_else(|| {
-                        format!("light {spec}: sun azimuth `{s}` is not a finite number of degrees")
-                    })?,
-            };
-            if parts.next().is_some() || elevation > 90.0 {
-                return Err(format!(
-                    "light {spec}: expected sky[:ELEVATION[:AZIMUTH]], the sun's elevation in [0, 90] degrees and its azimuth in degrees"
-                ));
-            }
-            Ok(Light::Env(std::sync::Arc::new(lobe::envmap::EnvMap::sky(
-                w, h, elevation, azimuth,
-            ))))
-        }
-        _ if spec == "sky" || is_envmap_path(spec) => {
-            let loaded = lobe_render::load_envmap_checked(std::path::Path::new(spec), 1.0, 0.0)
-                .map_err(|e| format!("light {spec}: {e}"))?;
-            Ok(Light::Env(std::sync::Arc::new(loaded.map)))
-        }
-        _ => Err(format!(
-            "light {spec}: unknown light `{kind}`, expected constant[:VALUE], beam[:K[:X,Y,Z[:VALUE]]], sky[:ELEVATION[:AZIMUTH]], or an environment map FILE.hdr / FILE.exr"
-        )),
-    }
+    lobe_render::light_spec::parse_light("light", spec, frame).map(|p| p.light)
 }
 
 /// The techniques: `all` ([`lobe::strategy::ALL_MEANS`]) or names, each
