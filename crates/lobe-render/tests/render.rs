@@ -319,18 +319,30 @@ fn batch_loop_matches_the_scalar_loop() {
         assert!(m.abs() < 4.5 * se, "{method}: mean difference {m} ± {se}");
         assert_eq!(same.stats.camera_rays, reference.stats.camera_rays);
     }
-    // Refused: bounces, one-sample MIS, a model without batch kernels.
-    let phong = MaterialDesc::from_json(r#"{"type":"phong","ks":0.5,"kd":0.3,"exponent":20}"#)
-        .unwrap()
-        .build()
-        .unwrap();
-    let mut with_phong = scene.clone();
-    with_phong.objects[0].material = phong;
+    // Refused: bounces, one-sample MIS, a material without batch kernels
+    // (every analytic model has them; a measured table with a diffuse term
+    // does not).
+    let ggx = Material::load(r#"{"type":"cook-torrance","alpha":0.3}"#).unwrap();
+    let dir = std::env::temp_dir().join(format!("lobe-render-test-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("t.bsdf");
+    std::fs::write(
+        &path,
+        lobe::models::measured::rgl::Rgl::write(|o, i| ggx.eval(o, i), 4, 8, "t"),
+    )
+    .unwrap();
+    let table = Material::load(&format!(
+        r#"{{"type":"measured","path":{:?}}}"#,
+        path.display().to_string()
+    ))
+    .unwrap();
+    let mut with_table = scene.clone();
+    with_table.objects[0].material = Material::with_diffuse(Rgb::splat(0.3), table.glossy).unwrap();
     let one_sample: Strategy = "mis-one".parse().unwrap();
     for (sc, method, depth) in [
         (&scene, Strategy::MIS, 2),
         (&scene, one_sample, 1),
-        (&with_phong, Strategy::MIS, 1),
+        (&with_table, Strategy::MIS, 1),
     ] {
         let why = batch_refusal(sc, method, depth);
         assert!(why.is_some(), "{method} depth {depth}");
