@@ -93,10 +93,17 @@
 //! dimensions as the scalar loop and weights them the same way, so the two
 //! loops estimate the same image and, for one seed, agree to f32 rounding
 //! (the test `batch_loop_matches_the_scalar_loop`). Adaptive MIS's pilot
-//! runs on the scalar loop. Where the batch loop does not apply (bounces,
-//! one-sample MIS, a material without batch kernels: Phong, Blinn-Phong,
-//! `spherical-caps`, `bounded-vndf`), the scalar loop renders the whole
-//! image and [`batch_refusal`] says why (`lobe render` prints it once);
+//! runs on the batch loop too (its draws recorded with
+//! [`lobe::estimator::Pilot::record`]), except under `--loop scalar`. The
+//! block's Sobol pairs come from [`lobe::sequence::sobol_pairs`] (SIMD
+//! lanes, the camera pair for every sample, the others for the samples
+//! that hit), its light draws from [`lobe::envmap::EnvMap::sample_lookup_many`]
+//! and its BSDF directions' map lookups from
+//! [`lobe::envmap::EnvMap::lookup_many`] (the reads of a block overlap).
+//! Where the batch loop does not apply (bounces, one-sample MIS, a material
+//! the batch kernels refuse: a measured table with a diffuse term), the
+//! scalar loop renders the whole image and [`batch_refusal`] says why
+//! (`lobe render` prints it once);
 //! [`RenderLoop::Scalar`] forces the scalar loop. Both give the same bits
 //! for any thread count.
 

@@ -319,19 +319,11 @@ fn batch_loop_matches_the_scalar_loop() {
         assert!(m.abs() < 4.5 * se, "{method}: mean difference {m} ± {se}");
         assert_eq!(same.stats.camera_rays, reference.stats.camera_rays);
     }
-    // Refused: bounces, one-sample MIS, a model without batch kernels.
-    let phong = MaterialDesc::from_json(r#"{"type":"phong","ks":0.5,"kd":0.3,"exponent":20}"#)
-        .unwrap()
-        .build()
-        .unwrap();
-    let mut with_phong = scene.clone();
-    with_phong.objects[0].material = phong;
+    // Refused: bounces, one-sample MIS. (Every analytic model has batch
+    // kernels now, Phong and Blinn-Phong included: `lobe::batch`'s test
+    // `grid_every_supported_combination_builds`.)
     let one_sample: Strategy = "mis-one".parse().unwrap();
-    for (sc, method, depth) in [
-        (&scene, Strategy::MIS, 2),
-        (&scene, one_sample, 1),
-        (&with_phong, Strategy::MIS, 1),
-    ] {
+    for (sc, method, depth) in [(&scene, Strategy::MIS, 2), (&scene, one_sample, 1)] {
         let why = batch_refusal(sc, method, depth);
         assert!(why.is_some(), "{method} depth {depth}");
         let o = RenderOptions {

@@ -194,6 +194,10 @@ struct Lanes {
     pair_index: Vec<u32>,
     pair_x: [Vec<f64>; PAIRS],
     pair_y: [Vec<f64>; PAIRS],
+    /// The seeds (pairs 1.. of [`PixelSeeds::all`]) and indices of the
+    /// samples that hit.
+    hit_seeds: [Vec<u64>; PAIRS],
+    hit_index: Vec<u32>,
     /// The block's light draws `(compensated, u)`, their results, and
     /// (here and for `bsdf_dirs`) their draw indices.
     light_u: Vec<(bool, DVec2)>,
@@ -220,6 +224,8 @@ impl Lanes {
             pair_index: Vec::with_capacity(BLOCK),
             pair_x: std::array::from_fn(|_| vec![0.0; BLOCK]),
             pair_y: std::array::from_fn(|_| vec![0.0; BLOCK]),
+            hit_seeds: std::array::from_fn(|_| Vec::with_capacity(BLOCK)),
+            hit_index: Vec::with_capacity(BLOCK),
             light_u: Vec::with_capacity(2 * BLOCK),
             light_out: Vec::with_capacity(2 * BLOCK),
             draw_index: Vec::with_capacity(2 * BLOCK),
@@ -245,10 +251,11 @@ impl PixelSeeds {
 }
 
 /// Where a sample's pairs come from: computed for the whole block
-/// (Sobol, [`sobol_pairs`]), or drawn one by one.
+/// (Sobol, [`sobol_pairs`]: the camera pair given, the others drawn
+/// afterwards for the samples that hit), or drawn one by one.
 #[derive(Debug, Clone, Copy)]
 enum Pairs {
-    Block([DVec2; PAIRS]),
+    Block(DVec2),
     Each,
 }
 
@@ -298,16 +305,16 @@ impl Batch<'_> {
                     debug_assert!(index <= u64::from(u32::MAX));
                     lanes.pair_index.push(index as u32);
                 }
+                // The camera pair of every sample; the others (below) only
+                // for the samples that hit.
                 let n = lanes.pair_index.len();
-                for p in 0..PAIRS {
-                    sobol_pairs(
-                        self.level,
-                        &lanes.pair_seeds[p],
-                        &lanes.pair_index,
-                        &mut lanes.pair_x[p][..n],
-                        &mut lanes.pair_y[p][..n],
-                    );
-                }
+                sobol_pairs(
+                    self.level,
+                    &lanes.pair_seeds[0],
+                    &lanes.pair_index,
+                    &mut lanes.pair_x[0][..n],
+                    &mut lanes.pair_y[0][..n],
+                );
             }
             let mut cur: Option<(usize, PixelSeeds, PixelPlan)> = None;
             for f in k..end {
@@ -322,13 +329,43 @@ impl Batch<'_> {
                 };
                 let pairs = if sobol {
                     let m = (f - k) as usize;
-                    Pairs::Block(std::array::from_fn(|p| {
-                        DVec2::new(lanes.pair_x[p][m], lanes.pair_y[p][m])
-                    }))
+                    Pairs::Block(DVec2::new(lanes.pair_x[0][m], lanes.pair_y[0][m]))
                 } else {
                     Pairs::Each
                 };
                 pts.push(self.camera_point(ctx, (x, y), index, &seeds, pairs, plan, &mut stats));
+            }
+            if sobol {
+                // The shading pairs of the samples that hit, compacted.
+                for v in &mut lanes.hit_seeds {
+                    v.clear();
+                }
+                lanes.hit_index.clear();
+                lanes.draw_index.clear();
+                for (m, pt) in pts.iter().enumerate() {
+                    if pt.obj == u32::MAX {
+                        continue;
+                    }
+                    lanes.draw_index.push(m);
+                    lanes.hit_index.push(lanes.pair_index[m]);
+                    for p in 1..PAIRS {
+                        lanes.hit_seeds[p].push(lanes.pair_seeds[p][m]);
+                    }
+                }
+                let n = lanes.hit_index.len();
+                for p in 1..PAIRS {
+                    sobol_pairs(
+                        self.level,
+                        &lanes.hit_seeds[p],
+                        &lanes.hit_index,
+                        &mut lanes.pair_x[p][..n],
+                        &mut lanes.pair_y[p][..n],
+                    );
+                }
+                for (h, &m) in lanes.draw_index.iter().enumerate() {
+                    let (px, py) = (&lanes.pair_x, &lanes.pair_y);
+                    self.assign_u(&mut pts[m], |p| DVec2::new(px[p][h], py[p][h]));
+                }
             }
             self.shade(ctx.scene, &mut pts, &mut draws, &mut lanes, &mut stats, pilots.as_deref_mut());
             for pt in &pts {
@@ -357,16 +394,18 @@ impl Batch<'_> {
         stats: &mut RenderStats,
     ) -> Point {
         // Pair p of `PixelSeeds::all`.
-        let pair = |p: usize| match pairs {
-            Pairs::Block(v) => v[p],
-            Pairs::Each => DVec2::from_array(pair_point_seeded(
+        let pair = |p: usize| {
+            DVec2::from_array(pair_point_seeded(
                 ctx.sequence,
                 seeds.all()[p],
                 ctx.spp,
                 index,
-            )),
+            ))
         };
-        let j = pair(0);
+        let j = match pairs {
+            Pairs::Block(c) => c,
+            Pairs::Each => pair(0),
+        };
         let ray = ctx.scene.camera.ray(x as f64 + j.x, y as f64 + j.y);
         stats.camera_rays += 1;
         stats.rays += 1;
@@ -405,9 +444,23 @@ impl Batch<'_> {
         if wo.z <= 0.0 {
             return pt;
         }
-        // The scalar loop's points: the BSDF point [bsdf_uc.x, bsdf_u], the
-        // light point [bsdf_uc.y, light]; light sampling alone takes the
-        // light point.
+        if let Pairs::Each = pairs {
+            self.assign_u(&mut pt, pair);
+        }
+        pt.obj = obj as u32;
+        pt.p = hit.p;
+        pt.ng = ng;
+        pt.frame = frame;
+        pt.wo = wo;
+        pt
+    }
+
+    /// The numbers of `pt`'s draws from its pairs (`pair(p)`, pair `p` of
+    /// [`PixelSeeds::all`]), as the scalar loop takes them: the BSDF point
+    /// `[bsdf_uc.x, bsdf_u]`, the light point `[bsdf_uc.y, light]`; light
+    /// sampling alone takes the light point.
+    fn assign_u(&self, pt: &mut Point, pair: impl Fn(usize) -> DVec2) {
+        let plan = pt.plan;
         let light_alone = matches!(self.kind, Kind::Light);
         // Light draws do not read `uc`.
         let uc = if plan.slots.contains(&Slot::Bsdf) {
@@ -431,12 +484,6 @@ impl Batch<'_> {
         if plan.slots[1] != Slot::Unused {
             pt.u[1] = light_point();
         }
-        pt.obj = obj as u32;
-        pt.p = hit.p;
-        pt.ng = ng;
-        pt.frame = frame;
-        pt.wo = wo;
-        pt
     }
 
     /// The draws of a block: BSDF samples and light samples' `f` and pdf
