@@ -93,10 +93,17 @@
 //! dimensions as the scalar loop and weights them the same way, so the two
 //! loops estimate the same image and, for one seed, agree to f32 rounding
 //! (the test `batch_loop_matches_the_scalar_loop`). Adaptive MIS's pilot
-//! runs on the scalar loop. Where the batch loop does not apply (bounces,
-//! one-sample MIS, a material without batch kernels: Phong, Blinn-Phong,
-//! `spherical-caps`, `bounded-vndf`), the scalar loop renders the whole
-//! image and [`batch_refusal`] says why (`lobe render` prints it once);
+//! runs on the batch loop too (its draws recorded with
+//! [`lobe::estimator::Pilot::record`]), except under `--loop scalar`. The
+//! block's Sobol pairs come from [`lobe::sequence::sobol_pairs`] (SIMD
+//! lanes, the camera pair for every sample, the others for the samples
+//! that hit), its light draws from [`lobe::envmap::EnvMap::sample_lookup_many`]
+//! and its BSDF directions' map lookups from
+//! [`lobe::envmap::EnvMap::lookup_many`] (the reads of a block overlap).
+//! Where the batch loop does not apply (bounces, one-sample MIS, a material
+//! the batch kernels refuse: a measured table with a diffuse term), the
+//! scalar loop renders the whole image and [`batch_refusal`] says why
+//! (`lobe render` prints it once);
 //! [`RenderLoop::Scalar`] forces the scalar loop. Both give the same bits
 //! for any thread count.
 
@@ -465,24 +472,44 @@ fn pilot_phase(scene: &Scene, opts: &RenderOptions) -> (Vec<Pilot>, RenderStats)
         spp: pilot_spp(opts.spp.max(1)),
         ..*opts
     };
-    let ctx = context(scene, &pilot_opts, 0, &light, &shading, &|_| {}, None);
+    // On the batch loop where it renders the scene: the same draws,
+    // recorded from f32 lanes.
+    let batch = match opts.render_loop {
+        RenderLoop::Batch => {
+            wavefront::Batch::new(scene, opts.strategy, opts.max_depth.max(1)).ok()
+        }
+        RenderLoop::Scalar => None,
+    };
+    let ctx = context(
+        scene,
+        &pilot_opts,
+        0,
+        &light,
+        &shading,
+        &|_| {},
+        batch.as_ref(),
+    );
     let k = ctx.spp;
-    let rows: Vec<(Vec<(Rgb, Pilot)>, RenderStats)> = (0..h)
-        .into_par_iter()
-        .map(|y| {
-            let mut stats = RenderStats::default();
-            let row = (0..w)
-                .map(|x| ctx.pixel(x, y, 0..k, FirstBounce::Pilot, &mut stats))
-                .collect();
-            (row, stats)
-        })
-        .collect();
-    let mut pilots = Vec::with_capacity(w * h);
-    let mut stats = RenderStats::default();
-    for (row, s) in rows {
-        pilots.extend(row.into_iter().map(|(_, p)| p));
-        stats = add_stats(stats, s);
+    let mut pilots = vec![Pilot::default(); w * h];
+    if w == 0 {
+        return (pilots, RenderStats::default());
     }
+    let stats = pilots
+        .par_chunks_mut(w)
+        .enumerate()
+        .map(|(y, row)| {
+            let mut stats = RenderStats::default();
+            if let Some(b) = ctx.batch {
+                let mut sums = vec![Rgb::ZERO; w];
+                stats = b.row(&ctx, y, &mut sums, &|_| FirstBounce::Pilot, Some(row));
+            } else {
+                for (x, p) in row.iter_mut().enumerate() {
+                    *p = ctx.pixel(x, y, 0..k, FirstBounce::Pilot, &mut stats).1;
+                }
+            }
+            stats
+        })
+        .reduce(RenderStats::default, add_stats);
     (pilots, stats)
 }
 
@@ -581,7 +608,7 @@ fn render_rows(
         .enumerate()
         .map(|(y, row)| {
             if let Some(b) = ctx.batch {
-                return b.row(ctx, y, row, &|x| plan(x, y).1);
+                return b.row(ctx, y, row, &|x| plan(x, y).1, None);
             }
             let mut stats = RenderStats::default();
             for (x, px) in row.iter_mut().enumerate() {

@@ -138,7 +138,7 @@ impl Distribution1D {
 
 /// Radiance and the two light-sampling densities of one direction
 /// ([`EnvMap::lookup`]).
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct EnvLookup {
     /// The radiance arriving from the direction ([`EnvMap::eval`]).
     pub radiance: Rgb,
@@ -165,6 +165,10 @@ fn acos_guess(y: f64) -> f64 {
     if y < 0.0 { PI - r } else { r }
 }
 
+/// Draws or directions per step of [`EnvMap::sample_lookup_many`] and
+/// [`EnvMap::lookup_many`].
+const LOOKUP_CHUNK: usize = 64;
+
 /// An equirectangular environment map with its sampling distribution.
 #[derive(Debug, Clone, PartialEq)]
 pub struct EnvMap {
@@ -174,7 +178,10 @@ pub struct EnvMap {
     row_cos: Vec<f64>,
     /// `(sin, cos)(2π i / width)` for `i = 0..=width`: the columns' edges.
     col_cs: Vec<(f64, f64)>,
-    texels: Vec<Rgb>,
+    /// Radiance and luminance per texel, together: a lookup reads one
+    /// 32-byte block (the densities are the luminance's functions,
+    /// [`TexelSampler::weight`]).
+    texels: Vec<Texel>,
     scale: f64,
     /// cos and sin of the rotation about +Y.
     rot: (f64, f64),
@@ -184,11 +191,21 @@ pub struct EnvMap {
     compensated: TexelSampler,
 }
 
+/// One texel: its radiance (before `scale`) and luminance.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[repr(C, align(32))]
+struct Texel {
+    rgb: [f64; 3],
+    lum: f64,
+}
+
 /// A piecewise-constant density over the texels: texel weights times their
 /// solid angles, a marginal over rows and a conditional within each row.
 #[derive(Debug, Clone, PartialEq)]
 struct TexelSampler {
-    weights: Vec<f64>,
+    /// The weight of a texel of luminance `lum`: `lum`, or with `Some(m)`
+    /// `max(0, lum − m)`.
+    shift: Option<f64>,
     rows: Distribution1D,
     cols: Vec<Distribution1D>,
     /// Σ weight·Ω over the texels.
@@ -196,28 +213,51 @@ struct TexelSampler {
 }
 
 impl TexelSampler {
-    fn new(width: usize, height: usize, weights: Vec<f64>) -> Self {
+    fn new(width: usize, height: usize, shift: Option<f64>, lum: &[f64]) -> Self {
+        let weights: Vec<f64> = lum.iter().map(|&l| Self::weight_of(shift, l)).collect();
         let dphi = 2.0 * PI / width as f64;
-        let mut row_weights = Vec::with_capacity(height);
-        let mut cols = Vec::with_capacity(height);
-        for j in 0..height {
+        let row = |j: usize| {
             let omega = dphi * EnvMap::band(height, j);
             let w: Vec<f64> = weights[j * width..(j + 1) * width]
                 .iter()
                 .map(|&t| t * omega)
                 .collect();
-            let d = Distribution1D::new(&w);
-            row_weights.push(d.total());
-            cols.push(d);
-        }
+            Distribution1D::new(&w)
+        };
+        // Each row's distribution is its own computation: the same numbers
+        // in parallel or not.
+        #[cfg(feature = "parallel")]
+        let cols: Vec<Distribution1D> = {
+            use rayon::prelude::*;
+            (0..height).into_par_iter().map(row).collect()
+        };
+        #[cfg(not(feature = "parallel"))]
+        let cols: Vec<Distribution1D> = (0..height).map(row).collect();
+        let row_weights: Vec<f64> = cols.iter().map(Distribution1D::total).collect();
         let rows = Distribution1D::new(&row_weights);
         let norm = rows.total();
         TexelSampler {
-            weights,
+            shift,
             rows,
             cols,
             norm,
         }
+    }
+}
+
+impl TexelSampler {
+    #[inline]
+    fn weight_of(shift: Option<f64>, lum: f64) -> f64 {
+        match shift {
+            None => lum,
+            Some(m) => (lum - m).max(0.0),
+        }
+    }
+
+    /// The density's weight of a texel of luminance `lum`.
+    #[inline]
+    fn weight(&self, lum: f64) -> f64 {
+        Self::weight_of(self.shift, lum)
     }
 }
 
@@ -295,15 +335,22 @@ impl EnvMap {
             }
         }
         let lum: Vec<f64> = texels.iter().map(|&t| luminance(t)).collect();
-        let plain = TexelSampler::new(width, height, lum.clone());
+        let plain = TexelSampler::new(width, height, None, &lum);
         // Mean luminance over the sphere, then the part above it.
         let mean = plain.norm / (4.0 * PI);
-        let above: Vec<f64> = lum.iter().map(|&l| (l - mean).max(0.0)).collect();
-        let compensated = if above.iter().any(|&w| w > 0.0) {
-            TexelSampler::new(width, height, above)
+        let compensated = if lum.iter().any(|&l| (l - mean).max(0.0) > 0.0) {
+            TexelSampler::new(width, height, Some(mean), &lum)
         } else {
             plain.clone()
         };
+        let texels = texels
+            .iter()
+            .zip(&lum)
+            .map(|(t, &lum)| Texel {
+                rgb: t.to_array(),
+                lum,
+            })
+            .collect();
         let r = rotation_y_deg.to_radians();
         Ok((
             EnvMap {
@@ -347,7 +394,7 @@ impl EnvMap {
 
     #[must_use]
     pub fn texel(&self, i: usize, j: usize) -> Rgb {
-        self.texels[j * self.width + i] * self.scale
+        Rgb::from_array(self.texels[j * self.width + i].rgb) * self.scale
     }
 
     /// Map coordinates `(u, v)` of a world direction.
@@ -505,7 +552,7 @@ impl EnvMap {
             return 0.0;
         }
         let (i, j) = self.texel_index(d);
-        t.weights[j * self.width + i] / t.norm
+        t.weight(self.texels[j * self.width + i].lum) / t.norm
     }
 
     /// Radiance and both densities ([`EnvMap::pdf`],
@@ -520,15 +567,16 @@ impl EnvMap {
 
     #[inline]
     fn texel_lookup(&self, k: usize) -> EnvLookup {
+        let texel = self.texels[k];
         let pdf = |t: &TexelSampler| {
             if t.norm > 0.0 {
-                t.weights[k] / t.norm
+                t.weight(texel.lum) / t.norm
             } else {
                 0.0
             }
         };
         EnvLookup {
-            radiance: self.texels[k] * self.scale,
+            radiance: Rgb::from_array(texel.rgb) * self.scale,
             pdf: pdf(&self.plain),
             pdf_compensated: pdf(&self.compensated),
         }
@@ -544,13 +592,80 @@ impl EnvMap {
     #[inline]
     #[must_use]
     pub fn sample_lookup(&self, compensated: bool, u: DVec2) -> Option<(DVec3, EnvLookup)> {
-        let t = if compensated {
+        let t = self.sampler(compensated);
+        let (j, ru) = t.rows.sample(u.x)?;
+        let (i, rv) = t.cols[j].sample(u.y)?;
+        self.finish_sample(compensated, (j, ru), (i, rv))
+    }
+
+    fn sampler(&self, compensated: bool) -> &TexelSampler {
+        if compensated {
             &self.compensated
         } else {
             &self.plain
-        };
-        let (j, ru) = t.rows.sample(u.x)?;
-        let (i, rv) = t.cols[j].sample(u.y)?;
+        }
+    }
+
+    /// [`EnvMap::sample_lookup`] of many draws `(compensated, u)`:
+    /// `out[k] = self.sample_lookup(draws[k].0, draws[k].1)`, bit for bit.
+    /// Each step (the row, the column, the texel) is taken for a chunk of
+    /// draws before the next, so that their reads of a map larger than the
+    /// caches overlap instead of waiting in turn.
+    ///
+    /// # Panics
+    /// If the slices differ in length.
+    pub fn sample_lookup_many(
+        &self,
+        draws: &[(bool, DVec2)],
+        out: &mut [Option<(DVec3, EnvLookup)>],
+    ) {
+        assert_eq!(draws.len(), out.len(), "sample_lookup_many: lengths differ");
+        for (dc, oc) in draws.chunks(LOOKUP_CHUNK).zip(out.chunks_mut(LOOKUP_CHUNK)) {
+            let mut rows = [None::<(usize, f64)>; LOOKUP_CHUNK];
+            for (r, &(comp, u)) in rows.iter_mut().zip(dc) {
+                *r = self.sampler(comp).rows.sample(u.x);
+            }
+            let mut cols = [None::<(usize, f64)>; LOOKUP_CHUNK];
+            for ((c, r), &(comp, u)) in cols.iter_mut().zip(&rows).zip(dc) {
+                *c = r.and_then(|(j, _)| self.sampler(comp).cols[j].sample(u.y));
+            }
+            for (k, o) in oc.iter_mut().enumerate() {
+                *o = match (rows[k], cols[k]) {
+                    (Some(r), Some(c)) => self.finish_sample(dc[k].0, r, c),
+                    _ => None,
+                };
+            }
+        }
+    }
+
+    /// [`EnvMap::lookup`] of many directions: `out[k] = self.lookup(dirs[k])`,
+    /// bit for bit, the texel searches of a chunk first and then its reads,
+    /// which overlap.
+    ///
+    /// # Panics
+    /// If the slices differ in length.
+    pub fn lookup_many(&self, dirs: &[DVec3], out: &mut [EnvLookup]) {
+        assert_eq!(dirs.len(), out.len(), "lookup_many: lengths differ");
+        for (dc, oc) in dirs.chunks(LOOKUP_CHUNK).zip(out.chunks_mut(LOOKUP_CHUNK)) {
+            let mut idx = [0usize; LOOKUP_CHUNK];
+            for (k, &d) in idx.iter_mut().zip(dc) {
+                let (i, j) = self.texel_index(d);
+                *k = j * self.width + i;
+            }
+            for (o, &k) in oc.iter_mut().zip(&idx) {
+                *o = self.texel_lookup(k);
+            }
+        }
+    }
+
+    /// The direction and lookup of a draw in texel `(i, j)` at `(ru, rv)`.
+    #[inline]
+    fn finish_sample(
+        &self,
+        compensated: bool,
+        (j, ru): (usize, f64),
+        (i, rv): (usize, f64),
+    ) -> Option<(DVec3, EnvLookup)> {
         let (c0, c1) = (self.row_cos[j], self.row_cos[j + 1]);
         let ct = (c0 + (c1 - c0) * ru).clamp(c1.min(c0), c0.max(c1));
         let st = (1.0 - ct * ct).max(0.0).sqrt();
@@ -784,6 +899,41 @@ mod tests {
         }
     }
 
+    /// The block forms give the single calls' values, bit for bit (over
+    /// more than two chunks, with both distributions).
+    #[test]
+    fn the_many_lookups_are_the_single_ones() {
+        let (m, _) = EnvMap::new(
+            64,
+            32,
+            EnvMap::sky(64, 32, 30.0, 40.0)
+                .texels
+                .iter()
+                .map(|t| Rgb::from_array(t.rgb))
+                .collect(),
+            1.5,
+            33.0,
+        )
+        .unwrap();
+        let n = 150;
+        let u = |k: usize| {
+            let a = crate::sequence::hash64(k as u64);
+            DVec2::new((a >> 40) as f64 / (1u64 << 24) as f64, (a & 0xffffff) as f64 / (1u64 << 24) as f64)
+        };
+        let draws: Vec<(bool, DVec2)> = (0..n).map(|k| (k % 3 == 0, u(k))).collect();
+        let mut got = vec![None; n];
+        m.sample_lookup_many(&draws, &mut got);
+        for (k, &(c, uk)) in draws.iter().enumerate() {
+            assert_eq!(got[k], m.sample_lookup(c, uk), "draw {k}");
+        }
+        let dirs: Vec<DVec3> = (0..n).map(|k| m.uv_to_direction(u(k + n))).collect();
+        let mut looked = vec![m.lookup(DVec3::Y); n];
+        m.lookup_many(&dirs, &mut looked);
+        for (k, &d) in dirs.iter().enumerate() {
+            assert_eq!(looked[k], m.lookup(d), "direction {k}");
+        }
+    }
+
     /// `sample_lookup` draws inside the texel whose lookup it returns, that
     /// lookup is `lookup` of the direction, and it is `sample`'s
     /// distribution (the same texel for the same numbers).
@@ -792,7 +942,11 @@ mod tests {
         let (m, _) = EnvMap::new(
             64,
             32,
-            EnvMap::sky(64, 32, 30.0, 40.0).texels.clone(),
+            EnvMap::sky(64, 32, 30.0, 40.0)
+                .texels
+                .iter()
+                .map(|t| Rgb::from_array(t.rgb))
+                .collect(),
             1.5,
             33.0,
         )

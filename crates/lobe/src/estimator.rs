@@ -243,8 +243,12 @@ impl Pilot {
     pub const MIN_EFFECTIVE_DRAWS: f64 = 64.0;
 
     /// One draw `d` of a pilot sample: `g = lum(f L cos)`, the three pdfs
-    /// at it and `q`.
-    fn record(&mut self, g: f64, pb: f64, pc: f64, pl: f64, q: f64) {
+    /// at it (`pb` the BSDF strategy's, `pc` the compensated light
+    /// distribution's, `pl` the plain one's) and `q = n_b p_b + n_l p_c`,
+    /// the density of the balance heuristic's mixture. Public for renderers
+    /// that draw the pilot's samples themselves (lobe-render's batch loop);
+    /// [`ShadingEstimator::estimate_pilot`] calls it for each draw.
+    pub fn record(&mut self, g: f64, pb: f64, pc: f64, pl: f64, q: f64) {
         if g <= 0.0 || q <= 0.0 || !g.is_finite() {
             return;
         }

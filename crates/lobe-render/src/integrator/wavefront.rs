@@ -9,11 +9,13 @@ use super::{Context, FirstBounce, RenderStats, dims, pixel_seed};
 use crate::geometry::spawn_ray;
 use crate::scene::Scene;
 use glam::{DVec2, DVec3};
-use lobe::batch::{BatchSampler, Dirs, DirsMut, EvalPdfOutput, RgbMut, SampleInput, SampleOutput};
+use lobe::batch::{
+    BatchSampler, Dirs, DirsMut, EvalPdfOutput, RgbMut, SampleInput, SampleOutput, SimdLevel,
+};
 use lobe::envmap::{EnvLookup, EnvMap};
-use lobe::estimator::{Allocation, Heuristic, MisForm, Strategy};
-use lobe::math::Rgb;
-use lobe::sequence::{Sequence, hash64, pair_point_seeded, pair_seed};
+use lobe::estimator::{Allocation, Heuristic, MisForm, Pilot, Strategy};
+use lobe::math::{Rgb, luminance};
+use lobe::sequence::{Sequence, hash64, pair_point_seeded, pair_seed, sobol_pairs};
 use lobe::{BsdfStrategy, Frame};
 
 /// Samples shaded together: camera rays, then every BSDF draw of the block
@@ -57,6 +59,8 @@ pub(super) struct Batch<'a> {
     samplers: Vec<BatchSampler>,
     kind: Kind,
     env: &'a EnvMap,
+    /// The SIMD level of the block's Sobol points (the BSDF kernels').
+    level: SimdLevel,
 }
 
 /// Why the batch loop does not render `scene` with `strategy` and
@@ -111,10 +115,14 @@ impl<'a> Batch<'a> {
                 .map_err(|e| format!("object {i} ({}, {s}): {e}", m.model_name()))?;
             samplers.push(b);
         }
+        let level = samplers
+            .first()
+            .map_or_else(SimdLevel::best, BatchSampler::level);
         Ok(Batch {
             samplers,
             kind,
             env: &scene.environment,
+            level,
         })
     }
 
@@ -163,7 +171,8 @@ struct Draw {
     dir: DVec3,
     /// The light draw's local `wi`.
     wi: DVec3,
-    /// The light draw's lookup.
+    /// The map at the draw's direction: a light draw's texel, an escaping
+    /// BSDF draw's lookup.
     light: Option<EnvLookup>,
     /// BSDF draw: the weight `f cos / p`; light draw: `f`.
     f: Rgb,
@@ -179,7 +188,29 @@ struct Lanes {
     valid: Vec<u8>,
     /// (object, draw index) of every BSDF or light draw, sorted by object.
     keys: Vec<u64>,
+    /// The block's Sobol pairs: per sample, the seeds of its [`PAIRS`]
+    /// pairs, its index, and the points.
+    pair_seeds: [Vec<u64>; PAIRS],
+    pair_index: Vec<u32>,
+    pair_x: [Vec<f64>; PAIRS],
+    pair_y: [Vec<f64>; PAIRS],
+    /// The seeds (pairs 1.. of [`PixelSeeds::all`]) and indices of the
+    /// samples that hit.
+    hit_seeds: [Vec<u64>; PAIRS],
+    hit_index: Vec<u32>,
+    /// The block's light draws `(compensated, u)`, their results, and
+    /// (here and for `bsdf_dirs`) their draw indices.
+    light_u: Vec<(bool, DVec2)>,
+    light_out: Vec<Option<(DVec3, EnvLookup)>>,
+    draw_index: Vec<usize>,
+    /// The escaping BSDF draws' world directions and the map there.
+    bsdf_dirs: Vec<DVec3>,
+    bsdf_env: Vec<EnvLookup>,
 }
+
+/// The pairs a sample of the batch loop draws: camera, BSDF direction,
+/// lobe choice, light ([`PixelSeeds`] in this order).
+const PAIRS: usize = 4;
 
 impl Lanes {
     fn new() -> Self {
@@ -189,6 +220,17 @@ impl Lanes {
             out: std::array::from_fn(|_| v()),
             valid: vec![0; 2 * BLOCK],
             keys: Vec::with_capacity(2 * BLOCK),
+            pair_seeds: std::array::from_fn(|_| Vec::with_capacity(BLOCK)),
+            pair_index: Vec::with_capacity(BLOCK),
+            pair_x: std::array::from_fn(|_| vec![0.0; BLOCK]),
+            pair_y: std::array::from_fn(|_| vec![0.0; BLOCK]),
+            hit_seeds: std::array::from_fn(|_| Vec::with_capacity(BLOCK)),
+            hit_index: Vec::with_capacity(BLOCK),
+            light_u: Vec::with_capacity(2 * BLOCK),
+            light_out: Vec::with_capacity(2 * BLOCK),
+            draw_index: Vec::with_capacity(2 * BLOCK),
+            bsdf_dirs: Vec::with_capacity(2 * BLOCK),
+            bsdf_env: Vec::with_capacity(2 * BLOCK),
         }
     }
 }
@@ -202,15 +244,35 @@ struct PixelSeeds {
     light: u64,
 }
 
+impl PixelSeeds {
+    fn all(&self) -> [u64; PAIRS] {
+        [self.camera, self.bsdf_u, self.bsdf_uc, self.light]
+    }
+}
+
+/// Where a sample's pairs come from: computed for the whole block
+/// (Sobol, [`sobol_pairs`]: the camera pair given, the others drawn
+/// afterwards for the samples that hit), or drawn one by one.
+#[derive(Debug, Clone, Copy)]
+enum Pairs {
+    Block(DVec2),
+    Each,
+}
+
 impl Batch<'_> {
     /// Samples `0..spp` of every pixel of row `y`, the pixel sums (not
-    /// divided) into `row`; `modes[x]` is pixel `x`'s first-bounce mode.
+    /// divided) into `row`; `mode(x)` is pixel `x`'s first-bounce mode.
+    /// With `pilots` (adaptive MIS's pilot, every mode
+    /// [`FirstBounce::Pilot`]), each sample's draws are recorded in its
+    /// pixel's [`Pilot`] as [`lobe::estimator::ShadingEstimator::estimate_pilot`]
+    /// records them.
     pub(super) fn row(
         &self,
         ctx: &Context<'_>,
         y: usize,
         row: &mut [Rgb],
         mode: &(dyn Fn(usize) -> FirstBounce + Sync),
+        mut pilots: Option<&mut [Pilot]>,
     ) -> RenderStats {
         let mut stats = RenderStats::default();
         let mut lanes = Lanes::new();
@@ -222,31 +284,90 @@ impl Batch<'_> {
         while k < total {
             let end = (k + BLOCK as u64).min(total);
             pts.clear();
-            let mut cur: Option<(usize, PixelSeeds, PixelPlan, u64)> = None;
+            let sobol = ctx.sequence == Sequence::Sobol;
+            if sobol {
+                // The block's Sobol pairs in SIMD lanes, first.
+                for v in &mut lanes.pair_seeds {
+                    v.clear();
+                }
+                lanes.pair_index.clear();
+                let mut cur: Option<(usize, [u64; PAIRS])> = None;
+                for f in k..end {
+                    let (x, i) = ((f / spp) as usize, f % spp);
+                    if cur.is_none_or(|c| c.0 != x) {
+                        cur = Some((x, pixel_seeds(ctx, x, y).all()));
+                    }
+                    let seeds = cur.expect("set above").1;
+                    for (v, s) in lanes.pair_seeds.iter_mut().zip(seeds) {
+                        v.push(s);
+                    }
+                    let index = ctx.pass * spp + i;
+                    debug_assert!(index <= u64::from(u32::MAX));
+                    lanes.pair_index.push(index as u32);
+                }
+                // The camera pair of every sample; the others (below) only
+                // for the samples that hit.
+                let n = lanes.pair_index.len();
+                sobol_pairs(
+                    self.level,
+                    &lanes.pair_seeds[0],
+                    &lanes.pair_index,
+                    &mut lanes.pair_x[0][..n],
+                    &mut lanes.pair_y[0][..n],
+                );
+            }
+            let mut cur: Option<(usize, PixelSeeds, PixelPlan)> = None;
             for f in k..end {
                 let (x, i) = ((f / spp) as usize, f % spp);
                 if cur.is_none_or(|c| c.0 != x) {
-                    let ps = pixel_seed(ctx.seed, (y * ctx.width + x) as u64);
-                    let seed = match ctx.sequence {
-                        Sequence::Stratified => hash64(ps ^ hash64(ctx.pass)),
-                        Sequence::Sobol | Sequence::Independent => ps,
-                    };
-                    let seeds = PixelSeeds {
-                        camera: pair_seed(seed, dims::CAMERA),
-                        bsdf_u: pair_seed(seed, dims::bsdf_u(0)),
-                        bsdf_uc: pair_seed(seed, dims::bsdf_uc(0)),
-                        light: pair_seed(seed, dims::light(0)),
-                    };
-                    cur = Some((x, seeds, self.plan(mode(x)), seed));
+                    cur = Some((x, pixel_seeds(ctx, x, y), self.plan(mode(x))));
                 }
-                let (_, seeds, plan, _) = cur.expect("set above");
+                let (_, seeds, plan) = cur.expect("set above");
                 let index = match ctx.sequence {
                     Sequence::Stratified => i,
                     Sequence::Sobol | Sequence::Independent => ctx.pass * spp + i,
                 };
-                pts.push(self.camera_point(ctx, (x, y), index, &seeds, plan, &mut stats));
+                let pairs = if sobol {
+                    let m = (f - k) as usize;
+                    Pairs::Block(DVec2::new(lanes.pair_x[0][m], lanes.pair_y[0][m]))
+                } else {
+                    Pairs::Each
+                };
+                pts.push(self.camera_point(ctx, (x, y), index, &seeds, pairs, plan, &mut stats));
             }
-            self.shade(ctx.scene, &mut pts, &mut draws, &mut lanes, &mut stats);
+            if sobol {
+                // The shading pairs of the samples that hit, compacted.
+                for v in &mut lanes.hit_seeds {
+                    v.clear();
+                }
+                lanes.hit_index.clear();
+                lanes.draw_index.clear();
+                for (m, pt) in pts.iter().enumerate() {
+                    if pt.obj == u32::MAX {
+                        continue;
+                    }
+                    lanes.draw_index.push(m);
+                    lanes.hit_index.push(lanes.pair_index[m]);
+                    for p in 1..PAIRS {
+                        lanes.hit_seeds[p].push(lanes.pair_seeds[p][m]);
+                    }
+                }
+                let n = lanes.hit_index.len();
+                for p in 1..PAIRS {
+                    sobol_pairs(
+                        self.level,
+                        &lanes.hit_seeds[p],
+                        &lanes.hit_index,
+                        &mut lanes.pair_x[p][..n],
+                        &mut lanes.pair_y[p][..n],
+                    );
+                }
+                for (h, &m) in lanes.draw_index.iter().enumerate() {
+                    let (px, py) = (&lanes.pair_x, &lanes.pair_y);
+                    self.assign_u(&mut pts[m], |p| DVec2::new(px[p][h], py[p][h]));
+                }
+            }
+            self.shade(ctx.scene, &mut pts, &mut draws, &mut lanes, &mut stats, pilots.as_deref_mut());
             for pt in &pts {
                 if pt.value.is_finite() {
                     row[pt.x as usize] += pt.value;
@@ -268,11 +389,23 @@ impl Batch<'_> {
         (x, y): (usize, usize),
         index: u64,
         seeds: &PixelSeeds,
+        pairs: Pairs,
         plan: PixelPlan,
         stats: &mut RenderStats,
     ) -> Point {
-        let pair = |s: u64| DVec2::from_array(pair_point_seeded(ctx.sequence, s, ctx.spp, index));
-        let j = pair(seeds.camera);
+        // Pair p of `PixelSeeds::all`.
+        let pair = |p: usize| {
+            DVec2::from_array(pair_point_seeded(
+                ctx.sequence,
+                seeds.all()[p],
+                ctx.spp,
+                index,
+            ))
+        };
+        let j = match pairs {
+            Pairs::Block(c) => c,
+            Pairs::Each => pair(0),
+        };
         let ray = ctx.scene.camera.ray(x as f64 + j.x, y as f64 + j.y);
         stats.camera_rays += 1;
         stats.rays += 1;
@@ -311,22 +444,36 @@ impl Batch<'_> {
         if wo.z <= 0.0 {
             return pt;
         }
-        // The scalar loop's points: the BSDF point [bsdf_uc.x, bsdf_u], the
-        // light point [bsdf_uc.y, light]; light sampling alone takes the
-        // light point.
+        if let Pairs::Each = pairs {
+            self.assign_u(&mut pt, pair);
+        }
+        pt.obj = obj as u32;
+        pt.p = hit.p;
+        pt.ng = ng;
+        pt.frame = frame;
+        pt.wo = wo;
+        pt
+    }
+
+    /// The numbers of `pt`'s draws from its pairs (`pair(p)`, pair `p` of
+    /// [`PixelSeeds::all`]), as the scalar loop takes them: the BSDF point
+    /// `[bsdf_uc.x, bsdf_u]`, the light point `[bsdf_uc.y, light]`; light
+    /// sampling alone takes the light point.
+    fn assign_u(&self, pt: &mut Point, pair: impl Fn(usize) -> DVec2) {
+        let plan = pt.plan;
         let light_alone = matches!(self.kind, Kind::Light);
         // Light draws do not read `uc`.
         let uc = if plan.slots.contains(&Slot::Bsdf) {
-            pair(seeds.bsdf_uc)
+            pair(2)
         } else {
             DVec2::ZERO
         };
         let bsdf_point = || {
-            let u = pair(seeds.bsdf_u);
+            let u = pair(1);
             [uc.x, u.x, u.y]
         };
         let light_point = || {
-            let u = pair(seeds.light);
+            let u = pair(3);
             [uc.y, u.x, u.y]
         };
         pt.u[0] = if light_alone {
@@ -337,12 +484,6 @@ impl Batch<'_> {
         if plan.slots[1] != Slot::Unused {
             pt.u[1] = light_point();
         }
-        pt.obj = obj as u32;
-        pt.p = hit.p;
-        pt.ng = ng;
-        pt.frame = frame;
-        pt.wo = wo;
-        pt
     }
 
     /// The draws of a block: BSDF samples and light samples' `f` and pdf
@@ -354,37 +495,50 @@ impl Batch<'_> {
         draws: &mut [Draw],
         lanes: &mut Lanes,
         stats: &mut RenderStats,
+        mut pilots: Option<&mut [Pilot]>,
     ) {
-        // Light draws first: their directions, by scalar sampling of the map.
+        // Light draws first: their directions, by sampling the map for the
+        // whole block (`EnvMap::sample_lookup_many`).
         lanes.keys.clear();
+        lanes.light_u.clear();
+        lanes.draw_index.clear();
+        let key = |obj: u32, di: usize| (u64::from(obj) << 32) | di as u64;
         for (i, pt) in pts.iter().enumerate() {
             if pt.obj == u32::MAX {
                 continue;
             }
             for s in 0..2 {
-                let d = &mut draws[2 * i + s];
-                *d = Draw::default();
+                draws[2 * i + s] = Draw::default();
                 match pt.plan.slots[s] {
-                    Slot::Unused => continue,
-                    Slot::Bsdf => {}
+                    Slot::Unused => {}
+                    Slot::Bsdf => lanes.keys.push(key(pt.obj, 2 * i + s)),
                     Slot::Light { compensated } => {
-                        let u = DVec2::new(pt.u[s][1], pt.u[s][2]);
-                        let Some((dir, l)) = self.env.sample_lookup(compensated, u) else {
-                            continue;
-                        };
-                        let wi = pt.frame.to_local(dir);
-                        if wi.z <= 0.0 {
-                            continue;
-                        }
-                        d.dir = dir;
-                        d.wi = wi;
-                        d.light = Some(l);
+                        lanes
+                            .light_u
+                            .push((compensated, DVec2::new(pt.u[s][1], pt.u[s][2])));
+                        lanes.draw_index.push(2 * i + s);
                     }
                 }
-                lanes
-                    .keys
-                    .push((u64::from(pt.obj) << 32) | (2 * i + s) as u64);
             }
+        }
+        let n = lanes.light_u.len();
+        lanes.light_out.resize(n, None);
+        self.env
+            .sample_lookup_many(&lanes.light_u, &mut lanes.light_out[..n]);
+        for (&di, out) in lanes.draw_index.iter().zip(&lanes.light_out[..n]) {
+            let pt = &pts[di / 2];
+            let Some((dir, l)) = *out else {
+                continue;
+            };
+            let wi = pt.frame.to_local(dir);
+            if wi.z <= 0.0 {
+                continue;
+            }
+            let d = &mut draws[di];
+            d.dir = dir;
+            d.wi = wi;
+            d.light = Some(l);
+            lanes.keys.push(key(pt.obj, di));
         }
         lanes.keys.sort_unstable();
         // One batch call per object and kind of draw.
@@ -398,6 +552,37 @@ impl Batch<'_> {
             self.batch_group(obj, g..e, pts, draws, lanes);
             g = e;
         }
+        // The BSDF draws' shadow rays, then the map at the directions that
+        // escape, for the whole block (`EnvMap::lookup_many`).
+        lanes.bsdf_dirs.clear();
+        lanes.draw_index.clear();
+        for (i, pt) in pts.iter().enumerate() {
+            if pt.obj == u32::MAX {
+                continue;
+            }
+            for s in 0..2 {
+                let d = &mut draws[2 * i + s];
+                if pt.plan.slots[s] != Slot::Bsdf || !d.ok {
+                    continue;
+                }
+                let dir = pt.frame.to_world(d.dir).normalize();
+                stats.rays += 1;
+                if scene.occluded(&spawn_ray(pt.p, pt.ng, dir)) {
+                    // No light: as a failed draw.
+                    d.ok = false;
+                    continue;
+                }
+                lanes.bsdf_dirs.push(dir);
+                lanes.draw_index.push(2 * i + s);
+            }
+        }
+        let n = lanes.bsdf_dirs.len();
+        lanes.bsdf_env.resize(n, EnvLookup::default());
+        self.env
+            .lookup_many(&lanes.bsdf_dirs, &mut lanes.bsdf_env[..n]);
+        for (&di, &l) in lanes.draw_index.iter().zip(&lanes.bsdf_env[..n]) {
+            draws[di].light = Some(l);
+        }
         // Shadow rays and the estimates, in sample order.
         for (i, pt) in pts.iter_mut().enumerate() {
             if pt.obj == u32::MAX {
@@ -405,6 +590,10 @@ impl Batch<'_> {
             }
             let mut sum = Rgb::ZERO;
             let mut n = 0.0;
+            let mut pilot = pilots.as_deref_mut().map(|p| &mut p[pt.x as usize]);
+            if let Some(p) = pilot.as_deref_mut() {
+                p.samples += 1;
+            }
             for s in 0..2 {
                 let slot = pt.plan.slots[s];
                 if slot == Slot::Unused {
@@ -418,13 +607,13 @@ impl Batch<'_> {
                 match slot {
                     Slot::Unused => {}
                     Slot::Bsdf => {
-                        let dir = pt.frame.to_world(d.dir).normalize();
-                        stats.rays += 1;
-                        if scene.occluded(&spawn_ray(pt.p, pt.ng, dir)) {
-                            continue;
-                        }
-                        let l = self.env.lookup(dir);
+                        // Unoccluded (above), looked up.
+                        let l = d.light.expect("a BSDF draw that escapes");
                         let v = d.f * l.radiance;
+                        if let Some(p) = pilot.as_deref_mut() {
+                            let q = d.pdf + l.pdf_compensated;
+                            p.record(luminance(v) * d.pdf, d.pdf, l.pdf_compensated, l.pdf, q);
+                        }
                         sum += match pt.plan.mis {
                             None => v,
                             Some(h) => v * h.weight(d.pdf, l.pdf_compensated),
@@ -440,6 +629,10 @@ impl Batch<'_> {
                             continue;
                         }
                         let v = d.f * l.radiance * d.wi.z;
+                        if let Some(p) = pilot.as_deref_mut() {
+                            let q = d.pdf + l.pdf_compensated;
+                            p.record(luminance(v), d.pdf, l.pdf_compensated, l.pdf, q);
+                        }
                         let p = if compensated {
                             l.pdf_compensated
                         } else {
@@ -582,5 +775,20 @@ impl Batch<'_> {
                 m += 1;
             }
         }
+    }
+}
+
+/// The pair seeds of pixel `(x, y)` in `ctx`'s pass.
+fn pixel_seeds(ctx: &Context<'_>, x: usize, y: usize) -> PixelSeeds {
+    let ps = pixel_seed(ctx.seed, (y * ctx.width + x) as u64);
+    let seed = match ctx.sequence {
+        Sequence::Stratified => hash64(ps ^ hash64(ctx.pass)),
+        Sequence::Sobol | Sequence::Independent => ps,
+    };
+    PixelSeeds {
+        camera: pair_seed(seed, dims::CAMERA),
+        bsdf_u: pair_seed(seed, dims::bsdf_u(0)),
+        bsdf_uc: pair_seed(seed, dims::bsdf_uc(0)),
+        light: pair_seed(seed, dims::light(0)),
     }
 }
