@@ -918,7 +918,10 @@ mod tests {
         let n = 150;
         let u = |k: usize| {
             let a = crate::sequence::hash64(k as u64);
-            DVec2::new((a >> 40) as f64 / (1u64 << 24) as f64, (a & 0xffffff) as f64 / (1u64 << 24) as f64)
+            DVec2::new(
+                (a >> 40) as f64 / (1u64 << 24) as f64,
+                (a & 0xffffff) as f64 / (1u64 << 24) as f64,
+            )
         };
         let draws: Vec<(bool, DVec2)> = (0..n).map(|k| (k % 3 == 0, u(k))).collect();
         let mut got = vec![None; n];

@@ -566,8 +566,7 @@ mod tests {
                 let (mut x, mut y) = (vec![0.0; n], vec![0.0; n]);
                 sobol_pairs(level, &seeds, &index, &mut x, &mut y);
                 for k in 0..n {
-                    let want =
-                        pair_point_seeded(Sequence::Sobol, seeds[k], 1, u64::from(index[k]));
+                    let want = pair_point_seeded(Sequence::Sobol, seeds[k], 1, u64::from(index[k]));
                     assert_eq!([x[k], y[k]], want, "{level:?} lane {k} of {n}");
                 }
             }

@@ -367,7 +367,14 @@ impl Batch<'_> {
                     self.assign_u(&mut pts[m], |p| DVec2::new(px[p][h], py[p][h]));
                 }
             }
-            self.shade(ctx.scene, &mut pts, &mut draws, &mut lanes, &mut stats, pilots.as_deref_mut());
+            self.shade(
+                ctx.scene,
+                &mut pts,
+                &mut draws,
+                &mut lanes,
+                &mut stats,
+                pilots.as_deref_mut(),
+            );
             for pt in &pts {
                 if pt.value.is_finite() {
                     row[pt.x as usize] += pt.value;
