@@ -22,7 +22,7 @@ use super::super::lanes::Lanes;
 use super::super::math::sincos_turns;
 use super::{
     BOUNDED, CtParams, Eval, GGX, INV_PI, Sampled, Shadow, V3, VNDF, dot, eval_at, eval_h, finish,
-    glossy_probability, reflect_or_diffuse, select3, stretched_len,
+    glossy_probability, plus_diffuse, reflect_or_diffuse, select3, stretched_len, with_weight,
 };
 
 /// The visible normal of the caps (`STRAT = CAPS`) or of the bounded VNDF.
@@ -133,18 +133,7 @@ fn eval_h_caps<L: Lanes, const STRAT: u8>(
     let pg = l.select(e.ok, e.pdf, zero);
     let pd = wi[2] * l.splat(INV_PI);
     let pdf = l.mul_add(glossy_probability(l, p, wo), pg - pd, pd);
-    let f = [
-        fg[0] + l.select(above, l.splat(p.kd_pi[0]), zero),
-        fg[1] + l.select(above, l.splat(p.kd_pi[1]), zero),
-        fg[2] + l.select(above, l.splat(p.kd_pi[2]), zero),
-    ];
-    let ws = wi[2] / pdf;
-    Eval {
-        ok: above,
-        f,
-        pdf,
-        weight: [f[0] * ws, f[1] * ws, f[2] * ws],
-    }
+    with_weight(above, plus_diffuse(l, fg, p.kd_pi, above), pdf, wi[2])
 }
 
 /// One vector of samples (`STRAT`: [`CAPS`] or [`BOUNDED`]).

@@ -320,14 +320,28 @@ fn eval_h<L: Lanes, const NDF: u8, const STRAT: u8>(
             l.mul_add(pr, pg - pd, pd)
         }
     };
-    let f = [
-        fg[0] + l.select(above, l.splat(p.kd_pi[0]), zero),
-        fg[1] + l.select(above, l.splat(p.kd_pi[1]), zero),
-        fg[2] + l.select(above, l.splat(p.kd_pi[2]), zero),
-    ];
-    let ws = wi[2] / pdf;
+    with_weight(above, plus_diffuse(l, fg, p.kd_pi, above), pdf, wi[2])
+}
+
+/// The glossy `fg` plus the diffuse `kd/π` where `above` (both directions
+/// above the horizon), as `Material::eval` adds them; no cosine.
+#[inline(always)]
+pub(super) fn plus_diffuse<L: Lanes>(l: L, fg: V3<L>, kd_pi: [f32; 3], above: L::M) -> V3<L> {
+    let zero = l.splat(0.0);
+    [
+        fg[0] + l.select(above, l.splat(kd_pi[0]), zero),
+        fg[1] + l.select(above, l.splat(kd_pi[1]), zero),
+        fg[2] + l.select(above, l.splat(kd_pi[2]), zero),
+    ]
+}
+
+/// The [`Eval`] of `f` (no cosine) and `pdf` valid where `ok`, with
+/// `weight = f·cos θi/pdf` (`cos_i` the cosine).
+#[inline(always)]
+pub(super) fn with_weight<L: Lanes>(ok: L::M, f: V3<L>, pdf: L::F, cos_i: L::F) -> Eval<L> {
+    let ws = cos_i / pdf;
     Eval {
-        ok: above,
+        ok,
         f,
         pdf,
         weight: [f[0] * ws, f[1] * ws, f[2] * ws],

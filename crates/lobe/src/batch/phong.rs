@@ -30,6 +30,7 @@ use super::super::lanes::Lanes;
 use super::super::math::{exp, expm1, log, pow_cos, sincos_turns};
 use super::{
     COSINE, Eval, INV_PI, INV_TWO_PI, Sampled, UNIFORM, V3, cosine_hemisphere, dot, finish,
+    with_weight,
 };
 
 /// `MODEL`: Phong.
@@ -147,13 +148,7 @@ fn eval_cn<L: Lanes, const MODEL: u8, const STRAT: u8>(
             }
         }
     };
-    let ws = wi[2] / pdf;
-    Eval {
-        ok: above,
-        f,
-        pdf,
-        weight: [f[0] * ws, f[1] * ws, f[2] * ws],
-    }
+    with_weight(above, f, pdf, wi[2])
 }
 
 /// `(f, pdf)` of `eval_pdf`: zero below the horizon or where not finite.
