@@ -474,12 +474,7 @@ fn pilot_phase(scene: &Scene, opts: &RenderOptions) -> (Vec<Pilot>, RenderStats)
     };
     // On the batch loop where it renders the scene: the same draws,
     // recorded from f32 lanes.
-    let batch = match opts.render_loop {
-        RenderLoop::Batch => {
-            wavefront::Batch::new(scene, opts.strategy, opts.max_depth.max(1)).ok()
-        }
-        RenderLoop::Scalar => None,
-    };
+    let batch = batch_loop(scene, opts);
     let ctx = context(
         scene,
         &pilot_opts,
@@ -544,12 +539,7 @@ fn render_on_pool(
     let (w, h) = (scene.camera.width as usize, scene.camera.height as usize);
     let shading = shadings(scene, opts);
     let light = Light::Env(scene.environment.clone());
-    let batch = match opts.render_loop {
-        RenderLoop::Batch => {
-            wavefront::Batch::new(scene, opts.strategy, opts.max_depth.max(1)).ok()
-        }
-        RenderLoop::Scalar => None,
-    };
+    let batch = batch_loop(scene, opts);
     let ctx = context(
         scene,
         opts,
@@ -851,5 +841,17 @@ impl Context<'_> {
             wo_world = -d.dir;
         }
         l
+    }
+}
+
+/// The batch loop for `scene` where `opts` asks for it and it covers the
+/// scene and strategy ([`batch_refusal`] says why not); else `None`, the
+/// scalar loop.
+fn batch_loop<'a>(scene: &'a Scene, opts: &RenderOptions) -> Option<wavefront::Batch<'a>> {
+    match opts.render_loop {
+        RenderLoop::Batch => {
+            wavefront::Batch::new(scene, opts.strategy, opts.max_depth.max(1)).ok()
+        }
+        RenderLoop::Scalar => None,
     }
 }

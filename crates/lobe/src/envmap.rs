@@ -899,22 +899,22 @@ mod tests {
         }
     }
 
+    /// The built-in sky at 64 × 32 through `EnvMap::new`, scaled by 1.5
+    /// and rotated by 33°.
+    fn scaled_sky() -> EnvMap {
+        let texels = EnvMap::sky(64, 32, 30.0, 40.0)
+            .texels
+            .iter()
+            .map(|t| Rgb::from_array(t.rgb))
+            .collect();
+        EnvMap::new(64, 32, texels, 1.5, 33.0).unwrap().0
+    }
+
     /// The block forms give the single calls' values, bit for bit (over
     /// more than two chunks, with both distributions).
     #[test]
     fn the_many_lookups_are_the_single_ones() {
-        let (m, _) = EnvMap::new(
-            64,
-            32,
-            EnvMap::sky(64, 32, 30.0, 40.0)
-                .texels
-                .iter()
-                .map(|t| Rgb::from_array(t.rgb))
-                .collect(),
-            1.5,
-            33.0,
-        )
-        .unwrap();
+        let m = scaled_sky();
         let n = 150;
         let u = |k: usize| {
             let a = crate::sequence::hash64(k as u64);
@@ -942,18 +942,7 @@ mod tests {
     /// distribution (the same texel for the same numbers).
     #[test]
     fn sample_lookup_agrees_with_sample_and_lookup() {
-        let (m, _) = EnvMap::new(
-            64,
-            32,
-            EnvMap::sky(64, 32, 30.0, 40.0)
-                .texels
-                .iter()
-                .map(|t| Rgb::from_array(t.rgb))
-                .collect(),
-            1.5,
-            33.0,
-        )
-        .unwrap();
+        let m = scaled_sky();
         for comp in [false, true] {
             for k in 0..2000 {
                 let u = DVec2::new(
