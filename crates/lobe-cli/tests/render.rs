@@ -218,7 +218,9 @@ fn errors_are_one_line_and_name_file_line_and_field() {
         &["render", d.join("none.toml").to_str().unwrap()],
         None,
     ));
-    assert!(e.contains("none.toml"), "{e}");
+    assert!(e.contains("none.toml: cannot read the scene file: "), "{e}");
+    // The OS reason once, not once more from the error chain.
+    assert_eq!(e.matches("os error").count(), 1, "{e}");
 }
 
 /// `--spp` takes any u64; more samples than fit in 64 bits in all, or a

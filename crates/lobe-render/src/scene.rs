@@ -408,10 +408,12 @@ impl fmt::Display for FieldPath {
 /// where it can, the line, column and field.
 #[derive(Debug, thiserror::Error)]
 pub enum SceneError {
-    #[error("{}: cannot read the scene file: {source}", path.display())]
+    /// The OS error is part of the message, not a `source()` (printing
+    /// the chain would repeat it).
+    #[error("{}: cannot read the scene file: {error}", path.display())]
     Io {
         path: PathBuf,
-        source: std::io::Error,
+        error: std::io::Error,
     },
     #[error("{}", at_message(file, *at, field.as_ref(), message))]
     At {
@@ -456,9 +458,9 @@ impl SceneError {
 /// Read a scene file. Relative paths in it (environment map, meshes) are
 /// taken relative to the file's directory.
 pub fn load_scene(path: &Path) -> Result<Scene, SceneError> {
-    let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io {
+    let text = std::fs::read_to_string(path).map_err(|error| SceneError::Io {
         path: path.to_path_buf(),
-        source,
+        error,
     })?;
     parse_scene(&text, path)
 }
