@@ -60,7 +60,15 @@ fn files() -> &'static Files {
         std::fs::create_dir_all(&dir).unwrap();
         let (merl, rgl) = (dir.join("t.binary"), dir.join("t.bsdf"));
         let o = lobe(
-            &["tabulate", "-m", ANALYTIC, "--format", "merl", "--out", merl.to_str().unwrap()],
+            &[
+                "tabulate",
+                "-m",
+                ANALYTIC,
+                "--format",
+                "merl",
+                "--out",
+                merl.to_str().unwrap(),
+            ],
             None,
             "",
         );
@@ -94,7 +102,10 @@ fn files() -> &'static Files {
 }
 
 fn measured(path: &Path) -> String {
-    format!(r#"{{"type":"measured","path":{:?}}}"#, path.to_str().unwrap())
+    format!(
+        r#"{{"type":"measured","path":{:?}}}"#,
+        path.to_str().unwrap()
+    )
 }
 
 fn parse_lines(s: &str) -> Vec<Value> {
@@ -175,7 +186,9 @@ fn estimate_takes_measured_tables() {
     let f = files();
     let analytic = {
         let o = lobe(
-            &["estimate", "-m", ANALYTIC, "--theta", "40", "-n", "4096", "--json", "--quiet"],
+            &[
+                "estimate", "-m", ANALYTIC, "--theta", "40", "-n", "4096", "--json", "--quiet",
+            ],
             None,
             "",
         );
@@ -223,7 +236,9 @@ fn estimate_takes_measured_tables() {
         }
         // The furnace: the table's albedo is the analytic material's.
         let o = lobe(
-            &["estimate", "-m", &m, "--theta", "40", "-n", "4096", "--json", "--quiet"],
+            &[
+                "estimate", "-m", &m, "--theta", "40", "-n", "4096", "--json", "--quiet",
+            ],
             None,
             "",
         );
@@ -309,8 +324,16 @@ fn plot_takes_a_measured_table_and_draws_its_fit() {
     let stdout = ok(&o, "plot");
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(err.contains(": pass at"), "{err}");
-    assert!(err.contains(r#"fit: {"type":"cook-torrance","distribution":"ggx""#), "{err}");
-    for name in ["polar.png", "polar-fit.png", "histogram-brdf.png", "weights-brdf.png"] {
+    assert!(
+        err.contains(r#"fit: {"type":"cook-torrance","distribution":"ggx""#),
+        "{err}"
+    );
+    for name in [
+        "polar.png",
+        "polar-fit.png",
+        "histogram-brdf.png",
+        "weights-brdf.png",
+    ] {
         assert!(stdout.contains(name), "{stdout}");
         let img = image::open(out.join(name)).unwrap();
         assert!(img.width() > 100 && img.height() > 100, "{name}");
@@ -339,35 +362,70 @@ fn fit_recovers_the_tabulated_parameters() {
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(err.is_empty(), "{err}");
 
-    let check = |path: &Path, extra: &[&str], alpha: f64, f0: [f64; 3], kd: [f64; 3], tol: (f64, f64)| {
-        let mut args = vec!["fit", path.to_str().unwrap(), "--json"];
-        args.extend_from_slice(extra);
-        let o = lobe(&args, None, "");
-        let v: Value = serde_json::from_str(&ok(&o, "fit --json")).unwrap();
-        eprintln!("{}: {v}", path.display());
-        let m = &v["material"];
-        let a = m["alpha"].as_f64().unwrap();
-        assert!((a - alpha).abs() <= tol.0 * alpha, "{}: alpha {a}", path.display());
-        for c in 0..3 {
-            let (g0, gd) = (
-                m["fresnel"]["f0"][c].as_f64().unwrap(),
-                m["kd"][c].as_f64().unwrap(),
+    let check =
+        |path: &Path, extra: &[&str], alpha: f64, f0: [f64; 3], kd: [f64; 3], tol: (f64, f64)| {
+            let mut args = vec!["fit", path.to_str().unwrap(), "--json"];
+            args.extend_from_slice(extra);
+            let o = lobe(&args, None, "");
+            let v: Value = serde_json::from_str(&ok(&o, "fit --json")).unwrap();
+            eprintln!("{}: {v}", path.display());
+            let m = &v["material"];
+            let a = m["alpha"].as_f64().unwrap();
+            assert!(
+                (a - alpha).abs() <= tol.0 * alpha,
+                "{}: alpha {a}",
+                path.display()
             );
-            assert!((g0 - f0[c]).abs() <= tol.1, "{}: f0 {}", path.display(), m["fresnel"]);
-            assert!((gd - kd[c]).abs() <= tol.1, "{}: kd {}", path.display(), m["kd"]);
-        }
-        assert!(v["error"].as_f64().unwrap() >= 0.0);
-        // The table's memory and build time are reported on stderr.
-        let err = String::from_utf8_lossy(&o.stderr);
-        assert!(err.contains("MB") && err.contains("built in"), "{err}");
-    };
-    check(&f.merl, &[], 0.2, [0.9, 0.6, 0.3], [0.1, 0.15, 0.05], (0.05, 0.02));
-    check(&f.rgl, &[], 0.2, [0.9, 0.6, 0.3], [0.1, 0.15, 0.05], (0.1, 0.05));
+            for c in 0..3 {
+                let (g0, gd) = (
+                    m["fresnel"]["f0"][c].as_f64().unwrap(),
+                    m["kd"][c].as_f64().unwrap(),
+                );
+                assert!(
+                    (g0 - f0[c]).abs() <= tol.1,
+                    "{}: f0 {}",
+                    path.display(),
+                    m["fresnel"]
+                );
+                assert!(
+                    (gd - kd[c]).abs() <= tol.1,
+                    "{}: kd {}",
+                    path.display(),
+                    m["kd"]
+                );
+            }
+            assert!(v["error"].as_f64().unwrap() >= 0.0);
+            // The table's memory and build time are reported on stderr.
+            let err = String::from_utf8_lossy(&o.stderr);
+            assert!(err.contains("MB") && err.contains("built in"), "{err}");
+        };
+    check(
+        &f.merl,
+        &[],
+        0.2,
+        [0.9, 0.6, 0.3],
+        [0.1, 0.15, 0.05],
+        (0.05, 0.02),
+    );
+    check(
+        &f.rgl,
+        &[],
+        0.2,
+        [0.9, 0.6, 0.3],
+        [0.1, 0.15, 0.05],
+        (0.1, 0.05),
+    );
 
     // --distribution beckmann fits a Beckmann lobe (the library's tests
     // recover a Beckmann table's parameters).
     let o = lobe(
-        &["fit", f.merl.to_str().unwrap(), "--distribution", "beckmann", "--json"],
+        &[
+            "fit",
+            f.merl.to_str().unwrap(),
+            "--distribution",
+            "beckmann",
+            "--json",
+        ],
         None,
         "",
     );
@@ -417,14 +475,26 @@ fn render_and_compare_take_measured_tables() {
         let path = f.dir.join(format!("{name}.toml"));
         std::fs::write(&path, scene).unwrap();
         let o = lobe(
-            &["render", path.to_str().unwrap(), "--spp", "64", "--out", name, "--quiet"],
+            &[
+                "render",
+                path.to_str().unwrap(),
+                "--spp",
+                "64",
+                "--out",
+                name,
+                "--quiet",
+            ],
             Some(&f.dir),
             "",
         );
         ok(&o, name);
-        let img = image::open(f.dir.join(format!("{name}.png"))).unwrap().to_rgb8();
+        let img = image::open(f.dir.join(format!("{name}.png")))
+            .unwrap()
+            .to_rgb8();
         assert_eq!(img.dimensions(), (16, 12));
-        img.pixels().map(|p| f64::from(p[0]) + f64::from(p[1]) + f64::from(p[2])).sum::<f64>()
+        img.pixels()
+            .map(|p| f64::from(p[0]) + f64::from(p[1]) + f64::from(p[2]))
+            .sum::<f64>()
     };
     let analytic_scene = SCENE.replace(
         r#"{ type = "measured", path = "TABLE" }"#,
@@ -476,7 +546,15 @@ fn bad_tables_are_one_line_errors_naming_the_file() {
         vec!["eval", "-m", &m],
         vec!["estimate", "-m", &m, "-n", "16", "--quiet"],
         vec!["fit", &name],
-        vec!["tabulate", "-m", &m, "--format", "rgl", "--out", "/dev/null"],
+        vec![
+            "tabulate",
+            "-m",
+            &m,
+            "--format",
+            "rgl",
+            "--out",
+            "/dev/null",
+        ],
     ] {
         let o = lobe(&args, None, "{\"wo\":[0,0,1],\"wi\":[0,0,1]}\n");
         let e = one_line_error(&o);
