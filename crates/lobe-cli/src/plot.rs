@@ -176,7 +176,12 @@ pub fn run(args: &PlotArgs) -> Result<()> {
                 if let Some((other, what)) = comparison(args, &material)? {
                     let path = args.out.join("polar-fit.png");
                     let title = format!("{label} (black) against {what} (red): f·cos θi");
-                    fit_polar(&path, &title, &material, &other, scale)?;
+                    let legend = if args.fit.is_some() {
+                        ["data", "fit"]
+                    } else {
+                        ["--material", "--against"]
+                    };
+                    fit_polar(&path, &title, &material, &other, legend, scale)?;
                     println!("{}", path.display());
                 }
             }
@@ -378,12 +383,13 @@ fn comparison(args: &PlotArgs, data: &Material) -> Result<Option<(Material, Stri
 /// Four polar panels (θo = 0°, 30°, 60°, 75°): `lum(f·cos θi)` of `data`
 /// (black) and `other` (red) in the plane of incidence, `wi` at its angle
 /// from the normal (up), the view in blue; one radius scale per panel
-/// (linear, or `--scale log`: four decades).
+/// (linear, or `--scale log`: four decades); `legend` names the two curves.
 fn fit_polar(
     path: &Path,
     title: &str,
     data: &Material,
     other: &Material,
+    legend: [&str; 2],
     scale: figures::PolarScale,
 ) -> Result<()> {
     use plotters::prelude::*;
@@ -478,13 +484,13 @@ fn fit_polar(
             chart
                 .draw_series(LineSeries::new(to_xy(&d), BLACK.stroke_width(3)))
                 .map_err(|x| e(&x))?
-                .label("data")
+                .label(legend[0])
                 .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], BLACK.stroke_width(3)));
             let red = RGBColor(220, 50, 30);
             chart
                 .draw_series(LineSeries::new(to_xy(&f), red.stroke_width(2)))
                 .map_err(|x| e(&x))?
-                .label("fit")
+                .label(legend[1])
                 .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], red.stroke_width(2)));
             chart
                 .configure_series_labels()

@@ -256,9 +256,10 @@ fn sampled_pdf_is_the_pdf_of_the_pair() {
     }
 }
 
-/// The estimate of a measured material under constant light and a beam is
-/// unbiased (t-test within 4 standard errors of the quadrature reference),
-/// for every strategy.
+/// The estimate of a measured material (a MERL table, linear, and an RGL
+/// file) under constant light and a beam is unbiased (t-test within 4
+/// standard errors of the quadrature reference), for every strategy
+/// (uniform, cosine, brdf, and for the RGL file vndf).
 #[test]
 fn estimates_are_unbiased() {
     let lights = [
@@ -269,21 +270,29 @@ fn estimates_are_unbiased() {
             radiance: Rgb::splat(2.0),
         },
     ];
-    let m = merl_material(BECKMANN, "beckmann.binary", "linear");
+    let merl = merl_material(BECKMANN, "beckmann.binary", "linear");
     let mut failures = Vec::new();
     let mut seed = 0;
-    for theta in [0.0, 45.0, 75.0] {
-        let sp = ShadingPoint::local(wo(theta));
-        for light in &lights {
-            let r = luminance(reference(&m, &sp, light, 1e-6));
-            for s in m.strategies() {
-                seed += 1;
-                let acc = estimate(&m, &sp, light, &Plan::independent(s, 1 << 15, seed)).unwrap();
-                let (mean, se) = (acc.lum.mean(), acc.lum.std_error());
-                if (mean - r).abs() > 4.0 * se + 1e-5 * r {
-                    failures.push(format!(
-                        "θ={theta} {light:?} {s}: {mean} ± {se}, reference {r}"
-                    ));
+    // The RGL file at one view: its quadrature reference (a
+    // piecewise-bilinear table) costs ~10 s of CPU per view.
+    for (name, m, thetas) in [
+        ("merl", &merl, &[0.0, 45.0, 75.0][..]),
+        ("rgl", beckmann_rgl(), &[45.0][..]),
+    ] {
+        for &theta in thetas {
+            let sp = ShadingPoint::local(wo(theta));
+            for light in &lights {
+                let r = luminance(reference(m, &sp, light, 1e-6));
+                for s in m.strategies() {
+                    seed += 1;
+                    let acc =
+                        estimate(m, &sp, light, &Plan::independent(s, 1 << 15, seed)).unwrap();
+                    let (mean, se) = (acc.lum.mean(), acc.lum.std_error());
+                    if (mean - r).abs() > 4.0 * se + 1e-5 * r {
+                        failures.push(format!(
+                            "{name} θ={theta} {light:?} {s}: {mean} ± {se}, reference {r}"
+                        ));
+                    }
                 }
             }
         }
@@ -336,6 +345,12 @@ fn the_table_is_shared_and_only_the_listed_strategies_apply() {
         table, sampler, x.data.read_seconds, x.data.build_seconds
     );
     assert_eq!(table, 90 * 90 * 180 * 12);
+    // "Reading a 33 MB MERL file takes well under a second."
+    assert!(
+        x.data.read_seconds < 1.0,
+        "read in {} s",
+        x.data.read_seconds
+    );
 }
 
 #[test]
@@ -551,17 +566,28 @@ fn a_measured_material_names_its_file_in_errors() {
 }
 
 /// `lobe fit` recovers the parameters of a tabulated analytic material
-/// (GGX; about 5 s): alpha within 5%, kd and f0 within 0.02.
+/// (GGX and Beckmann, each with a Lambert term and missing entries): alpha
+/// within 5%, kd and f0 within 0.02.
 #[test]
 fn fit_recovers_a_tabulated_material() {
-    for (json, name, ndf, alpha, f0, kd) in [(
-        r#"{"type":"cook-torrance","distribution":"ggx","alpha":0.15,"kd":[0.1,0.2,0.05],"fresnel":{"type":"schlick","f0":[0.9,0.6,0.3]}}"#,
-        "fit-ggx.binary",
-        lobe::Ndf::Ggx,
-        0.15,
-        Rgb::new(0.9, 0.6, 0.3),
-        Rgb::new(0.1, 0.2, 0.05),
-    )] {
+    for (json, name, ndf, alpha, f0, kd) in [
+        (
+            r#"{"type":"cook-torrance","distribution":"ggx","alpha":0.15,"kd":[0.1,0.2,0.05],"fresnel":{"type":"schlick","f0":[0.9,0.6,0.3]}}"#,
+            "fit-ggx.binary",
+            lobe::Ndf::Ggx,
+            0.15,
+            Rgb::new(0.9, 0.6, 0.3),
+            Rgb::new(0.1, 0.2, 0.05),
+        ),
+        (
+            r#"{"type":"cook-torrance","distribution":"beckmann","alpha":0.3,"kd":[0.3,0.2,0.1],"fresnel":{"type":"schlick","f0":[0.5,0.4,0.6]}}"#,
+            "fit-beckmann.binary",
+            lobe::Ndf::Beckmann,
+            0.3,
+            Rgb::new(0.5, 0.4, 0.6),
+            Rgb::new(0.3, 0.2, 0.1),
+        ),
+    ] {
         let m = merl_material(json, name, "nearest");
         let t0 = std::time::Instant::now();
         let fit = lobe::fit::fit_cook_torrance(&m, ndf).unwrap();
@@ -739,4 +765,157 @@ fn fit_recovers_anisotropic_alphas() {
         iso.alpha_u,
         iso.alpha_v
     );
+}
+
+/// The fields of the small RGL file, in the writer's order, with `edit`
+/// applied to the list (to replace, drop or add fields).
+fn rgl_with(edit: impl FnOnce(&mut Vec<(&'static str, rgl::Field)>)) -> Vec<u8> {
+    let fields = rgl::parse_tensor(&small_rgl_bytes()).unwrap();
+    let mut list: Vec<(&'static str, rgl::Field)> = [
+        "description",
+        "jacobian",
+        "theta_i",
+        "phi_i",
+        "ndf",
+        "sigma",
+        "vndf",
+        "luminance",
+        "rgb",
+    ]
+    .into_iter()
+    .map(|n| (n, fields[n].clone()))
+    .collect();
+    edit(&mut list);
+    rgl::write_tensor(&list)
+}
+
+fn field_f32(f: &rgl::Field) -> Vec<f32> {
+    f.data
+        .chunks_exact(4)
+        .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+        .collect()
+}
+
+/// Pairs above the horizon at several views, off the tabulated ones.
+fn rgl_pairs() -> Vec<(DVec3, DVec3)> {
+    let mut v = Vec::new();
+    for (to, po) in [(5.0, 0.0), (25.0, 40.0), (50.0, 200.0), (70.0, 300.0)] {
+        for (ti, dp) in [(10.0, 180.0), (30.0, 150.0), (45.0, 200.0), (60.0, 90.0)] {
+            v.push((dir_of(to, po), dir_of(ti, po + dp)));
+        }
+    }
+    v
+}
+
+/// A spectral RGL file (`spectra` + `wavelengths` instead of `rgb`) is
+/// reduced to RGB when read: a flat spectrum of value `s` is RGB `(s, s,
+/// s)` (white balanced), so the file whose spectrum at every grid point is
+/// the RGB file's green channel reads as that green channel in all three;
+/// a spectrum that is zero below 600 nm reads as red.
+#[test]
+fn spectral_rgl_files_are_reduced_to_rgb() {
+    let plain = Table::parse(&small_rgl_bytes(), "rgb").unwrap();
+    let wavelengths: Vec<f32> = (0..48).map(|i| 360.0 + 10.0 * i as f32).collect();
+    let spectral = |spectrum: &dyn Fn(f32, f32) -> f32| {
+        rgl_with(|list| {
+            let rgb = list.pop().unwrap().1;
+            let (np, nt, n1, n2) = (rgb.shape[0], rgb.shape[1], rgb.shape[3], rgb.shape[4]);
+            let values = field_f32(&rgb);
+            let nl = wavelengths.len();
+            let mut out = vec![0f32; np * nt * nl * n1 * n2];
+            for slice in 0..np * nt {
+                for (l, &lambda) in wavelengths.iter().enumerate() {
+                    for k in 0..n1 * n2 {
+                        let green = values[(slice * 3 + 1) * n1 * n2 + k];
+                        out[(slice * nl + l) * n1 * n2 + k] = spectrum(lambda, green);
+                    }
+                }
+            }
+            list.push(("wavelengths", rgl::Field::f32(&[nl], &wavelengths)));
+            list.push(("spectra", rgl::Field::f32(&[np, nt, nl, n1, n2], &out)));
+        })
+    };
+    let flat = Table::parse(&spectral(&|_, g| g), "flat").unwrap();
+    let red = Table::parse(&spectral(&|l, g| if l >= 600.0 { g } else { 0.0 }), "red").unwrap();
+    let mut checked = 0;
+    for (o, i) in rgl_pairs() {
+        let want = plain.eval(o, i, merl::Interpolation::Nearest).y;
+        if want <= 1e-6 {
+            continue;
+        }
+        let got = flat.eval(o, i, merl::Interpolation::Nearest);
+        for c in 0..3 {
+            assert!(
+                (got[c] - want).abs() <= 1e-5 * want,
+                "channel {c}: {got} vs {want}"
+            );
+        }
+        let r = red.eval(o, i, merl::Interpolation::Nearest);
+        assert!(
+            r.x > 0.3 * want && r.y < 0.5 * r.x && r.z < 0.1 * r.x,
+            "{r} of {want}"
+        );
+        checked += 1;
+    }
+    assert!(checked >= 12, "{checked}");
+    // A spectral file with `spectra` missing names the field.
+    let e = parse_err(&rgl_with(|list| {
+        list.pop();
+        list.push(("wavelengths", rgl::Field::f32(&[2], &[500.0, 600.0])));
+    }));
+    assert!(e.contains("missing field `spectra`"), "{e}");
+}
+
+/// `jacobian = 1`: the file's value is multiplied by `ndf(u_m) / (4
+/// sigma(u_wo))`, `u = (√(θ/(π/2)), (φ + π)/(2π))` (with `φm` relative to
+/// `φo`), both tables bilinear over the unit square: here `ndf = 1 + 3 x`
+/// and `sigma = 2 + y`, so the ratio to the `jacobian = 0` file is known.
+#[test]
+fn rgl_jacobian_scales_by_ndf_over_sigma() {
+    let plain = Table::parse(&small_rgl_bytes(), "plain").unwrap();
+    let scaled = Table::parse(
+        &rgl_with(|list| {
+            for (name, f) in list.iter_mut() {
+                match *name {
+                    "jacobian" => *f = rgl::Field::u8(&[1]),
+                    "ndf" => *f = rgl::Field::f32(&[2, 2], &[1.0, 4.0, 1.0, 4.0]),
+                    "sigma" => *f = rgl::Field::f32(&[2, 2], &[2.0, 2.0, 3.0, 3.0]),
+                    _ => {}
+                }
+            }
+        }),
+        "jacobian",
+    )
+    .unwrap();
+    let mut checked = 0;
+    for (o, i) in rgl_pairs() {
+        let a = plain.eval(o, i, merl::Interpolation::Nearest);
+        if a.y <= 1e-6 {
+            continue;
+        }
+        let b = scaled.eval(o, i, merl::Interpolation::Nearest);
+        let m = (o + i).normalize();
+        let u_m = (m.z.acos() / std::f64::consts::FRAC_PI_2).sqrt();
+        let phi_o = o.y.atan2(o.x);
+        let v_o = (phi_o + std::f64::consts::PI) / std::f64::consts::TAU;
+        let want = (1.0 + 3.0 * u_m) / (4.0 * (2.0 + v_o));
+        let ratio = b.y / a.y;
+        assert!(
+            (ratio - want).abs() <= 2e-5 * want,
+            "wo {o} wi {i}: ratio {ratio} vs {want}"
+        );
+        checked += 1;
+    }
+    assert!(checked >= 12, "{checked}");
+    // With the Jacobian, a sigma ≤ 0 is refused.
+    let e = parse_err(&rgl_with(|list| {
+        for (name, f) in list.iter_mut() {
+            match *name {
+                "jacobian" => *f = rgl::Field::u8(&[1]),
+                "sigma" => *f = rgl::Field::f32(&[2, 2], &[1.0, 0.0, 1.0, 1.0]),
+                _ => {}
+            }
+        }
+    }));
+    assert!(e.contains("`sigma` has a value ≤ 0"), "{e}");
 }

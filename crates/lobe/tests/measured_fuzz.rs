@@ -4,15 +4,19 @@
 //! that is accepted must evaluate to finite, non-negative values without
 //! panicking. The corpus of past crashers in `tests/corpus/` is replayed.
 //!
-//! `cargo test -p lobe --test measured_fuzz` runs a short round (about 2 s);
+//! An accepted RGL file's own warps are drawn from and their pdf
+//! evaluated; every 100th accepted file (10th in the long run) also builds
+//! the tabulated sampler, which is drawn from and evaluated.
+//!
+//! `cargo test -p lobe --test measured_fuzz` runs a short round (a few s);
 //! the long run is `LOBE_FUZZ_SECONDS=600 cargo test -p lobe --release
 //! --test measured_fuzz -- --ignored --nocapture` (crashers are written to
 //! `target/fuzz-crashers/`).
 
-use glam::DVec3;
+use glam::{DVec2, DVec3};
 use lobe::models::measured::merl::Interpolation;
 use lobe::models::measured::rgl::Rgl;
-use lobe::models::measured::{Table, merl::Merl};
+use lobe::models::measured::{MeasuredData, Table, merl::Merl};
 use rand::{Rng, RngExt, SeedableRng};
 use rand_pcg::Pcg64;
 use std::panic::{AssertUnwindSafe, catch_unwind};
@@ -131,9 +135,10 @@ fn mutate(rng: &mut Pcg64, bytes: &mut Vec<u8>) {
     }
 }
 
-/// Parse, and when accepted evaluate at a few pairs: `Err` describes a
-/// panic or a bad value.
-fn check(bytes: &[u8], rng: &mut impl Rng) -> Result<bool, String> {
+/// Parse, and when accepted evaluate at a few pairs (and an RGL file's
+/// warps; with `build` also build the tabulated sampler and draw from it):
+/// `Err` describes a panic or a bad value.
+fn check(bytes: &[u8], rng: &mut impl Rng, build: bool) -> Result<bool, String> {
     let parsed = catch_unwind(AssertUnwindSafe(|| Table::parse(bytes, "fuzz")))
         .map_err(|_| "Table::parse panicked".to_string())?;
     let Ok(table) = parsed else { return Ok(false) };
@@ -149,26 +154,64 @@ fn check(bytes: &[u8], rng: &mut impl Rng) -> Result<bool, String> {
             (d(&mut r), d(&mut r))
         })
         .collect();
+    let us: Vec<DVec2> = (0..pairs.len())
+        .map(|_| DVec2::new(rng.random(), rng.random()))
+        .collect();
     catch_unwind(AssertUnwindSafe(|| {
-        for (wo, wi) in &pairs {
+        for ((wo, wi), u) in pairs.iter().zip(&us) {
             for interp in [Interpolation::Nearest, Interpolation::Linear] {
                 let f = table.eval(*wo, *wi, interp);
                 if !(f.is_finite() && f.min_element() >= 0.0) {
                     return Err(format!("eval({wo}, {wi}) = {f}"));
                 }
             }
+            // An RGL file's own warps (the `vndf` strategy).
+            if let Table::Rgl(r) = &table {
+                let p = r.pdf_warps(*wo, *wi);
+                if !(p.is_finite() && p >= 0.0) {
+                    return Err(format!("pdf_warps({wo}, {wi}) = {p}"));
+                }
+                if let Some(s) = r.sample_warps(*wo, *u) {
+                    if !(s.is_finite() && s.z > 0.0 && (s.length() - 1.0).abs() < 1e-9) {
+                        return Err(format!("sample_warps({wo}, {u}) = {s}"));
+                    }
+                }
+            }
         }
-        Ok(true)
+        Ok(())
     }))
-    .map_err(|_| "eval panicked".to_string())?
+    .map_err(|_| "eval or the RGL warps panicked".to_string())??;
+    if build {
+        // The tabulated sampler built from the table (`brdf`).
+        catch_unwind(AssertUnwindSafe(|| {
+            let data = MeasuredData::new("fuzz".into(), table, Interpolation::Nearest, 0.0);
+            for ((wo, wi), u) in pairs.iter().zip(&us) {
+                let p = data.sampler.pdf(*wo, *wi);
+                if !(p.is_finite() && p > 0.0) {
+                    return Err(format!("sampler pdf({wo}, {wi}) = {p}"));
+                }
+                if let Some(s) = data.sampler.sample(*wo, *u) {
+                    let p = data.sampler.pdf(*wo, s);
+                    if !(s.is_finite() && s.z > 0.0 && p.is_finite() && p > 0.0) {
+                        return Err(format!("sampler sample({wo}, {u}) = {s}, pdf {p}"));
+                    }
+                }
+            }
+            Ok(())
+        }))
+        .map_err(|_| "building or using the sampler panicked".to_string())??;
+    }
+    Ok(true)
 }
 
-/// Run mutations from the seeds until `deadline` or `iterations`; returns
-/// the number run and the crashers found.
+/// Run mutations from the seeds until `deadline` or `iterations` (every
+/// `build_every`-th accepted file also builds the tabulated sampler);
+/// returns the number run, the number accepted and the crashers found.
 fn fuzz(
     seed: u64,
     iterations: usize,
     deadline: Option<std::time::Instant>,
+    build_every: usize,
 ) -> (usize, usize, Vec<(String, Vec<u8>)>) {
     let mut rng = Pcg64::seed_from_u64(seed);
     let seeds = [seed_rgl(3, 6), seed_rgl(2, 2), seed_rgl(5, 9)];
@@ -186,7 +229,9 @@ fn fuzz(
         for _ in 0..rng.random_range(1..4) {
             mutate(&mut rng, &mut bytes);
         }
-        match check(&bytes, &mut rng) {
+        // Every `build_every`-th accepted file also builds its sampler.
+        let build = accepted % build_every == build_every - 1;
+        match check(&bytes, &mut rng, build) {
             Ok(ok) => accepted += usize::from(ok),
             Err(e) => crashers.push((e, bytes)),
         }
@@ -214,7 +259,7 @@ fn report(crashers: &[(String, Vec<u8>)]) {
 
 #[test]
 fn mutated_files_never_panic() {
-    let (n, accepted, crashers) = fuzz(1, 2000, None);
+    let (n, accepted, crashers) = fuzz(1, 2000, None, 100);
     assert_eq!(n, 2000);
     // The mutations must leave some files valid, so that eval is fuzzed too.
     assert!(accepted > 100, "{accepted} of {n} accepted");
@@ -235,7 +280,7 @@ fn fuzz_for_a_long_time() {
         .ok()
         .and_then(|s| s.parse().ok())
         .unwrap_or(2);
-    let (n, accepted, crashers) = fuzz(seed, usize::MAX, Some(deadline));
+    let (n, accepted, crashers) = fuzz(seed, usize::MAX, Some(deadline), 10);
     eprintln!(
         "fuzzed {n} files in {:.0} s (seed {seed}): {accepted} accepted and evaluated, {} crashers",
         t0.elapsed().as_secs_f64(),
@@ -254,7 +299,7 @@ fn corpus_replays_without_panics() {
     for entry in std::fs::read_dir(&dir).unwrap() {
         let path = entry.unwrap().path();
         let bytes = std::fs::read(&path).unwrap();
-        check(&bytes, &mut rng).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        check(&bytes, &mut rng, true).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
         n += 1;
     }
     assert!(n > 0, "empty corpus in {}", dir.display());
