@@ -54,7 +54,7 @@ pub fn run(args: &FitArgs) -> Result<()> {
         bail!("--model: only cook-torrance can be fitted");
     }
     let lobe = Measured::load(&args.file, None).context("FILE")?;
-    eprintln!("{}", table_summary(&lobe));
+    eprintln!("{}", lobe.summary());
     let m = lobe::Material::with_diffuse(lobe::Rgb::ZERO, lobe::Glossy::Measured(lobe))?;
     let ndf = if args.distribution == "beckmann" {
         Ndf::Beckmann
@@ -102,22 +102,6 @@ pub fn run(args: &FitArgs) -> Result<()> {
         eprintln!("wrote {}", path.display());
     }
     Ok(())
-}
-
-/// `read FILE: MERL table, 17.5 MB, read in 0.04 s; sampler 1.3 MB, built
-/// in 0.40 s` (the table's memory and its times, for stderr).
-pub fn table_summary(m: &Measured) -> String {
-    let (table, sampler) = m.memory();
-    let mb = |b: usize| b as f64 / 1e6;
-    format!(
-        "read {}: {} table, {:.1} MB, read in {:.2} s; sampler {:.1} MB, built in {:.2} s",
-        m.data.path.display(),
-        m.data.table.format(),
-        mb(table),
-        m.data.read_seconds,
-        mb(sampler),
-        m.data.build_seconds
-    )
 }
 
 /// A spinner on stderr while a fit runs (hidden when stderr is not a

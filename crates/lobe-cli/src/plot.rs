@@ -289,7 +289,7 @@ fn histogram(
     let cfg = Chi2Config {
         samples: args.samples,
         seed: args.seed,
-        ..Chi2Config::default()
+        ..Chi2Config::for_material(m)
     };
     let pb = progress(args.samples as u64, "chi-square test", args.quiet);
     let drawn = AtomicU64::new(0);

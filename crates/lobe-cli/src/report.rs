@@ -66,6 +66,12 @@ pub struct ReportArgs {
     /// Seed of every random sequence in the report
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
+    /// Report on this material instead of the lecture's models, as
+    /// `--material` of the other commands (JSON, TOML, @FILE, or
+    /// {"type": "measured", "path": ...}); repeat it for several, each gets
+    /// its own section
+    #[arg(long = "material", value_name = "M")]
+    pub materials: Vec<String>,
     /// No progress bar
     #[arg(long, short)]
     pub quiet: bool,
@@ -123,15 +129,17 @@ impl ReportSizes {
 /// The view angles of the tables, in degrees.
 const THETAS: [f64; 3] = [0.0, 45.0, 75.0];
 
-/// One reflection model and its parameter values.
+/// One section of the page: a reflection model of the lecture and its
+/// parameter values, or a material given with `--material`.
 struct Model {
     /// File-name stem and HTML anchor.
-    id: &'static str,
+    id: String,
     /// Section title.
-    title: &'static str,
-    /// The parameter's name in HTML (`n`, `α`).
+    title: String,
+    /// The parameter's name in HTML (`n`, `α`); empty for a given material.
     param: &'static str,
-    values: [f64; 3],
+    /// The parameter values (one, `0`, for a given material).
+    values: Vec<f64>,
     /// The configuration of the figures: index into `values`, and θo.
     figure_value: usize,
     figure_theta: f64,
@@ -140,79 +148,174 @@ struct Model {
     /// the projected hemisphere.
     warp_theta: f64,
     /// Extra strategies whose sampler is warp-tested (brdf always is).
-    warp_extra: &'static [BsdfStrategy],
+    warp_extra: Vec<BsdfStrategy>,
     /// Extra strategies whose weights are mapped (uniform and brdf always are).
-    heat_extra: &'static [BsdfStrategy],
-    /// The material description for a parameter value.
-    json: fn(f64) -> String,
+    heat_extra: Vec<BsdfStrategy>,
+    /// Where the materials come from.
+    source: Source,
     /// What the model is and how its brdf sampler works (HTML).
-    intro: &'static str,
+    intro: String,
+    /// Which notes of the figures apply: `phong`, `blinn-phong`, `ggx`,
+    /// `beckmann`, `measured` or `other`.
+    family: &'static str,
+}
+
+/// The materials of a section.
+enum Source {
+    /// The material description for a parameter value.
+    Lecture(fn(f64) -> String),
+    /// A material of `--material` (loaded once).
+    Given(Material),
 }
 
 fn models() -> Vec<Model> {
     vec![
         Model {
-            id: "phong",
-            title: "Phong",
+            id: "phong".into(),
+            title: "Phong".into(),
             param: "n",
-            values: [10.0, 100.0, 1000.0],
+            values: vec![10.0, 100.0, 1000.0],
             figure_value: 1,
             figure_theta: 45.0,
             warp_theta: 45.0,
-            warp_extra: &[],
-            heat_extra: &[],
-            json: |n| format!(r#"{{"type":"phong","exponent":{n}}}"#),
-            intro: PHONG_INTRO,
+            warp_extra: vec![],
+            heat_extra: vec![],
+            source: Source::Lecture(|n| format!(r#"{{"type":"phong","exponent":{n}}}"#)),
+            intro: PHONG_INTRO.into(),
+            family: "phong",
         },
         Model {
-            id: "blinn-phong",
-            title: "Blinn-Phong",
+            id: "blinn-phong".into(),
+            title: "Blinn-Phong".into(),
             param: "n",
-            values: [10.0, 100.0, 1000.0],
+            values: vec![10.0, 100.0, 1000.0],
             figure_value: 1,
             figure_theta: 45.0,
             warp_theta: 45.0,
-            warp_extra: &[],
-            heat_extra: &[],
-            json: |n| format!(r#"{{"type":"blinn-phong","exponent":{n}}}"#),
-            intro: BLINN_INTRO,
+            warp_extra: vec![],
+            heat_extra: vec![],
+            source: Source::Lecture(|n| format!(r#"{{"type":"blinn-phong","exponent":{n}}}"#)),
+            intro: BLINN_INTRO.into(),
+            family: "blinn-phong",
         },
         Model {
-            id: "ggx",
-            title: "Cook-Torrance with GGX",
+            id: "ggx".into(),
+            title: "Cook-Torrance with GGX".into(),
             param: "α",
-            values: [0.05, 0.2, 0.5],
+            values: vec![0.05, 0.2, 0.5],
             figure_value: 1,
             figure_theta: 75.0,
             warp_theta: 45.0,
-            warp_extra: &[BsdfStrategy::Vndf],
-            heat_extra: &[BsdfStrategy::Vndf],
-            json: |a| format!(r#"{{"type":"cook-torrance","distribution":"ggx","alpha":{a}}}"#),
-            intro: GGX_INTRO,
+            warp_extra: vec![BsdfStrategy::Vndf],
+            heat_extra: vec![BsdfStrategy::Vndf],
+            source: Source::Lecture(|a| {
+                format!(r#"{{"type":"cook-torrance","distribution":"ggx","alpha":{a}}}"#)
+            }),
+            intro: GGX_INTRO.into(),
+            family: "ggx",
         },
         Model {
-            id: "beckmann",
-            title: "Cook-Torrance with Beckmann",
+            id: "beckmann".into(),
+            title: "Cook-Torrance with Beckmann".into(),
             param: "α",
-            values: [0.05, 0.2, 0.5],
+            values: vec![0.05, 0.2, 0.5],
             figure_value: 1,
             figure_theta: 75.0,
             warp_theta: 45.0,
-            warp_extra: &[],
-            heat_extra: &[BsdfStrategy::Vndf],
-            json: |a| {
+            warp_extra: vec![],
+            heat_extra: vec![BsdfStrategy::Vndf],
+            source: Source::Lecture(|a| {
                 format!(r#"{{"type":"cook-torrance","distribution":"beckmann","alpha":{a}}}"#)
-            },
-            intro: BECKMANN_INTRO,
+            }),
+            intro: BECKMANN_INTRO.into(),
+            family: "beckmann",
         },
     ]
 }
 
+/// The sections of the materials given with `--material`, one each,
+/// every material loaded (and checked) before any work.
+fn given_models(specs: &[String]) -> Result<Vec<Model>> {
+    specs
+        .iter()
+        .enumerate()
+        .map(|(i, spec)| {
+            let m =
+                crate::common::load_material(spec).with_context(|| format!("--material {spec}"))?;
+            let has = |s| m.check(s).is_ok();
+            let vndf: Vec<BsdfStrategy> = [BsdfStrategy::Vndf]
+                .into_iter()
+                .filter(|&s| has(s))
+                .collect();
+            let name = m.model_name();
+            let label = match m.measured() {
+                Some(t) => format!(
+                    "{name} ({})",
+                    t.data.path.file_name().map_or_else(
+                        || t.data.path.display().to_string(),
+                        |f| f.to_string_lossy().into_owned()
+                    )
+                ),
+                None => name.to_string(),
+            };
+            let family = match (name, m.measured()) {
+                (_, Some(_)) => "measured",
+                ("phong", _) => "phong",
+                ("blinn-phong", _) => "blinn-phong",
+                ("cook-torrance", _) => "ggx",
+                _ => "other",
+            };
+            let mut intro = format!(
+                "<p>The material given with <code>--material {}</code>: <code>{}</code>, under the \
+                 same white furnace and at the same three views as the lecture's models. Its \
+                 strategies: {}.</p>\n",
+                esc(spec),
+                esc(name),
+                m.strategies()
+                    .iter()
+                    .map(|s| format!("<code>{s}</code>"))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            );
+            if let Some(t) = m.measured() {
+                let _ = writeln!(
+                    intro,
+                    "<p>A measured table ({}). Its <code>brdf</code> sampler draws from a \
+                     tabulated distribution built from the data (per bin of θ<sub>o</sub>, a \
+                     piecewise-constant density over the half vector weighted by luminance × \
+                     cos&thinsp;θ<sub>i</sub> × the half-vector Jacobian, mixed with a small share \
+                     of cosine sampling), with an exact pdf: the warp test below checks it.</p>",
+                    esc(&t.summary())
+                );
+            }
+            Ok(Model {
+                id: format!("material-{}", i + 1),
+                title: format!("Material {}: {}", i + 1, label),
+                param: "",
+                values: vec![0.0],
+                figure_value: 0,
+                figure_theta: if vndf.is_empty() { 45.0 } else { 75.0 },
+                warp_theta: 45.0,
+                warp_extra: vndf.clone(),
+                heat_extra: vndf,
+                source: Source::Given(m),
+                intro,
+                family,
+            })
+        })
+        .collect()
+}
+
 fn build(model: &Model, value: f64) -> Result<Material> {
-    let json = (model.json)(value);
-    MaterialDesc::from_json(&json)
-        .and_then(|d| d.build())
-        .map_err(|e| anyhow!("report material {json}: {e}"))
+    match &model.source {
+        Source::Lecture(json) => {
+            let json = json(value);
+            MaterialDesc::from_json(&json)
+                .and_then(|d| d.build())
+                .map_err(|e| anyhow!("report material {json}: {e}"))
+        }
+        Source::Given(m) => Ok(*m),
+    }
 }
 
 fn view(theta: f64) -> DVec3 {
@@ -280,7 +383,11 @@ pub fn run(args: &ReportArgs) -> Result<()> {
     let dir = &args.out;
     std::fs::create_dir_all(dir)
         .with_context(|| format!("--out: cannot create the directory {}", dir.display()))?;
-    let models = models();
+    let models = if args.materials.is_empty() {
+        models()
+    } else {
+        given_models(&args.materials)?
+    };
     let light = Light::Constant(Rgb::ONE);
 
     // Every material, built once (and checked before any work).
@@ -300,18 +407,18 @@ pub fn run(args: &ReportArgs) -> Result<()> {
         jobs.push(Job::Convergence(i));
         jobs.push(Job::Polar(i));
         jobs.push(Job::Warp(i, BsdfStrategy::Brdf));
-        for &s in model.warp_extra {
+        for &s in &model.warp_extra {
             jobs.push(Job::Warp(i, s));
         }
         for &s in [BsdfStrategy::Uniform, BsdfStrategy::Brdf]
             .iter()
-            .chain(model.heat_extra)
+            .chain(&model.heat_extra)
         {
             jobs.push(Job::Heat(i, s));
         }
         jobs.push(Job::Lost(i));
     }
-    let tables = models.len() * 3 * THETAS.len();
+    let tables: usize = models.iter().map(|m| m.values.len() * THETAS.len()).sum();
     let pb = progress((tables + jobs.len()) as u64, "report", args.quiet);
 
     // Phase 1: the tables, one at a time, so that the times are undisturbed.
@@ -434,10 +541,8 @@ fn run_job(
     let light = Light::Constant(Rgb::ONE);
     let caption = |model: &Model| {
         format!(
-            "{}, {} = {}, θo = {}°",
-            model.title,
-            strip_tags(model.param),
-            model.values[model.figure_value],
+            "{}, θo = {}°",
+            plain_point(model, model.values[model.figure_value]),
             model.figure_theta
         )
     };
@@ -507,7 +612,7 @@ fn run_job(
                 n_phi: st.chi2_nphi,
                 samples: st.warp_samples,
                 seed: wseed,
-                ..Chi2Config::default()
+                ..Chi2Config::for_material(m)
             };
             let chi2 = chi2_test(
                 &cfg,
@@ -517,10 +622,8 @@ fn run_job(
             let h = projected_histograms(m, s, wo, st.warp_samples, wseed, st.warp_res, &());
             let file = format!("{}-warp-{}.png", model.id, s.name());
             let title = format!(
-                "{}, {} = {}, θo = {}°: {} sampler",
-                model.title,
-                strip_tags(model.param),
-                model.values[k],
+                "{}, θo = {}°: {} sampler",
+                plain_point(model, model.values[k]),
                 model.warp_theta,
                 s.name()
             );
@@ -697,9 +800,22 @@ fn lum(c: [f64; 3]) -> f64 {
     luminance(Rgb::from_array(c))
 }
 
-/// The value of a parameter: `n = 100`, `α = 0.2`.
+/// The value of a parameter: `n = 100`, `α = 0.2` (HTML); a given
+/// material's name.
 fn param_value(model: &Model, v: f64) -> String {
-    format!("<i>{}</i>&nbsp;=&nbsp;{v}", model.param)
+    match &model.source {
+        Source::Lecture(_) => format!("<i>{}</i>&nbsp;=&nbsp;{v}", model.param),
+        Source::Given(..) => esc(&model.title),
+    }
+}
+
+/// The section's title and the parameter value, as plain text for figure
+/// titles: `Phong, n = 100`.
+fn plain_point(model: &Model, v: f64) -> String {
+    match &model.source {
+        Source::Lecture(_) => format!("{}, {} = {v}", model.title, strip_tags(model.param)),
+        Source::Given(..) => model.title.clone(),
+    }
 }
 
 fn strategy_cell(name: &str) -> String {
@@ -792,13 +908,18 @@ fn summary_table(h: &mut String, model: &Model, r: &ModelResult) {
         .first()
         .map(|p| p.table.strategies.iter().map(|r| r.name.clone()).collect())
         .unwrap_or_default();
+    let lecture = matches!(model.source, Source::Lecture(_));
     let _ = write!(
         h,
         "<p class=\"tcap\">Variance reduction against uniform sampling (uniform's variance \
          divided by each strategy's; higher is better, the best of each row in bold)</p>\
-         <table class=\"data summary\"><thead><tr><th><i>{}</i></th><th>θ<sub>o</sub></th>\
+         <table class=\"data summary\"><thead><tr>{}<th>θ<sub>o</sub></th>\
          <th>reference</th>",
-        model.param
+        if lecture {
+            format!("<th><i>{}</i></th>", model.param)
+        } else {
+            String::new()
+        }
     );
     for n in &names {
         let _ = write!(h, "<th><code>{}</code></th>", esc(n));
@@ -813,8 +934,12 @@ fn summary_table(h: &mut String, model: &Model, r: &ModelResult) {
             .fold(0.0, f64::max);
         let _ = write!(
             h,
-            "<tr><td>{}</td><td>{}°</td><td>{}</td>",
-            p.value,
+            "<tr>{}<td>{}°</td><td>{}</td>",
+            if lecture {
+                format!("<td>{}</td>", p.value)
+            } else {
+                String::new()
+            },
             p.theta,
             num(lum(p.table.reference))
         );
@@ -895,9 +1020,14 @@ fn findings(model: &Model, r: &ModelResult) -> String {
         };
         let _ = write!(
             out,
-            "The lecture's <code>brdf</code> sampler cuts the variance of uniform sampling {most} \
+            "The {} <code>brdf</code> sampler cuts the variance of uniform sampling {most} \
              at {}: the sharper the lobe, the more a blind (uniform) sampler misses it, and the \
              more importance sampling gains. ",
+            if matches!(model.source, Source::Lecture(_)) {
+                "lecture's"
+            } else {
+                "material's"
+            },
             at(hi.0)
         );
         if lo.1 >= 1.0 {
@@ -919,6 +1049,7 @@ fn findings(model: &Model, r: &ModelResult) -> String {
     }
     // VNDF against brdf at the most grazing view.
     let theta = THETAS[THETAS.len() - 1];
+    let mut all_better = true;
     let vs: Vec<String> = model
         .values
         .iter()
@@ -926,22 +1057,42 @@ fn findings(model: &Model, r: &ModelResult) -> String {
             let p = find_point(r, v, theta)?;
             let b = variance_of(p, "brdf")?;
             let n = variance_of(p, "vndf")?;
+            all_better &= b > n;
             let lost = lost_of(p, "brdf").unwrap_or(f64::NAN);
+            let name = if matches!(model.source, Source::Lecture(_)) {
+                format!("{}: ", param_value(model, v))
+            } else {
+                String::new()
+            };
             Some(format!(
-                "{}: {} (<code>brdf</code> loses {} of its samples below the horizon)",
-                param_value(model, v),
+                "{name}{} (<code>brdf</code> loses {} of its samples below the horizon)",
                 if n > 0.0 { factor(b / n) } else { "∞".into() },
                 percent(lost)
             ))
         })
         .collect();
     if !vs.is_empty() {
-        let _ = write!(
-            out,
-            "At the grazing view θ<sub>o</sub>&nbsp;=&nbsp;{theta}°, VNDF sampling has less \
-             variance than <code>brdf</code> (D·cos) sampling by {}.",
-            vs.join("; ")
-        );
+        // A measured table's brdf sampler follows the data, not D·cos.
+        let brdf = if model.family == "measured" {
+            "<code>brdf</code> (tabulated)"
+        } else {
+            "<code>brdf</code> (D·cos)"
+        };
+        if all_better {
+            let _ = write!(
+                out,
+                "At the grazing view θ<sub>o</sub>&nbsp;=&nbsp;{theta}°, VNDF sampling has less \
+                 variance than {brdf} sampling by {}.",
+                vs.join("; ")
+            );
+        } else {
+            let _ = write!(
+                out,
+                "At the grazing view θ<sub>o</sub>&nbsp;=&nbsp;{theta}°, VNDF sampling does not \
+                 always beat {brdf} sampling here: the variance of {brdf} over VNDF's is {}.",
+                vs.join("; ")
+            );
+        }
     }
     out
 }
@@ -956,19 +1107,19 @@ fn slope_text(c: &Curve) -> String {
 fn section(h: &mut String, model: &Model, r: &ModelResult, st: &ReportSizes) {
     let fig_value = model.values[model.figure_value];
     let _ = writeln!(h, "<section id=\"{}\"><h2>{}</h2>", model.id, model.title);
-    h.push_str(model.intro);
+    h.push_str(&model.intro);
     let _ = writeln!(h, "<p class=\"finding\">{}</p>", findings(model, r));
 
     let _ = writeln!(
         h,
         "<h3>Strategies compared</h3>\
-         <p>Every strategy at three {} and three view angles, with {} samples each. The best \
+         <p>Every strategy at {} view angles, with {} samples each. The best \
          strategy of each row is in bold. The full tables, with estimates, errors, lost samples, \
          times and efficiencies, follow.</p>",
-        if model.param == "n" {
-            "exponents"
-        } else {
-            "roughnesses"
+        match (&model.source, model.param) {
+            (Source::Given(..), _) => "three",
+            (_, "n") => "three exponents and three",
+            _ => "three roughnesses and three",
         },
         st.samples
     );
@@ -981,7 +1132,11 @@ fn section(h: &mut String, model: &Model, r: &ModelResult, st: &ReportSizes) {
         );
         point_table(h, model, p);
     }
-    h.push_str("<details><summary>All nine shading points in full</summary>\n");
+    let _ = writeln!(
+        h,
+        "<details><summary>All {} shading points in full</summary>",
+        r.points.len()
+    );
     for p in &r.points {
         point_table(h, model, p);
     }
@@ -1116,7 +1271,7 @@ fn lost_note(w: &Warp) -> String {
 }
 
 fn warp_note(model: &Model, s: BsdfStrategy) -> &'static str {
-    match (model.id, s) {
+    match (model.family, s) {
         ("blinn-phong", BsdfStrategy::Brdf) => {
             " This sampler draws the half vector h, not ω<sub>i</sub>; its pdf includes the \
              Jacobian 1/(4&thinsp;ω<sub>o</sub>·h) of the reflection. Without it the right map \
@@ -1131,7 +1286,14 @@ fn warp_note(model: &Model, s: BsdfStrategy) -> &'static str {
 }
 
 fn heat_note(model: &Model) -> &'static str {
-    match model.id {
+    match model.family {
+        "measured" => {
+            " For a measured table the <code>brdf</code> sampler follows the tabulated data \
+             (luminance × cos&thinsp;θ<sub>i</sub>), so its weight is nearly flat where the \
+             data are smooth, and stays bounded where the cosine share of the mixture covers \
+             what the table misses."
+        }
+        "other" => "",
         "phong" => {
             " For Phong the <code>brdf</code> weight is k<sub>s</sub>(n+2)/(n+1)·cos&thinsp;θ<sub>i</sub>: \
              it varies only with cos&thinsp;θ<sub>i</sub> across the lobe."
@@ -1169,10 +1331,20 @@ fn page(
     );
     h.push_str(CSS);
     h.push_str("</style>\n</head>\n<body>\n<main>\n");
-    h.push_str(
+    let _ = writeln!(
+        h,
         "<header><h1>Importance sampling in BRDF evaluation</h1>\
-         <p class=\"sub\">Phong, Blinn-Phong and Cook-Torrance (GGX and Beckmann): how the choice of \
-         sampling density changes the noise of a Monte Carlo estimate.</p></header>\n",
+         <p class=\"sub\">{}: how the choice of sampling density changes the noise of a Monte \
+         Carlo estimate.</p></header>",
+        if args.materials.is_empty() {
+            "Phong, Blinn-Phong and Cook-Torrance (GGX and Beckmann)".to_string()
+        } else {
+            models
+                .iter()
+                .map(|m| esc(&m.title))
+                .collect::<Vec<_>>()
+                .join("; ")
+        }
     );
     h.push_str("<nav><b>Contents:</b> <a href=\"#background\">Background</a>");
     for m in models {
@@ -1185,14 +1357,18 @@ fn page(
     }
     let _ = writeln!(
         h,
-        "<section id=\"about\"><h2>About this page</h2><p>Generated by <code>lobe report{}{}</code> \
+        "<section id=\"about\"><h2>About this page</h2><p>Generated by <code>lobe report{}{}{}</code> \
          in {elapsed:.1}&nbsp;s. Tables: {} samples per estimate (independent samples, seed {}). \
          Convergence: {} runs per N, N up to 2<sup>{}</sup>; each estimate uses its own sequence of \
          exactly N samples. Warp tests: {} samples, chi-square over {}×{} bins of the sphere. \
-         References: deterministic adaptive quadrature (relative tolerance 10<sup>−9</sup>). \
+         References: {}. \
          Times are wall-clock on every thread of this machine and vary from run to run; all other \
          numbers depend only on the seed. {}</p>",
         if args.quick { " --quick" } else { "" },
+        args.materials
+            .iter()
+            .map(|m| format!(" --material {}", esc(&shell_quote(m))))
+            .collect::<String>(),
         if args.seed != 1 {
             format!(" --seed {}", args.seed)
         } else {
@@ -1200,6 +1376,7 @@ fn page(
         },
         st.samples,
         args.seed,
+        reference_methods(results),
         st.runs,
         st.max_exp,
         st.warp_samples,
@@ -1220,6 +1397,29 @@ fn page(
     h.push_str(IMAGE_CHECK);
     h.push_str("</script>\n</body>\n</html>\n");
     h
+}
+
+/// The distinct ways the tables' references were computed, joined.
+fn reference_methods(results: &[ModelResult]) -> String {
+    let mut v: Vec<&str> = Vec::new();
+    for p in results.iter().flat_map(|r| &r.points) {
+        if !v.contains(&p.table.reference_method) {
+            v.push(p.table.reference_method);
+        }
+    }
+    esc(&v.join("; "))
+}
+
+/// `s` as a shell word: bare when it is plain, else in single quotes.
+fn shell_quote(s: &str) -> String {
+    if !s.is_empty()
+        && s.chars()
+            .all(|c| c.is_ascii_alphanumeric() || "@%+=:,./_-".contains(c))
+    {
+        s.to_string()
+    } else {
+        format!("'{}'", s.replace('\'', r"'\''"))
+    }
 }
 
 /// Writes `ok N/N images loaded`, or the images that did not load, into

@@ -24,43 +24,22 @@ fn dir(name: &str) -> PathBuf {
     d
 }
 
-const SCENE: &str = r#"[camera]
-origin = [0, 1, 4]
-target = [0, 1, 0]
-up = [0, 1, 0]
-fov_y = 40
-width = 20
-height = 14
-
-[environment]
-path = "sky"
-scale = 1.0
-rotation_y = 0.0
-
-[[object]]
-type = "sphere"
-center = [0, 1, 0]
-radius = 1
-material = { type = "cook-torrance", distribution = "ggx", alpha = 0.3 }
-
-[[object]]
-type = "plane"
-point = [0, 0, 0]
-normal = [0, 1, 0]
-material = { type = "phong", exponent = 20, kd = 0.4, ks = 0.3 }
-
-[render]
-spp = 64
-strategy = "mis"
-seed = 1
-max_depth = 1
-"#;
+/// A glossy sphere on a Phong plane.
+fn test_scene() -> String {
+    common::sphere_scene(
+        20,
+        14,
+        r#"{ type = "cook-torrance", distribution = "ggx", alpha = 0.3 }"#,
+        r#"{ type = "phong", exponent = 20, kd = 0.4, ks = 0.3 }"#,
+        64,
+    )
+}
 
 #[test]
 fn writes_exr_and_png() {
     let d = dir("out");
     let scene = d.join("scene.toml");
-    std::fs::write(&scene, SCENE).unwrap();
+    std::fs::write(&scene, test_scene()).unwrap();
     let out = d.join("img");
     let o = lobe(
         &[
@@ -129,7 +108,11 @@ fn writes_exr_and_png() {
 fn threads_do_not_change_the_image() {
     let d = dir("threads");
     let scene = d.join("s.toml");
-    std::fs::write(&scene, SCENE.replace("max_depth = 1", "max_depth = 4")).unwrap();
+    std::fs::write(
+        &scene,
+        test_scene().replace("max_depth = 1", "max_depth = 4"),
+    )
+    .unwrap();
     let mut files = Vec::new();
     for t in ["1", "2"] {
         let out = d.join(format!("t{t}"));
@@ -171,7 +154,7 @@ fn errors_are_one_line_and_name_file_line_and_field() {
             None,
         ))
     };
-    let e = run(&SCENE.replace("radius = 1", "radius = \"a\""));
+    let e = run(&test_scene().replace("radius = 1", "radius = \"a\""));
     assert!(
         e.contains(&format!(
             "{}:17:10: field object[0].radius: invalid type: string \"a\", expected f64",
@@ -179,19 +162,19 @@ fn errors_are_one_line_and_name_file_line_and_field() {
         )),
         "{e}"
     );
-    let e = run(&SCENE.replace("alpha = 0.3", "alpha = 7"));
+    let e = run(&test_scene().replace("alpha = 0.3", "alpha = 7"));
     assert!(
         e.contains("scene.toml:18:") && e.contains("field object[0].material.alpha: "),
         "{e}"
     );
-    let e = run(&SCENE.replace("fov_y = 40", "fov_y = 0"));
+    let e = run(&test_scene().replace("fov_y = 40", "fov_y = 0"));
     assert!(e.contains("scene.toml:5:9: field camera.fov_y: "), "{e}");
-    let e = run(&SCENE.replace("\"sky\"", "\"forest.hdr\""));
+    let e = run(&test_scene().replace("\"sky\"", "\"forest.hdr\""));
     assert!(
         e.contains(&d.join("forest.hdr").display().to_string()),
         "{e}"
     );
-    let e = run(&SCENE.replace(
+    let e = run(&test_scene().replace(
         "type = \"plane\"\npoint = [0, 0, 0]\nnormal = [0, 1, 0]",
         "type = \"mesh\"\npath = \"meshes/bunny.obj\"",
     ));
@@ -203,7 +186,7 @@ fn errors_are_one_line_and_name_file_line_and_field() {
     let e = run("[camera\n");
     assert!(e.contains("scene.toml:1:"), "{e}");
 
-    std::fs::write(&scene, SCENE).unwrap();
+    std::fs::write(&scene, test_scene()).unwrap();
     let e = one_line_error(&lobe(
         &["render", scene.to_str().unwrap(), "--strategy", "fast"],
         None,
@@ -229,7 +212,7 @@ fn errors_are_one_line_and_name_file_line_and_field() {
 fn huge_spp_is_accepted_or_refused_clearly() {
     let d = dir("huge-spp");
     let scene = d.join("scene.toml");
-    std::fs::write(&scene, SCENE).unwrap();
+    std::fs::write(&scene, test_scene()).unwrap();
     let s = scene.to_str().unwrap();
     let e = one_line_error(&lobe(&["render", s, "--spp", "18446744073709551615"], None));
     assert!(

@@ -809,9 +809,35 @@ pub fn estimate_chunk(
     acc
 }
 
+/// The finest relative tolerance a quadrature reference over a measured
+/// table is asked for. A table's values are piecewise constant (MERL's
+/// nearest entry) or piecewise smooth between its nodes, so adaptive
+/// quadrature converges slowly on it and cannot reach `1e-9` within any
+/// budget; `1e-6` is still far below the standard error of any estimate
+/// it is compared with.
+pub const TABLE_REFERENCE_TOLERANCE: f64 = 1e-6;
+
+/// The evaluation budget of a quadrature reference over a measured table,
+/// per channel (the analytic models keep [`Tolerance`]'s default).
+pub const TABLE_REFERENCE_MAX_EVALS: usize = 2_000_000;
+
+/// The tolerance of [`reference`] for `m` when `rel` is asked for: `rel`
+/// itself for an analytic model; for a measured table at most
+/// [`TABLE_REFERENCE_TOLERANCE`], within [`TABLE_REFERENCE_MAX_EVALS`].
+#[must_use]
+pub fn reference_tolerance(m: &Material, rel: f64) -> Tolerance {
+    if m.measured().is_some() {
+        Tolerance::relative(rel.max(TABLE_REFERENCE_TOLERANCE))
+            .with_max_evals(TABLE_REFERENCE_MAX_EVALS)
+    } else {
+        Tolerance::relative(rel)
+    }
+}
+
 /// The reflected radiance by deterministic quadrature (f64), per channel.
 /// For an analytic light: adaptive Gauss–Kronrod over the hemisphere to
-/// `rel` relative accuracy. For an environment map: a sum over the map's
+/// `rel` relative accuracy ([`reference_tolerance`]: a measured table gets
+/// at most `1e-6`). For an environment map: a sum over the map's
 /// texels of the texel's radiance times `∫ f cos dω` over the texel
 /// ([`reference_env_row`]).
 #[must_use]
@@ -827,7 +853,7 @@ pub fn reference(m: &Material, sp: &ShadingPoint, light: &Light, rel: f64) -> Rg
     let channel = |c: usize| {
         integrate_hemisphere(
             |wi| (m.eval(wo, wi) * light.radiance(sp.frame.to_world(wi)))[c] * wi.z,
-            Tolerance::relative(rel),
+            reference_tolerance(m, rel),
         )
         .value
     };

@@ -52,6 +52,15 @@ impl Material {
             .map_err(|e| Error::Parse(format!("{origin}: {e}")))
     }
 
+    /// The measured table of this material, if its glossy lobe is one.
+    #[must_use]
+    pub fn measured(&self) -> Option<&crate::models::measured::Measured> {
+        match &self.glossy {
+            Glossy::Measured(t) => Some(t),
+            _ => None,
+        }
+    }
+
     /// A short name of the model, for tables.
     #[must_use]
     pub fn model_name(&self) -> &'static str {

@@ -278,6 +278,24 @@ impl Measured {
     pub fn memory(&self) -> (usize, usize) {
         (self.data.table.memory(), self.data.sampler.memory())
     }
+
+    /// One line on the table: its file, format, memory, and the times to
+    /// read it and to build its sampler (`read gold.bsdf: RGL table, 1.2 MB,
+    /// read in 0.01 s; sampler 1.3 MB, built in 0.40 s`).
+    #[must_use]
+    pub fn summary(&self) -> String {
+        let (table, sampler) = self.memory();
+        let mb = |b: usize| b as f64 / 1e6;
+        format!(
+            "read {}: {} table, {:.1} MB, read in {:.2} s; sampler {:.1} MB, built in {:.2} s",
+            self.data.path.display(),
+            self.data.table.format(),
+            mb(table),
+            self.data.read_seconds,
+            mb(sampler),
+            self.data.build_seconds
+        )
+    }
 }
 
 impl Bxdf for Measured {
