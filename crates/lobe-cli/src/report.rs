@@ -50,6 +50,9 @@ use std::time::Instant;
                   convergence plot, a polar plot of the integrand and the sampling densities, the warp \
                   test of the brdf sampler (and of VNDF for GGX) with its chi-square p-value, and maps \
                   of the sample weights, each with a short explanation.\n\n\
+                  With --material M (repeatable; JSON, TOML, @FILE or a measured table, as the other \
+                  commands take it) the page is about the given materials instead: one section each, \
+                  with the same tables and figures at the same three views.\n\n\
                   The default settings take some seconds to a minute on two cores; --quick takes fewer \
                   samples (for checking the page, not the numbers).",
     after_help = "Examples:\n  \
