@@ -245,11 +245,11 @@ fn given_models(specs: &[String]) -> Result<Vec<Model>> {
         .map(|(i, spec)| {
             let m =
                 crate::common::load_material(spec).with_context(|| format!("--material {spec}"))?;
-            let has = |s| m.check(s).is_ok();
-            let vndf: Vec<BsdfStrategy> = [BsdfStrategy::Vndf]
-                .into_iter()
-                .filter(|&s| has(s))
-                .collect();
+            let vndf = if m.check(BsdfStrategy::Vndf).is_ok() {
+                vec![BsdfStrategy::Vndf]
+            } else {
+                vec![]
+            };
             let name = m.model_name();
             let label = match m.measured() {
                 Some(t) => format!(
