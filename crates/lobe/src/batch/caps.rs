@@ -147,7 +147,7 @@ pub(super) fn sample<L: Lanes, const STRAT: u8>(
     uc: L::F,
 ) -> Sampled<L> {
     let m = cap_normal::<L, STRAT>(l, p, wo, u1, u2);
-    let r = reflect_or_diffuse(l, p, wo, m, u1, u2, uc);
+    let r = reflect_or_diffuse(l, p, wo, m, l.splat(1.0), u1, u2, uc);
     if p.two_lobes {
         let e = eval_h_caps::<L, STRAT>(l, p, wo, r.wi, r.h, r.hh, r.oh, r.ih);
         return finish(l, r.valid, r.wi, e.f, e.pdf, e.weight);

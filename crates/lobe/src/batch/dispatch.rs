@@ -14,10 +14,11 @@ use super::kernel::{
 };
 #[cfg(target_arch = "x86_64")]
 use super::lanes::{Avx2, Avx512};
-use super::lanes::{Lanes, Scalar};
+use super::lanes::{Lanes, Scalar, X2};
 
-/// The widest level's lane count: the size of the tail buffers.
-const MAX_LANES: usize = 16;
+/// The widest lane count (two AVX-512 vectors, [`X2`]): the size of the
+/// tail buffers.
+const MAX_LANES: usize = 32;
 
 /// What a [`super::BatchSampler`] runs: the model's parameters and the
 /// instance of its kernel, chosen once in `BatchSampler::new`.
@@ -393,17 +394,90 @@ macro_rules! instances {
 }
 
 #[inline(always)]
-fn sample_level<L: Lanes>(l: L, k: &Kernel, inp: SampleIn<'_>, out: SampleOut<'_, '_>) {
+pub(super) fn sample_level<L: Lanes>(l: L, k: &Kernel, inp: SampleIn<'_>, out: SampleOut<'_, '_>) {
     instances!(k, sample_block, l, inp, out,)
 }
 
 #[inline(always)]
-fn eval_pdf_level<L: Lanes>(l: L, k: &Kernel, mode: u8, inp: EvalIn<'_>, out: EvalOut<'_, '_>) {
+pub(super) fn eval_pdf_level<L: Lanes>(
+    l: L,
+    k: &Kernel,
+    mode: u8,
+    inp: EvalIn<'_>,
+    out: EvalOut<'_, '_>,
+) {
     match mode {
         F_ONLY => instances!(k, eval_pdf_block, l, inp, out, , F_ONLY),
         PDF_ONLY => instances!(k, eval_pdf_block, l, inp, out, , PDF_ONLY),
         _ => instances!(k, eval_pdf_block, l, inp, out, , BOTH),
     }
+}
+
+/// Whether the AVX-512 level runs `k`'s `sample` (`eval = false`) or
+/// `eval_pdf` two vectors at a time ([`X2`]): the visible-normal samplers
+/// (GGX and Beckmann), whose long dependency chains (square root, division,
+/// reflection, square root, division; Beckmann's Newton steps) leave the
+/// pipelines idle one vector at a time, and Beckmann's evaluation. Where
+/// the chains are short (GGX brdf, GGX eval_pdf) two vectors only add
+/// register spills and run slower. Measured by `lobe bench` on Zen 4
+/// (BENCHMARKS.md).
+pub(super) fn runs_x2(k: &Kernel, eval: bool) -> bool {
+    matches!(
+        k,
+        Kernel::CookTorrance { ndf, strat: VNDF, .. } if *ndf == BECKMANN || (*ndf == GGX && !eval)
+    )
+}
+
+/// The [`runs_x2`] instances, two vectors of `L` at a time.
+#[inline(always)]
+pub(super) fn sample_x2<L: Lanes>(l: X2<L>, k: &Kernel, inp: SampleIn<'_>, out: SampleOut<'_, '_>) {
+    let Kernel::CookTorrance { ndf, strat, p } = k else {
+        unreachable!("runs_x2 admits only Cook-Torrance")
+    };
+    match (*ndf, *strat) {
+        (GGX, VNDF) => sample_block::<X2<L>, GGX, VNDF>(l, p, inp, out),
+        (BECKMANN, VNDF) => sample_block::<X2<L>, BECKMANN, VNDF>(l, p, inp, out),
+        _ => unreachable!("runs_x2 admits only these"),
+    }
+}
+
+/// As [`sample_x2`], for `eval_pdf`.
+#[inline(always)]
+pub(super) fn eval_pdf_x2<L: Lanes>(
+    l: X2<L>,
+    k: &Kernel,
+    mode: u8,
+    inp: EvalIn<'_>,
+    out: EvalOut<'_, '_>,
+) {
+    let Kernel::CookTorrance { ndf, strat, p } = k else {
+        unreachable!("runs_x2 admits only Cook-Torrance")
+    };
+    macro_rules! by_mode {
+        ($ndf:ident, $strat:ident) => {
+            match mode {
+                F_ONLY => eval_pdf_block::<X2<L>, $ndf, $strat, F_ONLY>(l, p, inp, out),
+                PDF_ONLY => eval_pdf_block::<X2<L>, $ndf, $strat, PDF_ONLY>(l, p, inp, out),
+                _ => eval_pdf_block::<X2<L>, $ndf, $strat, BOTH>(l, p, inp, out),
+            }
+        };
+    }
+    match (*ndf, *strat) {
+        (BECKMANN, VNDF) => by_mode!(BECKMANN, VNDF),
+        _ => unreachable!("runs_x2 admits only these"),
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f,avx512dq,avx512bw,avx512vl,avx2,fma")]
+fn sample_avx512_x2(l: Avx512, k: &Kernel, inp: SampleIn<'_>, out: SampleOut<'_, '_>) {
+    sample_x2(X2(l), k, inp, out);
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f,avx512dq,avx512bw,avx512vl,avx2,fma")]
+fn eval_pdf_avx512_x2(l: Avx512, k: &Kernel, mode: u8, inp: EvalIn<'_>, out: EvalOut<'_, '_>) {
+    eval_pdf_x2(X2(l), k, mode, inp, out);
 }
 
 #[cfg(target_arch = "x86_64")]
@@ -443,6 +517,9 @@ pub(crate) fn sample(b: Backend, k: &Kernel, inp: SampleIn<'_>, out: SampleOut<'
         // SAFETY: an `Avx512` token exists only if the CPU has AVX-512F/DQ/BW/VL and FMA
         // (AVX2 is implied by AVX-512F).
         #[cfg(target_arch = "x86_64")]
+        Backend::Avx512(l) if runs_x2(k, false) => unsafe { sample_avx512_x2(l, k, inp, out) },
+        // SAFETY: as above.
+        #[cfg(target_arch = "x86_64")]
         Backend::Avx512(l) => unsafe { sample_avx512(l, k, inp, out) },
     }
 }
@@ -459,6 +536,11 @@ pub(crate) fn eval_pdf(b: Backend, k: &Kernel, mode: u8, inp: EvalIn<'_>, out: E
         #[cfg(target_arch = "x86_64")]
         Backend::Avx2(l) => unsafe { eval_pdf_avx2(l, k, mode, inp, out) },
         // SAFETY: an `Avx512` token exists only if the CPU has AVX-512F/DQ/BW/VL and FMA.
+        #[cfg(target_arch = "x86_64")]
+        Backend::Avx512(l) if runs_x2(k, true) => unsafe {
+            eval_pdf_avx512_x2(l, k, mode, inp, out)
+        },
+        // SAFETY: as above.
         #[cfg(target_arch = "x86_64")]
         Backend::Avx512(l) => unsafe { eval_pdf_avx512(l, k, mode, inp, out) },
     }

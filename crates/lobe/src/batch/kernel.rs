@@ -6,7 +6,7 @@
 //!
 //! The algebra is the scalar path's, rearranged for f32. With
 //! `Lo = ‖(αx wo.x, αy wo.y, wo.z)‖`, `Li` the same for `wi`, and `h = wo + wi`
-//! unnormalized (or the drawn unit normal):
+//! unnormalized (or the drawn normal, of any length):
 //! * GGX `D(h) = 1/(π αx αy) · (|h|² / s)²`, `s = (hx/αx)² + (hy/αy)² + hz²`;
 //!   Beckmann `D(h) = 1/(π αx αy) · e^(−t) (|h|²/hz²)²`,
 //!   `t = ((hx/αx)² + (hy/αy)²)/hz²` (both scale-invariant in `h`);
@@ -27,8 +27,9 @@
 //! is a function of its own, compiled without the level's features).
 //!
 //! `sample` evaluates `f`, `pdf` and `weight` with the microfacet normal it
-//! drew as the half vector (`|h| = 1`, `wo·h = wi·h = wo·m`), as the scalar
-//! path does; `eval_pdf`, and `sample` for uniform and cosine, with
+//! drew as the half vector (`wo·h = wi·h = wo·m`), as the scalar path does,
+//! left unnormalized where the formulas are scale-invariant in `h` (GGX's
+//! visible and `D cos` normals: no square root and division for the length); `eval_pdf`, and `sample` for uniform and cosine, with
 //! `h = wo + wi`.
 
 use super::lanes::Lanes;
@@ -213,6 +214,19 @@ fn ks_fresnel<L: Lanes>(l: L, f: &FresnelP, c: L::F) -> V3<L> {
     }
 }
 
+/// `ks F(cos θ)` per channel at `cos θ = wo·h/|h|` (`oh`, `hh = |h|²`);
+/// without the square root and division where `F` is a constant (Schlick
+/// with `F0 = 1`, Fresnel `none`).
+#[inline(always)]
+fn ks_fresnel_h<L: Lanes>(l: L, f: &FresnelP, oh: L::F, hh: L::F) -> V3<L> {
+    match *f {
+        FresnelP::Schlick { ks_f0, ks_1mf0 } if ks_1mf0 == [0.0; 3] => {
+            [l.splat(ks_f0[0]), l.splat(ks_f0[1]), l.splat(ks_f0[2])]
+        }
+        _ => ks_fresnel(l, f, l.min(oh / l.sqrt(hh), l.splat(1.0))),
+    }
+}
+
 /// Unpolarized dielectric reflectance, `c ∈ [0, 1]` (1 under total
 /// internal reflection), as `crate::fresnel::fr_dielectric`.
 #[inline(always)]
@@ -366,7 +380,7 @@ fn glossy_probability<L: Lanes>(l: L, p: &CtParams, wo: V3<L>) -> L::F {
 
 /// `f`, `pdf`, `weight` given a half vector `h` of any length (`hh = |h|²`,
 /// `oh = wo·h`, `ih = wi·h`, read by the V-cavity term only). The sampler
-/// passes the unit normal it drew: where `wi` is nearly `−wo` (grazing
+/// passes the normal it drew: where `wi` is nearly `−wo` (grazing
 /// retro-reflection) `wo + wi` in f32 is mostly the rounding of `wi`, and
 /// the drawn normal is the accurate half vector.
 #[inline(always)]
@@ -384,14 +398,53 @@ fn eval_at<L: Lanes, const NDF: u8, const STRAT: u8>(
     let zero = l.splat(0.0);
     let one = l.splat(1.0);
     let ok = l.gt(wo[2], zero) & l.gt(wi[2], zero) & l.gt(oh, zero);
-    let cos_oh = l.min(oh / l.sqrt(hh), one);
-    // D, scale-invariant in h.
+    // D, scale-invariant in h: GGX's s = sxy + hz² (its division below).
     let sx = h[0] * l.splat(p.inv_ax);
     let sy = h[1] * l.splat(p.inv_ay);
     let sxy = l.mul_add(sx, sx, sy * sy);
     let hz2 = h[2] * h[2];
+    let s = sxy + hz2;
+    if NDF == GGX && p.shadow == Shadow::Correlated && (STRAT == VNDF || STRAT == BRDF) {
+        // The fast path: height-correlated Smith without cancellation,
+        // with R = wi.z Lo + wo.z Li, P = wo.z + Lo:
+        // f = ks F D/(2R), vndf pdf = D/(2P), weight = ks F wi.z P/R;
+        // brdf pdf = D hz/(4 wo·h), weight = 2 ks F wi.z (wo·h)/(R hz).
+        // One division for vndf (1/(s R P), each factor bounded away from
+        // 0 and ∞ above the horizon), two for brdf.
+        let lo = stretched_len(l, p, wo);
+        let li = stretched_len(l, p, wi);
+        let rr = l.mul_add(wi[2], lo, wo[2] * li);
+        let ksf = ks_fresnel_h(l, &p.fresnel, oh, hh);
+        let kd = l.splat(p.inv_pi_axay);
+        let (dg, pdf, wscale) = if STRAT == VNDF {
+            let pp = wo[2] + lo;
+            let sr = s * rr;
+            let iq = one / (sr * pp);
+            // q = hh/s, D = q²/(π αx αy).
+            let q = hh * rr * pp * iq;
+            let d = kd * q * q;
+            let rden = s * pp * iq;
+            let pdf = l.splat(0.5) * d * (sr * iq);
+            (l.splat(0.5) * d * rden, pdf, wi[2] * pp * rden)
+        } else {
+            let isr = one / (s * rr);
+            let q = hh * rr * isr;
+            let d = kd * q * q;
+            let rden = s * isr;
+            let ioz = one / (oh * h[2]);
+            let pdf = l.splat(0.25) * d * (h[2] * h[2]) * ioz;
+            let wscale = l.splat(2.0) * wi[2] * (oh * oh) * rden * ioz;
+            (l.splat(0.5) * d * rden, pdf, wscale)
+        };
+        return Eval {
+            ok,
+            f: [ksf[0] * dg, ksf[1] * dg, ksf[2] * dg],
+            pdf,
+            weight: [ksf[0] * wscale, ksf[1] * wscale, ksf[2] * wscale],
+        };
+    }
     let d = if NDF == GGX {
-        let q = hh / (sxy + hz2);
+        let q = hh / s;
         l.splat(p.inv_pi_axay) * q * q
     } else {
         let inv_z2 = one / hz2;
@@ -403,27 +456,7 @@ fn eval_at<L: Lanes, const NDF: u8, const STRAT: u8>(
     } else {
         d
     };
-    let ksf = ks_fresnel(l, &p.fresnel, cos_oh);
-    if NDF == GGX && p.shadow == Shadow::Correlated && (STRAT == VNDF || STRAT == BRDF) {
-        // The fast path: height-correlated Smith without cancellation.
-        let lo = stretched_len(l, p, wo);
-        let li = stretched_len(l, p, wi);
-        let rden = one / l.mul_add(wi[2], lo, wo[2] * li);
-        let dg = l.splat(0.5) * d * rden;
-        let (pdf, wscale) = if STRAT == VNDF {
-            let pdf = l.splat(0.5) * d / (wo[2] + lo);
-            (pdf, wi[2] * (wo[2] + lo) * rden)
-        } else {
-            let pdf = l.splat(0.25) * d * h[2] / oh;
-            (pdf, l.splat(2.0) * wi[2] * oh * rden / h[2])
-        };
-        return Eval {
-            ok,
-            f: [ksf[0] * dg, ksf[1] * dg, ksf[2] * dg],
-            pdf,
-            weight: [ksf[0] * wscale, ksf[1] * wscale, ksf[2] * wscale],
-        };
-    }
+    let ksf = ks_fresnel_h(l, &p.fresnel, oh, hh);
     // General: 1 + Λo (also the vndf pdf's), 1 + Λi, G.
     let (lam1o, lo) = if NDF == GGX {
         let lo = stretched_len(l, p, wo);
@@ -479,7 +512,13 @@ pub(crate) struct Sampled<L: Lanes> {
     pub weight: V3<L>,
 }
 
-/// Heitz 2018's visible GGX normal for `wo`, with `(sin, cos)` of `2π u2`.
+/// Heitz 2018's visible GGX normal for `wo`, with `(sin, cos)` of `2π u2`,
+/// not normalized: `(n, |n|²)`, `n` along the unit normal the scalar path
+/// draws (the evaluation is scale-invariant in the half vector, and the
+/// reflection divides by `|n|²`: no square root for the length).
+///
+/// Three divisions per vector: one reciprocal for the basis and `1 − h`,
+/// one for `1 − u1` over `a + |rs|`, one for the normal's `z` where `p2 < 0`.
 #[inline(always)]
 fn ggx_vndf_normal<L: Lanes>(
     l: L,
@@ -488,66 +527,77 @@ fn ggx_vndf_normal<L: Lanes>(
     u1: L::F,
     sin: L::F,
     cos: L::F,
-) -> V3<L> {
+) -> (V3<L>, L::F) {
     let zero = l.splat(0.0);
     let one = l.splat(1.0);
     let (ax, ay) = (l.splat(p.ax), l.splat(p.ay));
-    // The stretched view direction and a basis around it.
+    // The stretched view direction w, |w| = wl, its tangent length txy,
+    // and a basis around it.
     let w = [wo[0] * ax, wo[1] * ay, wo[2]];
-    let inv = one / l.sqrt(dot(l, w, w));
-    let wh = [w[0] * inv, w[1] * inv, w[2] * inv];
-    let len2 = l.mul_add(wh[0], wh[0], wh[1] * wh[1]);
-    let has = l.gt(len2, zero);
-    let il = one / l.sqrt(len2);
+    let sxy2 = l.mul_add(w[0], w[0], w[1] * w[1]);
+    let has = l.gt(sxy2, zero);
+    let txy = l.sqrt(sxy2);
+    let wl = l.sqrt(l.mul_add(w[2], w[2], sxy2));
+    // One reciprocal r = 1/(tx wl e), e = wl + w.z, tx = txy (1 at the pole):
+    // 1/txy = wl e r, 1/wl = tx e r, and 1 − h = (1 − wh.z)/2 =
+    // txy²/(2 wl e) (no cancellation near the normal).
+    let tx = l.select(has, txy, one);
+    let e = wl + w[2];
+    let wle = wl * e;
+    let r = one / (tx * wle);
+    let il = wle * r;
+    let inv = tx * e * r;
+    let whz = w[2] * inv;
     let t1 = [
-        l.select(has, -wh[1] * il, one),
-        l.select(has, wh[0] * il, zero),
+        l.select(has, -w[1] * il, one),
+        l.select(has, w[0] * il, zero),
     ];
-    // t2 = wh × (t1x, t1y, 0); its z is √len2 (0 at the pole).
-    let tl = l.sqrt(len2);
-    let t2 = [-wh[2] * t1[1], wh[2] * t1[0], tl];
+    // t2 = wh × (t1x, t1y, 0); its z is the tangent length of wh (0 at the pole).
+    let tl = txy * inv;
+    let t2 = [-whz * t1[1], whz * t1[0], tl];
     // A point of the unit disk (p1, p2), its lower half squeezed onto
     // the visible part: p2 ← (1 − h) a + h p2 with a = √(1 − p1²) and
     // h = (1 + wh.z)/2. Written so that nothing cancels where the f32
     // result would be all rounding (the rim of the disk, u1 → 1, and
     // the rim of the visible part, grazing views): with rs = r sin,
     // (a − rs)(a + rs) = 1 − u1 exactly.
-    let r = l.sqrt(u1);
-    let p1 = r * cos;
+    let rt = l.sqrt(u1);
+    let p1 = rt * cos;
     let one_m_u = one - u1;
     let a = l.sqrt(l.mul_add(u1, sin * sin, one_m_u));
-    let rs = r * sin;
+    let rs = rt * sin;
     // One of a ± rs is a + |rs|; the other is (1 − u1) over it.
     let big = a + l.abs(rs);
     let small = one_m_u / big;
     let rs_pos = l.gt(rs, zero);
     let a_minus = l.select(rs_pos, small, big);
     let a_plus = l.select(rs_pos, big, small);
-    // 1 − h = len2 / (2 (1 + wh.z)).
-    let omh = l.splat(0.5) * len2 / (one + wh[2]);
+    let omh = l.splat(0.5) * (txy * txy) * (tx * r);
     let hv = one - omh;
     // p2 = (1 − h) a + h rs = h (a + rs) − wh.z a: small terms where
     // p2 is small at grazing views, where nh.z needs it to full precision.
-    let p2 = l.mul_add(hv, a_plus, -(wh[2] * a));
+    let p2 = l.mul_add(hv, a_plus, -(whz * a));
     // pz² = a² − p2² = (a − p2)(a + p2) = h (a − rs) (2(1 − h) a + h (a + rs)).
     let pz = l.sqrt(hv * a_minus * l.mul_add(omh + omh, a, hv * a_plus));
     // nh.z = p2 tl + pz wh.z; for p2 < 0 through
     // (pz wh.z)² − (p2 tl)² = (a wh.z − p2) h (a + rs).
-    let nz_pos = l.mul_add(p2, tl, pz * wh[2]);
-    let nz_neg = (l.mul_add(a, wh[2], -p2) * hv * a_plus) / l.mul_add(pz, wh[2], -(p2 * tl));
+    let nz_pos = l.mul_add(p2, tl, pz * whz);
+    let nz_neg = (l.mul_add(a, whz, -p2) * hv * a_plus) / l.mul_add(pz, whz, -(p2 * tl));
+    let whx = w[0] * inv;
+    let why = w[1] * inv;
     let nh = [
-        l.mul_add(p1, t1[0], l.mul_add(p2, t2[0], pz * wh[0])),
-        l.mul_add(p1, t1[1], l.mul_add(p2, t2[1], pz * wh[1])),
+        l.mul_add(p1, t1[0], l.mul_add(p2, t2[0], pz * whx)),
+        l.mul_add(p1, t1[1], l.mul_add(p2, t2[1], pz * why)),
         l.select(l.lt(p2, zero), nz_neg, nz_pos),
     ];
-    // Unstretch into the microfacet normal.
+    // Unstretch into the microfacet normal, of length between min(α, 1)
+    // and max(α, 1).
     let n = [
         ax * nh[0],
         ay * nh[1],
         l.max(nh[2], l.splat(f32::MIN_POSITIVE)),
     ];
-    let inv = one / l.sqrt(dot(l, n, n));
-    [n[0] * inv, n[1] * inv, n[2] * inv]
+    (n, dot(l, n, n))
 }
 
 /// Most Newton steps of the Beckmann slope inversion (each lane stops when
@@ -713,32 +763,30 @@ pub(crate) fn sample<L: Lanes, const NDF: u8, const STRAT: u8>(
         return finish(l, valid & l.gt(wi[2], zero), wi, e.f, e.pdf, e.weight);
     }
     if STRAT == VNDF || STRAT == BRDF {
-        let m = if STRAT == VNDF && NDF == GGX {
+        // The drawn normal m and |m|² (not normalized: the evaluation is
+        // scale-invariant in the half vector).
+        let (m, mm) = if STRAT == VNDF && NDF == GGX {
             let (sin, cos) = sincos_turns(l, u2);
             ggx_vndf_normal(l, p, wo, u1, sin, cos)
         } else if STRAT == VNDF {
-            beckmann_vndf_normal(l, p, wo, u1, u2)
+            (beckmann_vndf_normal(l, p, wo, u1, u2), one)
+        } else if NDF == BLINN_PHONG {
+            (blinn_ndf::sample_normal(l, p, u1, u2), one)
         } else {
             // D(m) cos θm: slope radius² u/(1 − u) (GGX), −ln(1 − u)
-            // (Beckmann), u below 1.
+            // (Beckmann), u below 1; GGX's normal (−αx r cos, −αy r sin, 1)
+            // times √(1 − u), no division.
             let (sin, cos) = sincos_turns(l, u2);
             let u = l.min(u1, l.splat(1.0 - f32::EPSILON / 2.0));
-            let r2 = if NDF == GGX {
-                u / (one - u)
+            let (r, z) = if NDF == GGX {
+                (l.sqrt(u), l.sqrt(one - u))
             } else {
-                -log1p(l, -u)
+                (l.sqrt(-log1p(l, -u)), one)
             };
-            let r = l.sqrt(r2);
-            let n = [-(ax * r * cos), -(ay * r * sin), one];
-            let inv = one / l.sqrt(dot(l, n, n));
-            [n[0] * inv, n[1] * inv, inv]
+            let n = [-(ax * r * cos), -(ay * r * sin), z];
+            (n, dot(l, n, n))
         };
-        let m = if STRAT == BRDF && NDF == BLINN_PHONG {
-            blinn_ndf::sample_normal(l, p, u1, u2)
-        } else {
-            m
-        };
-        let r = reflect_or_diffuse(l, p, wo, m, u1, u2, uc);
+        let r = reflect_or_diffuse(l, p, wo, m, mm, u1, u2, uc);
         wi = r.wi;
         if p.two_lobes {
             let e = eval_h::<L, NDF, STRAT>(l, p, wo, wi, r.h, r.hh, r.oh, r.ih);
@@ -766,7 +814,7 @@ pub(crate) fn sample<L: Lanes, const NDF: u8, const STRAT: u8>(
 
 /// `wo` reflected about a drawn microfacet normal, with what `f` and the
 /// pdf are evaluated at: for one lobe, the normal itself as the half vector
-/// (`|h| = 1`, `wo·h = wi·h = wo·m`); where `uc` chooses between the lobe
+/// (`|h|² = mm`, `wo·h = wi·h = wo·m`); where `uc` chooses between the lobe
 /// and the diffuse term (`p.two_lobes`), as `Material::sample` does: `uc <
 /// P` keeps the reflection, else a cosine-weighted direction with `h = wo +
 /// wi` (the drawn normal stays the half vector where the lobe drew: accurate
@@ -789,14 +837,15 @@ pub(crate) fn reflect_or_diffuse<L: Lanes>(
     p: &CtParams,
     wo: V3<L>,
     m: V3<L>,
+    mm: L::F,
     u1: L::F,
     u2: L::F,
     uc: L::F,
 ) -> Reflected<L> {
     let zero = l.splat(0.0);
-    let one = l.splat(1.0);
     let om = dot(l, wo, m);
-    let two_om = om + om;
+    // 2 (wo·m̂) m̂ = 2 (wo·m)/|m|² m (one division, none where |m| = 1).
+    let two_om = (om + om) / mm;
     let wi = [
         l.mul_add(two_om, m[0], -wo[0]),
         l.mul_add(two_om, m[1], -wo[1]),
@@ -808,7 +857,7 @@ pub(crate) fn reflect_or_diffuse<L: Lanes>(
             valid,
             wi,
             h: m,
-            hh: one,
+            hh: mm,
             oh: om,
             ih: om,
         };
@@ -827,7 +876,7 @@ pub(crate) fn reflect_or_diffuse<L: Lanes>(
         l.select(choose, m[1], hd[1]),
         l.select(choose, m[2], hd[2]),
     ];
-    let hh = l.select(choose, one, dot(l, hd, hd));
+    let hh = l.select(choose, mm, dot(l, hd, hd));
     let oh = l.select(choose, om, dot(l, wo, hd));
     let ih = if p.shadow == Shadow::VCavity {
         l.select(choose, om, dot(l, wi, hd))
@@ -856,13 +905,11 @@ fn finish<L: Lanes>(
     weight: V3<L>,
 ) -> Sampled<L> {
     let zero = l.splat(0.0);
-    let finite = l.is_finite(f[0])
-        & l.is_finite(f[1])
-        & l.is_finite(f[2])
-        & l.is_finite(weight[0])
-        & l.is_finite(weight[1])
-        & l.is_finite(weight[2])
-        & l.is_finite(pdf);
+    // All seven finite at once: f, weight and pdf are never negative, so
+    // their sum is finite exactly where each is (NaN and ∞ carry through a
+    // sum of non-negative terms; finite terms below f32::MAX/7 stay finite).
+    let sum = (f[0] + f[1]) + (f[2] + weight[0]) + ((weight[1] + weight[2]) + pdf);
+    let finite = l.is_finite(sum);
     let valid = valid & l.gt(pdf, zero) & finite;
     Sampled {
         valid,

@@ -566,3 +566,145 @@ mod x86 {
         }
     }
 }
+
+// ------------------------------------------------------------ two vectors
+
+/// Two vectors of a level side by side (`2 N` lanes): every operation is
+/// the level's, twice, on independent data. The kernels' dependency chains
+/// (square root, division, reflection, square root, division) are long;
+/// two interleaved chains keep the core's pipelines busy where one leaves
+/// them waiting. Lane for lane the same operations as `L`: the same bits.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct X2<L>(pub L);
+
+/// A pair of vectors or masks of [`X2`].
+#[derive(Clone, Copy)]
+pub(crate) struct Pair<T>(T, T);
+
+macro_rules! pair_ops {
+    ($($tr:ident $method:ident),*) => {$(
+        impl<T: $tr<Output = T>> $tr for Pair<T> {
+            type Output = Pair<T>;
+            #[inline(always)]
+            fn $method(self, o: Pair<T>) -> Pair<T> {
+                Pair(self.0.$method(o.0), self.1.$method(o.1))
+            }
+        }
+    )*};
+}
+pair_ops!(Add add, Sub sub, Mul mul, Div div, BitAnd bitand, BitOr bitor);
+
+impl<T: Neg<Output = T>> Neg for Pair<T> {
+    type Output = Pair<T>;
+    #[inline(always)]
+    fn neg(self) -> Pair<T> {
+        Pair(-self.0, -self.1)
+    }
+}
+
+impl<T: Not<Output = T>> Not for Pair<T> {
+    type Output = Pair<T>;
+    #[inline(always)]
+    fn not(self) -> Pair<T> {
+        Pair(!self.0, !self.1)
+    }
+}
+
+impl<L: Lanes> Lanes for X2<L> {
+    const N: usize = 2 * L::N;
+    type F = Pair<L::F>;
+    type M = Pair<L::M>;
+
+    #[inline(always)]
+    fn splat(self, x: f32) -> Self::F {
+        let v = self.0.splat(x);
+        Pair(v, v)
+    }
+    #[inline(always)]
+    fn load(self, s: &[f32]) -> Self::F {
+        Pair(self.0.load(s), self.0.load(&s[L::N..]))
+    }
+    #[inline(always)]
+    fn store(self, v: Self::F, s: &mut [f32]) {
+        self.0.store(v.0, s);
+        self.0.store(v.1, &mut s[L::N..]);
+    }
+    #[inline(always)]
+    fn store_mask(self, m: Self::M, s: &mut [u8]) {
+        self.0.store_mask(m.0, s);
+        self.0.store_mask(m.1, &mut s[L::N..]);
+    }
+    #[inline(always)]
+    fn mul_add(self, a: Self::F, b: Self::F, c: Self::F) -> Self::F {
+        Pair(self.0.mul_add(a.0, b.0, c.0), self.0.mul_add(a.1, b.1, c.1))
+    }
+    #[inline(always)]
+    fn sqrt(self, a: Self::F) -> Self::F {
+        Pair(self.0.sqrt(a.0), self.0.sqrt(a.1))
+    }
+    #[inline(always)]
+    fn min(self, a: Self::F, b: Self::F) -> Self::F {
+        Pair(self.0.min(a.0, b.0), self.0.min(a.1, b.1))
+    }
+    #[inline(always)]
+    fn max(self, a: Self::F, b: Self::F) -> Self::F {
+        Pair(self.0.max(a.0, b.0), self.0.max(a.1, b.1))
+    }
+    #[inline(always)]
+    fn round(self, a: Self::F) -> Self::F {
+        Pair(self.0.round(a.0), self.0.round(a.1))
+    }
+    #[inline(always)]
+    fn floor(self, a: Self::F) -> Self::F {
+        Pair(self.0.floor(a.0), self.0.floor(a.1))
+    }
+    #[inline(always)]
+    fn lt(self, a: Self::F, b: Self::F) -> Self::M {
+        Pair(self.0.lt(a.0, b.0), self.0.lt(a.1, b.1))
+    }
+    #[inline(always)]
+    fn gt(self, a: Self::F, b: Self::F) -> Self::M {
+        Pair(self.0.gt(a.0, b.0), self.0.gt(a.1, b.1))
+    }
+    #[inline(always)]
+    fn eq(self, a: Self::F, b: Self::F) -> Self::M {
+        Pair(self.0.eq(a.0, b.0), self.0.eq(a.1, b.1))
+    }
+    #[inline(always)]
+    fn select(self, m: Self::M, a: Self::F, b: Self::F) -> Self::F {
+        Pair(self.0.select(m.0, a.0, b.0), self.0.select(m.1, a.1, b.1))
+    }
+    #[inline(always)]
+    fn abs(self, a: Self::F) -> Self::F {
+        Pair(self.0.abs(a.0), self.0.abs(a.1))
+    }
+    #[inline(always)]
+    fn any(self, m: Self::M) -> bool {
+        self.0.any(m.0) | self.0.any(m.1)
+    }
+    #[inline(always)]
+    fn gather(self, table: &[f32], i: Self::F) -> Self::F {
+        Pair(self.0.gather(table, i.0), self.0.gather(table, i.1))
+    }
+    #[inline(always)]
+    fn exp2i(self, n: Self::F) -> Self::F {
+        Pair(self.0.exp2i(n.0), self.0.exp2i(n.1))
+    }
+    #[inline(always)]
+    fn frexp(self, x: Self::F) -> (Self::F, Self::F) {
+        let (m0, e0) = self.0.frexp(x.0);
+        let (m1, e1) = self.0.frexp(x.1);
+        (Pair(m0, m1), Pair(e0, e1))
+    }
+    #[inline(always)]
+    fn select_mask(self, m: Self::M, a: Self::M, b: Self::M) -> Self::M {
+        Pair(
+            self.0.select_mask(m.0, a.0, b.0),
+            self.0.select_mask(m.1, a.1, b.1),
+        )
+    }
+    #[inline(always)]
+    fn is_finite(self, a: Self::F) -> Self::M {
+        Pair(self.0.is_finite(a.0), self.0.is_finite(a.1))
+    }
+}

@@ -863,6 +863,127 @@ fn batch_chi2() {
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
 
+/// Two vectors at a time ([`dispatch`]'s `X2`, which the AVX-512 level runs
+/// for the visible-normal samplers) give the bits of one vector at a time:
+/// checked here on the portable lanes (`X2<Scalar>` against `Scalar`), so
+/// that every machine runs it, with an odd block for the padded tail, for
+/// every kernel `X2` runs, both Fresnel kinds and a diffuse term.
+#[test]
+fn two_vectors_at_a_time_give_the_same_bits() {
+    use super::dispatch::{self as d, Kernel};
+    use super::lanes::{Scalar, X2};
+    let mut rng = Pcg64::seed_from_u64(0x7832);
+    let n = 4097;
+    let mut inp: [Vec<f32>; 6] = Default::default();
+    for _ in 0..n {
+        let wo = random_wo(&mut rng);
+        for c in 0..3 {
+            inp[c].push(wo[c]);
+        }
+        for v in &mut inp[3..] {
+            v.push(uniform(&mut rng));
+        }
+    }
+    let beckmann = {
+        let mf = Microfacet::new(Ndf::Beckmann, 0.2, 0.6).unwrap();
+        let lobe = CookTorrance::new(
+            Rgb::splat(0.8),
+            mf,
+            Shadowing::SmithCorrelated,
+            Fresnel::Schlick {
+                f0: Rgb::splat(0.04),
+            },
+        )
+        .unwrap();
+        Material::with_diffuse(Rgb::splat(0.3), Glossy::CookTorrance(lobe)).unwrap()
+    };
+    let materials = [
+        ggx(0.2, 0.2, Fresnel::None, Rgb::ONE),
+        ggx(
+            1e-4,
+            0.5,
+            Fresnel::Schlick {
+                f0: Rgb::new(0.9, 0.6, 0.3),
+            },
+            Rgb::ONE,
+        ),
+        beckmann,
+    ];
+    let mut checked = 0;
+    for (mi, m) in materials.iter().enumerate() {
+        let b = BatchSampler::with_level(m, BsdfStrategy::Vndf, SimdLevel::Scalar).unwrap();
+        let k: &Kernel = &b.kernel;
+        assert!(d::runs_x2(k, false), "material {mi}: a kernel that X2 runs");
+        let ins = [
+            &inp[0][..],
+            &inp[1][..],
+            &inp[2][..],
+            &inp[3][..],
+            &inp[4][..],
+            &inp[5][..],
+        ];
+        let run = |x2: bool| {
+            let mut out: [Vec<f32>; 10] = std::array::from_fn(|_| vec![0.0; n]);
+            let mut valid = vec![0u8; n];
+            let mut ev: [Vec<f32>; 4] = std::array::from_fn(|_| vec![0.0; n]);
+            {
+                let mut o = out.each_mut().map(|v| &mut v[..]);
+                if x2 {
+                    d::sample_x2(X2(Scalar), k, ins, (&mut o, &mut valid));
+                } else {
+                    d::sample_level(Scalar, k, ins, (&mut o, &mut valid));
+                }
+            }
+            {
+                let ein = [
+                    ins[0],
+                    ins[1],
+                    ins[2],
+                    &out[0][..],
+                    &out[1][..],
+                    &out[2][..],
+                ];
+                let mut e = ev.each_mut().map(|v| &mut v[..]);
+                if x2 && d::runs_x2(k, true) {
+                    d::eval_pdf_x2(X2(Scalar), k, d::BOTH, ein, &mut e);
+                } else {
+                    d::eval_pdf_level(Scalar, k, d::BOTH, ein, &mut e);
+                }
+            }
+            (out, valid, ev)
+        };
+        let (one, x2) = (run(false), run(true));
+        assert_eq!(one.1, x2.1, "material {}: valid masks differ", mi);
+        for (c, (a, b)) in one.0.iter().zip(&x2.0).enumerate() {
+            for i in 0..n {
+                assert_eq!(
+                    a[i].to_bits(),
+                    b[i].to_bits(),
+                    "material {}: sample output {c} at {i}",
+                    mi
+                );
+            }
+        }
+        for (c, (a, b)) in one.2.iter().zip(&x2.2).enumerate() {
+            for i in 0..n {
+                assert_eq!(
+                    a[i].to_bits(),
+                    b[i].to_bits(),
+                    "material {}: eval_pdf output {c} at {i}",
+                    mi
+                );
+            }
+        }
+        assert!(
+            one.1.iter().filter(|&&v| v == 1).count() > n / 2,
+            "material {}: most samples valid",
+            mi
+        );
+        checked += 1;
+    }
+    assert_eq!(checked, materials.len());
+}
+
 /// The whole model × strategy × Fresnel × shadowing grid.
 #[path = "tests_grid.rs"]
 mod grid;
