@@ -267,10 +267,16 @@ mod x86 {
         }
         #[inline(always)]
         fn store_mask(self, m: M8, s: &mut [u8]) {
-            // SAFETY: the token proves AVX2.
-            let bits = unsafe { _mm256_movemask_ps(m.0) };
-            for (i, b) in s[..8].iter_mut().enumerate() {
-                *b = ((bits >> i) & 1) as u8;
+            let s = &mut s[..8];
+            // SAFETY: the token proves AVX2; `s` holds 8 writable bytes. A
+            // mask lane is all ones or all zeros (compares and their bitwise
+            // combinations), so the saturating packs give −1 or 0 per byte.
+            unsafe {
+                let v = _mm256_castps_si256(m.0);
+                let w =
+                    _mm_packs_epi32(_mm256_castsi256_si128(v), _mm256_extracti128_si256::<1>(v));
+                let b = _mm_and_si128(_mm_packs_epi16(w, w), _mm_set1_epi8(1));
+                _mm_storel_epi64(s.as_mut_ptr().cast(), b);
             }
         }
         #[inline(always)]

@@ -953,27 +953,17 @@ fn two_vectors_at_a_time_give_the_same_bits() {
             (out, valid, ev)
         };
         let (one, x2) = (run(false), run(true));
-        assert_eq!(one.1, x2.1, "material {}: valid masks differ", mi);
-        for (c, (a, b)) in one.0.iter().zip(&x2.0).enumerate() {
-            for i in 0..n {
-                assert_eq!(
-                    a[i].to_bits(),
-                    b[i].to_bits(),
-                    "material {}: sample output {c} at {i}",
-                    mi
-                );
+        assert_eq!(one.1, x2.1, "material {mi}: valid masks differ");
+        let same_bits = |a: &[Vec<f32>], b: &[Vec<f32>], what: &str| {
+            for (c, (a, b)) in a.iter().zip(b).enumerate() {
+                for i in 0..n {
+                    let (x, y) = (a[i].to_bits(), b[i].to_bits());
+                    assert_eq!(x, y, "material {mi}: {what} output {c} at {i}");
+                }
             }
-        }
-        for (c, (a, b)) in one.2.iter().zip(&x2.2).enumerate() {
-            for i in 0..n {
-                assert_eq!(
-                    a[i].to_bits(),
-                    b[i].to_bits(),
-                    "material {}: eval_pdf output {c} at {i}",
-                    mi
-                );
-            }
-        }
+        };
+        same_bits(&one.0, &x2.0, "sample");
+        same_bits(&one.2, &x2.2, "eval_pdf");
         assert!(
             one.1.iter().filter(|&&v| v == 1).count() > n / 2,
             "material {}: most samples valid",
