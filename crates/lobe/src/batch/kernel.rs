@@ -29,8 +29,9 @@
 //! `sample` evaluates `f`, `pdf` and `weight` with the microfacet normal it
 //! drew as the half vector (`wo·h = wi·h = wo·m`), as the scalar path does,
 //! left unnormalized where the formulas are scale-invariant in `h` (GGX's
-//! visible and `D cos` normals: no square root and division for the length); `eval_pdf`, and `sample` for uniform and cosine, with
-//! `h = wo + wi`.
+//! visible and `D cos` normals, Beckmann's `D cos` normal: no square root
+//! and division for the length); `eval_pdf`, and `sample` for uniform and
+//! cosine, with `h = wo + wi`.
 
 use super::lanes::Lanes;
 use super::math::{erfc_abs, erfc_exp, erfinv_u, erfinv_u_refined, exp, log, log1p, sincos_turns};
