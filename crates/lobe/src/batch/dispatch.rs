@@ -413,14 +413,14 @@ pub(super) fn eval_pdf_level<L: Lanes>(
     }
 }
 
-/// Whether the AVX-512 level runs `k`'s `sample` (`eval = false`) or
+/// Whether the AVX-512 and AVX2 levels run `k`'s `sample` (`eval = false`) or
 /// `eval_pdf` two vectors at a time ([`X2`]): the visible-normal samplers
 /// (GGX and Beckmann), whose long dependency chains (square root, division,
 /// reflection, square root, division; Beckmann's Newton steps) leave the
 /// pipelines idle one vector at a time, and Beckmann's evaluation. Where
 /// the chains are short (GGX brdf, GGX eval_pdf) two vectors only add
 /// register spills and run slower. Measured by `lobe bench` on Zen 4
-/// (BENCHMARKS.md).
+/// (BENCHMARKS.md), at both levels.
 pub(super) fn runs_x2(k: &Kernel, eval: bool) -> bool {
     matches!(
         k,
@@ -482,6 +482,18 @@ fn eval_pdf_avx512_x2(l: Avx512, k: &Kernel, mode: u8, inp: EvalIn<'_>, out: Eva
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
+fn sample_avx2_x2(l: Avx2, k: &Kernel, inp: SampleIn<'_>, out: SampleOut<'_, '_>) {
+    sample_x2(X2(l), k, inp, out);
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+fn eval_pdf_avx2_x2(l: Avx2, k: &Kernel, mode: u8, inp: EvalIn<'_>, out: EvalOut<'_, '_>) {
+    eval_pdf_x2(X2(l), k, mode, inp, out);
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
 fn sample_avx2(l: Avx2, k: &Kernel, inp: SampleIn<'_>, out: SampleOut<'_, '_>) {
     sample_level(l, k, inp, out);
 }
@@ -513,6 +525,9 @@ pub(crate) fn sample(b: Backend, k: &Kernel, inp: SampleIn<'_>, out: SampleOut<'
         Backend::Scalar(l) => sample_level(l, k, inp, out),
         // SAFETY: an `Avx2` token exists only if the CPU has AVX2 and FMA.
         #[cfg(target_arch = "x86_64")]
+        Backend::Avx2(l) if runs_x2(k, false) => unsafe { sample_avx2_x2(l, k, inp, out) },
+        // SAFETY: as above.
+        #[cfg(target_arch = "x86_64")]
         Backend::Avx2(l) => unsafe { sample_avx2(l, k, inp, out) },
         // SAFETY: an `Avx512` token exists only if the CPU has AVX-512F/DQ/BW/VL and FMA
         // (AVX2 is implied by AVX-512F).
@@ -533,6 +548,9 @@ pub(crate) fn eval_pdf(b: Backend, k: &Kernel, mode: u8, inp: EvalIn<'_>, out: E
     match b {
         Backend::Scalar(l) => eval_pdf_level(l, k, mode, inp, out),
         // SAFETY: an `Avx2` token exists only if the CPU has AVX2 and FMA.
+        #[cfg(target_arch = "x86_64")]
+        Backend::Avx2(l) if runs_x2(k, true) => unsafe { eval_pdf_avx2_x2(l, k, mode, inp, out) },
+        // SAFETY: as above.
         #[cfg(target_arch = "x86_64")]
         Backend::Avx2(l) => unsafe { eval_pdf_avx2(l, k, mode, inp, out) },
         // SAFETY: an `Avx512` token exists only if the CPU has AVX-512F/DQ/BW/VL and FMA.

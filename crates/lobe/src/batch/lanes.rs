@@ -2,7 +2,7 @@
 //! are written once, and its three instances: [`Scalar`] (one `f32` lane,
 //! portable), [`Avx2`] (8 lanes, AVX2 + FMA) and [`Avx512`] (16 lanes,
 //! AVX-512F/DQ/BW/VL); and [`X2`], two vectors of a level side by side,
-//! which the AVX-512 level runs for its longest kernels.
+//! which the AVX-512 and AVX2 levels run for their longest kernels.
 //!
 //! A level is a zero-sized *token*: `Avx2` and `Avx512` can only be made by
 //! [`Avx2::new`] / [`Avx512::new`], which check the CPU at run time, and
