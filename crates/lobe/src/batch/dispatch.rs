@@ -469,51 +469,43 @@ pub(super) fn eval_pdf_x2<L: Lanes>(
 }
 
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx512f,avx512dq,avx512bw,avx512vl,avx2,fma")]
-fn sample_avx512_x2(l: Avx512, k: &Kernel, inp: SampleIn<'_>, out: SampleOut<'_, '_>) {
-    sample_x2(X2(l), k, inp, out);
-}
-
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx512f,avx512dq,avx512bw,avx512vl,avx2,fma")]
-fn eval_pdf_avx512_x2(l: Avx512, k: &Kernel, mode: u8, inp: EvalIn<'_>, out: EvalOut<'_, '_>) {
-    eval_pdf_x2(X2(l), k, mode, inp, out);
-}
-
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2,fma")]
-fn sample_avx2_x2(l: Avx2, k: &Kernel, inp: SampleIn<'_>, out: SampleOut<'_, '_>) {
-    sample_x2(X2(l), k, inp, out);
-}
-
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2,fma")]
-fn eval_pdf_avx2_x2(l: Avx2, k: &Kernel, mode: u8, inp: EvalIn<'_>, out: EvalOut<'_, '_>) {
-    eval_pdf_x2(X2(l), k, mode, inp, out);
-}
-
-#[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
 fn sample_avx2(l: Avx2, k: &Kernel, inp: SampleIn<'_>, out: SampleOut<'_, '_>) {
-    sample_level(l, k, inp, out);
+    if runs_x2(k, false) {
+        sample_x2(X2(l), k, inp, out);
+    } else {
+        sample_level(l, k, inp, out);
+    }
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,avx512dq,avx512bw,avx512vl,avx2,fma")]
 fn sample_avx512(l: Avx512, k: &Kernel, inp: SampleIn<'_>, out: SampleOut<'_, '_>) {
-    sample_level(l, k, inp, out);
+    if runs_x2(k, false) {
+        sample_x2(X2(l), k, inp, out);
+    } else {
+        sample_level(l, k, inp, out);
+    }
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
 fn eval_pdf_avx2(l: Avx2, k: &Kernel, mode: u8, inp: EvalIn<'_>, out: EvalOut<'_, '_>) {
-    eval_pdf_level(l, k, mode, inp, out);
+    if runs_x2(k, true) {
+        eval_pdf_x2(X2(l), k, mode, inp, out);
+    } else {
+        eval_pdf_level(l, k, mode, inp, out);
+    }
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,avx512dq,avx512bw,avx512vl,avx2,fma")]
 fn eval_pdf_avx512(l: Avx512, k: &Kernel, mode: u8, inp: EvalIn<'_>, out: EvalOut<'_, '_>) {
-    eval_pdf_level(l, k, mode, inp, out);
+    if runs_x2(k, true) {
+        eval_pdf_x2(X2(l), k, mode, inp, out);
+    } else {
+        eval_pdf_level(l, k, mode, inp, out);
+    }
 }
 
 /// Run `sample` over a block (lengths already checked equal).
@@ -525,15 +517,9 @@ pub(crate) fn sample(b: Backend, k: &Kernel, inp: SampleIn<'_>, out: SampleOut<'
         Backend::Scalar(l) => sample_level(l, k, inp, out),
         // SAFETY: an `Avx2` token exists only if the CPU has AVX2 and FMA.
         #[cfg(target_arch = "x86_64")]
-        Backend::Avx2(l) if runs_x2(k, false) => unsafe { sample_avx2_x2(l, k, inp, out) },
-        // SAFETY: as above.
-        #[cfg(target_arch = "x86_64")]
         Backend::Avx2(l) => unsafe { sample_avx2(l, k, inp, out) },
         // SAFETY: an `Avx512` token exists only if the CPU has AVX-512F/DQ/BW/VL and FMA
         // (AVX2 is implied by AVX-512F).
-        #[cfg(target_arch = "x86_64")]
-        Backend::Avx512(l) if runs_x2(k, false) => unsafe { sample_avx512_x2(l, k, inp, out) },
-        // SAFETY: as above.
         #[cfg(target_arch = "x86_64")]
         Backend::Avx512(l) => unsafe { sample_avx512(l, k, inp, out) },
     }
@@ -549,16 +535,8 @@ pub(crate) fn eval_pdf(b: Backend, k: &Kernel, mode: u8, inp: EvalIn<'_>, out: E
         Backend::Scalar(l) => eval_pdf_level(l, k, mode, inp, out),
         // SAFETY: an `Avx2` token exists only if the CPU has AVX2 and FMA.
         #[cfg(target_arch = "x86_64")]
-        Backend::Avx2(l) if runs_x2(k, true) => unsafe { eval_pdf_avx2_x2(l, k, mode, inp, out) },
-        // SAFETY: as above.
-        #[cfg(target_arch = "x86_64")]
         Backend::Avx2(l) => unsafe { eval_pdf_avx2(l, k, mode, inp, out) },
         // SAFETY: an `Avx512` token exists only if the CPU has AVX-512F/DQ/BW/VL and FMA.
-        #[cfg(target_arch = "x86_64")]
-        Backend::Avx512(l) if runs_x2(k, true) => unsafe {
-            eval_pdf_avx512_x2(l, k, mode, inp, out)
-        },
-        // SAFETY: as above.
         #[cfg(target_arch = "x86_64")]
         Backend::Avx512(l) => unsafe { eval_pdf_avx512(l, k, mode, inp, out) },
     }
