@@ -113,7 +113,10 @@ impl VecKernel for LectureParams {
     }
 }
 
-/// Which outputs `eval_pdf_block` writes: `f` and the pdf, `f` only, the pdf only.
+/// Which outputs [`eval_pdf`] writes: `f` and the pdf, `f` only, the pdf
+/// only. The analytic kernels compute both and skip the stores (one
+/// instance per kernel, not three: CI's time is compile time); the measured
+/// kernels (`super::measured`) skip the work.
 pub(crate) const BOTH: u8 = 0;
 pub(crate) const F_ONLY: u8 = 1;
 pub(crate) const PDF_ONLY: u8 = 2;
@@ -210,24 +213,25 @@ fn run_sample<L: Lanes, const NDF: u8, const STRAT: u8>(
     )
 }
 
-/// One vector of `eval_pdf`, stored at `k`.
+/// One vector of `eval_pdf`, stored at `k` (`f` if `wf`, the pdf if `wp`).
 #[inline(always)]
-fn run_eval_pdf<L: Lanes, const NDF: u8, const STRAT: u8, const MODE: u8>(
+fn run_eval_pdf<L: Lanes, const NDF: u8, const STRAT: u8>(
     l: L,
     p: &impl VecKernel,
     x: [&[f32]; 6],
     out: &mut [&mut [f32]; 4],
     k: usize,
+    (wf, wp): (bool, bool),
 ) {
     let wo = [l.load(x[0]), l.load(x[1]), l.load(x[2])];
     let wi = [l.load(x[3]), l.load(x[4]), l.load(x[5])];
     let (f, pdf) = p.eval_pdf::<L, NDF, STRAT>(l, wo, wi);
-    if MODE != PDF_ONLY {
+    if wf {
         l.store(f[0], &mut out[0][k..]);
         l.store(f[1], &mut out[1][k..]);
         l.store(f[2], &mut out[2][k..]);
     }
-    if MODE != F_ONLY {
+    if wp {
         l.store(pdf, &mut out[3][k..]);
     }
 }
@@ -294,9 +298,10 @@ fn sample_block<L: Lanes, const NDF: u8, const STRAT: u8>(
 }
 
 #[inline(always)]
-fn eval_pdf_block<L: Lanes, const NDF: u8, const STRAT: u8, const MODE: u8>(
+fn eval_pdf_block<L: Lanes, const NDF: u8, const STRAT: u8>(
     l: L,
     p: &impl VecKernel,
+    mode: u8,
     inp: EvalIn<'_>,
     out: EvalOut<'_, '_>,
 ) {
@@ -304,12 +309,9 @@ fn eval_pdf_block<L: Lanes, const NDF: u8, const STRAT: u8, const MODE: u8>(
     for s in &inp {
         assert_eq!(s.len(), n);
     }
+    let writes = (mode != PDF_ONLY, mode != F_ONLY);
     for (i, o) in out.iter().enumerate() {
-        let written = if i == 3 {
-            MODE != F_ONLY
-        } else {
-            MODE != PDF_ONLY
-        };
+        let written = if i == 3 { writes.1 } else { writes.0 };
         assert!(!written || o.len() == n);
     }
     let mut k = 0;
@@ -322,7 +324,7 @@ fn eval_pdf_block<L: Lanes, const NDF: u8, const STRAT: u8, const MODE: u8>(
             &inp[4][k..],
             &inp[5][k..],
         ];
-        run_eval_pdf::<L, NDF, STRAT, MODE>(l, p, x, out, k);
+        run_eval_pdf::<L, NDF, STRAT>(l, p, x, out, k, writes);
         k += L::N;
     }
     if k < n {
@@ -344,48 +346,101 @@ fn eval_pdf_block<L: Lanes, const NDF: u8, const STRAT: u8, const MODE: u8>(
                 &ib[4][..],
                 &ib[5][..],
             ];
-            run_eval_pdf::<L, NDF, STRAT, BOTH>(l, p, x, &mut refs, 0);
+            run_eval_pdf::<L, NDF, STRAT>(l, p, x, &mut refs, 0, (true, true));
         }
         for (i, (o, b)) in out.iter_mut().zip(&ob).enumerate() {
-            let wanted = if i == 3 {
-                MODE != F_ONLY
-            } else {
-                MODE != PDF_ONLY
-            };
-            if wanted {
+            if (i == 3 && writes.1) || (i < 3 && writes.0) {
                 o[k..].copy_from_slice(&b[..rem]);
             }
         }
     }
 }
 
-/// Every kernel instance of one level: the match picks it once per block.
+/// One function per kernel instance and level, each compiled on its own
+/// (`#[inline(never)]`): a match that inlined all of them into one function
+/// per level made that function so large that LLVM spent minutes on it.
+/// A call per block costs nothing against a block's work. `$feat`: the
+/// level's target features (none for the portable level); the lanes type
+/// is generic, so that one function serves a level and its [`X2`].
+macro_rules! instance_fns {
+    ($sample:ident, $eval:ident $(, $feat:literal)?) => {
+        $(#[target_feature(enable = $feat)])?
+        #[inline(never)]
+        fn $sample<L: Lanes, P: VecKernel, const NDF: u8, const STRAT: u8>(
+            l: L,
+            p: &P,
+            inp: SampleIn<'_>,
+            out: SampleOut<'_, '_>,
+        ) {
+            sample_block::<L, NDF, STRAT>(l, p, inp, out)
+        }
+
+        $(#[target_feature(enable = $feat)])?
+        #[inline(never)]
+        fn $eval<L: Lanes, P: VecKernel, const NDF: u8, const STRAT: u8>(
+            l: L,
+            p: &P,
+            mode: u8,
+            inp: EvalIn<'_>,
+            out: EvalOut<'_, '_>,
+        ) {
+            eval_pdf_block::<L, NDF, STRAT>(l, p, mode, inp, out)
+        }
+    };
+}
+
+instance_fns!(sample_one, eval_pdf_one);
+
+/// An instance inlined into its caller: the AVX-512 level's [`X2`]
+/// samplers, which ran 8 to 12% slower as functions of their own (Beckmann
+/// vndf, `lobe bench`, Intel Xeon; at AVX2 and for the other kernels no
+/// difference was measured). Two instances, so the compile time stays small.
+#[inline(always)]
+fn sample_inl<L: Lanes, P: VecKernel, const NDF: u8, const STRAT: u8>(
+    l: L,
+    p: &P,
+    inp: SampleIn<'_>,
+    out: SampleOut<'_, '_>,
+) {
+    sample_block::<L, NDF, STRAT>(l, p, inp, out)
+}
+#[cfg(target_arch = "x86_64")]
+instance_fns!(sample_one_avx2, eval_pdf_one_avx2, "avx2,fma");
+#[cfg(target_arch = "x86_64")]
+instance_fns!(
+    sample_one_avx512,
+    eval_pdf_one_avx512,
+    "avx512f,avx512dq,avx512bw,avx512vl,avx2,fma"
+);
+
+/// Every kernel instance of one level: the match picks it once per block
+/// and calls the instance function `$f` (arguments `$args`).
 macro_rules! instances {
-    ($k:expr, $block:ident, $l:ident, $inp:ident, $out:ident, $($extra:tt)*) => {
+    ($k:expr, $f:ident, $l:expr, $($args:expr),*) => {
         match $k {
             Kernel::CookTorrance { ndf, strat, p } => match (*ndf, *strat) {
-                (GGX, VNDF) => $block::<L, GGX, VNDF $($extra)*>($l, p, $inp, $out),
-                (GGX, BRDF) => $block::<L, GGX, BRDF $($extra)*>($l, p, $inp, $out),
-                (GGX, UNIFORM) => $block::<L, GGX, UNIFORM $($extra)*>($l, p, $inp, $out),
-                (GGX, COSINE) => $block::<L, GGX, COSINE $($extra)*>($l, p, $inp, $out),
-                (BECKMANN, VNDF) => $block::<L, BECKMANN, VNDF $($extra)*>($l, p, $inp, $out),
-                (BECKMANN, BRDF) => $block::<L, BECKMANN, BRDF $($extra)*>($l, p, $inp, $out),
-                (BECKMANN, UNIFORM) => $block::<L, BECKMANN, UNIFORM $($extra)*>($l, p, $inp, $out),
-                (BECKMANN, COSINE) => $block::<L, BECKMANN, COSINE $($extra)*>($l, p, $inp, $out),
-                (GGX, CAPS) => $block::<L, GGX, CAPS $($extra)*>($l, p, $inp, $out),
-                (GGX, BOUNDED) => $block::<L, GGX, BOUNDED $($extra)*>($l, p, $inp, $out),
-                (BLINN_PHONG, BRDF) => $block::<L, BLINN_PHONG, BRDF $($extra)*>($l, p, $inp, $out),
-                (BLINN_PHONG, UNIFORM) => $block::<L, BLINN_PHONG, UNIFORM $($extra)*>($l, p, $inp, $out),
-                (BLINN_PHONG, COSINE) => $block::<L, BLINN_PHONG, COSINE $($extra)*>($l, p, $inp, $out),
+                (GGX, VNDF) => $f::<_, _, GGX, VNDF>($l, p, $($args),*),
+                (GGX, BRDF) => $f::<_, _, GGX, BRDF>($l, p, $($args),*),
+                (GGX, UNIFORM) => $f::<_, _, GGX, UNIFORM>($l, p, $($args),*),
+                (GGX, COSINE) => $f::<_, _, GGX, COSINE>($l, p, $($args),*),
+                (BECKMANN, VNDF) => $f::<_, _, BECKMANN, VNDF>($l, p, $($args),*),
+                (BECKMANN, BRDF) => $f::<_, _, BECKMANN, BRDF>($l, p, $($args),*),
+                (BECKMANN, UNIFORM) => $f::<_, _, BECKMANN, UNIFORM>($l, p, $($args),*),
+                (BECKMANN, COSINE) => $f::<_, _, BECKMANN, COSINE>($l, p, $($args),*),
+                (GGX, CAPS) => $f::<_, _, GGX, CAPS>($l, p, $($args),*),
+                (GGX, BOUNDED) => $f::<_, _, GGX, BOUNDED>($l, p, $($args),*),
+                (BLINN_PHONG, BRDF) => $f::<_, _, BLINN_PHONG, BRDF>($l, p, $($args),*),
+                (BLINN_PHONG, UNIFORM) => $f::<_, _, BLINN_PHONG, UNIFORM>($l, p, $($args),*),
+                (BLINN_PHONG, COSINE) => $f::<_, _, BLINN_PHONG, COSINE>($l, p, $($args),*),
                 _ => unreachable!("BatchSampler::new builds only these"),
             },
             Kernel::Lecture { model, strat, p } => match (*model, *strat) {
-                (PHONG, BRDF) => $block::<L, PHONG, BRDF $($extra)*>($l, p, $inp, $out),
-                (PHONG, UNIFORM) => $block::<L, PHONG, UNIFORM $($extra)*>($l, p, $inp, $out),
-                (PHONG, COSINE) => $block::<L, PHONG, COSINE $($extra)*>($l, p, $inp, $out),
-                (BLINN, BRDF) => $block::<L, BLINN, BRDF $($extra)*>($l, p, $inp, $out),
-                (BLINN, UNIFORM) => $block::<L, BLINN, UNIFORM $($extra)*>($l, p, $inp, $out),
-                (BLINN, COSINE) => $block::<L, BLINN, COSINE $($extra)*>($l, p, $inp, $out),
+                (PHONG, BRDF) => $f::<_, _, PHONG, BRDF>($l, p, $($args),*),
+                (PHONG, UNIFORM) => $f::<_, _, PHONG, UNIFORM>($l, p, $($args),*),
+                (PHONG, COSINE) => $f::<_, _, PHONG, COSINE>($l, p, $($args),*),
+                (BLINN, BRDF) => $f::<_, _, BLINN, BRDF>($l, p, $($args),*),
+                (BLINN, UNIFORM) => $f::<_, _, BLINN, UNIFORM>($l, p, $($args),*),
+                (BLINN, COSINE) => $f::<_, _, BLINN, COSINE>($l, p, $($args),*),
                 _ => unreachable!("BatchSampler::new builds only these"),
             },
             Kernel::Measured(_) => unreachable!("run before the level's dispatch"),
@@ -393,12 +448,27 @@ macro_rules! instances {
     };
 }
 
-#[inline(always)]
-pub(super) fn sample_level<L: Lanes>(l: L, k: &Kernel, inp: SampleIn<'_>, out: SampleOut<'_, '_>) {
-    instances!(k, sample_block, l, inp, out,)
+/// The [`runs_x2`] instances: `$f` called with two vectors at a time.
+macro_rules! instances_x2 {
+    ($k:expr, $f:ident, $l:expr, $($args:expr),*) => {{
+        let Kernel::CookTorrance { ndf, strat, p } = $k else {
+            unreachable!("runs_x2 admits only Cook-Torrance")
+        };
+        match (*ndf, *strat) {
+            (GGX, VNDF) => $f::<_, _, GGX, VNDF>(X2($l), p, $($args),*),
+            (BECKMANN, VNDF) => $f::<_, _, BECKMANN, VNDF>(X2($l), p, $($args),*),
+            _ => unreachable!("runs_x2 admits only these"),
+        }
+    }};
 }
 
-#[inline(always)]
+/// `sample` at a portable level `L` (the scalar level; `X2<Scalar>` in the
+/// tests).
+pub(super) fn sample_level<L: Lanes>(l: L, k: &Kernel, inp: SampleIn<'_>, out: SampleOut<'_, '_>) {
+    instances!(k, sample_one, l, inp, out)
+}
+
+/// `eval_pdf` at a portable level `L`, writing what `mode` names.
 pub(super) fn eval_pdf_level<L: Lanes>(
     l: L,
     k: &Kernel,
@@ -406,11 +476,7 @@ pub(super) fn eval_pdf_level<L: Lanes>(
     inp: EvalIn<'_>,
     out: EvalOut<'_, '_>,
 ) {
-    match mode {
-        F_ONLY => instances!(k, eval_pdf_block, l, inp, out, , F_ONLY),
-        PDF_ONLY => instances!(k, eval_pdf_block, l, inp, out, , PDF_ONLY),
-        _ => instances!(k, eval_pdf_block, l, inp, out, , BOTH),
-    }
+    instances!(k, eval_pdf_one, l, mode, inp, out)
 }
 
 /// Whether the AVX-512 and AVX2 levels run `k`'s `sample` (`eval = false`) or
@@ -428,53 +494,32 @@ pub(super) fn runs_x2(k: &Kernel, eval: bool) -> bool {
     )
 }
 
-/// The [`runs_x2`] instances, two vectors of `L` at a time.
-#[inline(always)]
-pub(super) fn sample_x2<L: Lanes>(l: X2<L>, k: &Kernel, inp: SampleIn<'_>, out: SampleOut<'_, '_>) {
-    let Kernel::CookTorrance { ndf, strat, p } = k else {
-        unreachable!("runs_x2 admits only Cook-Torrance")
-    };
-    match (*ndf, *strat) {
-        (GGX, VNDF) => sample_block::<X2<L>, GGX, VNDF>(l, p, inp, out),
-        (BECKMANN, VNDF) => sample_block::<X2<L>, BECKMANN, VNDF>(l, p, inp, out),
-        _ => unreachable!("runs_x2 admits only these"),
-    }
+/// The [`runs_x2`] instances at a portable level, two vectors of `L` at a
+/// time (for the tests).
+#[cfg(test)]
+pub(super) fn sample_x2<L: Lanes>(l: L, k: &Kernel, inp: SampleIn<'_>, out: SampleOut<'_, '_>) {
+    instances_x2!(k, sample_one, l, inp, out)
 }
 
 /// As [`sample_x2`], for `eval_pdf`.
-#[inline(always)]
+#[cfg(test)]
 pub(super) fn eval_pdf_x2<L: Lanes>(
-    l: X2<L>,
+    l: L,
     k: &Kernel,
     mode: u8,
     inp: EvalIn<'_>,
     out: EvalOut<'_, '_>,
 ) {
-    let Kernel::CookTorrance { ndf, strat, p } = k else {
-        unreachable!("runs_x2 admits only Cook-Torrance")
-    };
-    macro_rules! by_mode {
-        ($ndf:ident, $strat:ident) => {
-            match mode {
-                F_ONLY => eval_pdf_block::<X2<L>, $ndf, $strat, F_ONLY>(l, p, inp, out),
-                PDF_ONLY => eval_pdf_block::<X2<L>, $ndf, $strat, PDF_ONLY>(l, p, inp, out),
-                _ => eval_pdf_block::<X2<L>, $ndf, $strat, BOTH>(l, p, inp, out),
-            }
-        };
-    }
-    match (*ndf, *strat) {
-        (BECKMANN, VNDF) => by_mode!(BECKMANN, VNDF),
-        _ => unreachable!("runs_x2 admits only these"),
-    }
+    instances_x2!(k, eval_pdf_one, l, mode, inp, out)
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
 fn sample_avx2(l: Avx2, k: &Kernel, inp: SampleIn<'_>, out: SampleOut<'_, '_>) {
     if runs_x2(k, false) {
-        sample_x2(X2(l), k, inp, out);
+        instances_x2!(k, sample_one_avx2, l, inp, out)
     } else {
-        sample_level(l, k, inp, out);
+        instances!(k, sample_one_avx2, l, inp, out)
     }
 }
 
@@ -482,9 +527,9 @@ fn sample_avx2(l: Avx2, k: &Kernel, inp: SampleIn<'_>, out: SampleOut<'_, '_>) {
 #[target_feature(enable = "avx512f,avx512dq,avx512bw,avx512vl,avx2,fma")]
 fn sample_avx512(l: Avx512, k: &Kernel, inp: SampleIn<'_>, out: SampleOut<'_, '_>) {
     if runs_x2(k, false) {
-        sample_x2(X2(l), k, inp, out);
+        instances_x2!(k, sample_inl, l, inp, out)
     } else {
-        sample_level(l, k, inp, out);
+        instances!(k, sample_one_avx512, l, inp, out)
     }
 }
 
@@ -492,9 +537,9 @@ fn sample_avx512(l: Avx512, k: &Kernel, inp: SampleIn<'_>, out: SampleOut<'_, '_
 #[target_feature(enable = "avx2,fma")]
 fn eval_pdf_avx2(l: Avx2, k: &Kernel, mode: u8, inp: EvalIn<'_>, out: EvalOut<'_, '_>) {
     if runs_x2(k, true) {
-        eval_pdf_x2(X2(l), k, mode, inp, out);
+        instances_x2!(k, eval_pdf_one_avx2, l, mode, inp, out)
     } else {
-        eval_pdf_level(l, k, mode, inp, out);
+        instances!(k, eval_pdf_one_avx2, l, mode, inp, out)
     }
 }
 
@@ -502,9 +547,9 @@ fn eval_pdf_avx2(l: Avx2, k: &Kernel, mode: u8, inp: EvalIn<'_>, out: EvalOut<'_
 #[target_feature(enable = "avx512f,avx512dq,avx512bw,avx512vl,avx2,fma")]
 fn eval_pdf_avx512(l: Avx512, k: &Kernel, mode: u8, inp: EvalIn<'_>, out: EvalOut<'_, '_>) {
     if runs_x2(k, true) {
-        eval_pdf_x2(X2(l), k, mode, inp, out);
+        instances_x2!(k, eval_pdf_one_avx512, l, mode, inp, out)
     } else {
-        eval_pdf_level(l, k, mode, inp, out);
+        instances!(k, eval_pdf_one_avx512, l, mode, inp, out)
     }
 }
 

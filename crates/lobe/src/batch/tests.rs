@@ -871,7 +871,7 @@ fn batch_chi2() {
 #[test]
 fn two_vectors_at_a_time_give_the_same_bits() {
     use super::dispatch::{self as d, Kernel};
-    use super::lanes::{Scalar, X2};
+    use super::lanes::Scalar;
     let mut rng = Pcg64::seed_from_u64(0x7832);
     let n = 4097;
     let mut inp: [Vec<f32>; 6] = Default::default();
@@ -929,7 +929,7 @@ fn two_vectors_at_a_time_give_the_same_bits() {
             {
                 let mut o = out.each_mut().map(|v| &mut v[..]);
                 if x2 {
-                    d::sample_x2(X2(Scalar), k, ins, (&mut o, &mut valid));
+                    d::sample_x2(Scalar, k, ins, (&mut o, &mut valid));
                 } else {
                     d::sample_level(Scalar, k, ins, (&mut o, &mut valid));
                 }
@@ -945,7 +945,7 @@ fn two_vectors_at_a_time_give_the_same_bits() {
                 ];
                 let mut e = ev.each_mut().map(|v| &mut v[..]);
                 if x2 && d::runs_x2(k, true) {
-                    d::eval_pdf_x2(X2(Scalar), k, d::BOTH, ein, &mut e);
+                    d::eval_pdf_x2(Scalar, k, d::BOTH, ein, &mut e);
                 } else {
                     d::eval_pdf_level(Scalar, k, d::BOTH, ein, &mut e);
                 }
