@@ -261,11 +261,15 @@ fn given_models(specs: &[String]) -> Result<Vec<Model>> {
                 ),
                 None => name.to_string(),
             };
-            let family = match (name, m.measured()) {
+            let family = match (&m.glossy, m.measured()) {
                 (_, Some(_)) => "measured",
-                ("phong", _) => "phong",
-                ("blinn-phong", _) => "blinn-phong",
-                ("cook-torrance", _) => "ggx",
+                (lobe::Glossy::Phong(_), _) => "phong",
+                (lobe::Glossy::BlinnPhong(_), _) => "blinn-phong",
+                (lobe::Glossy::CookTorrance(ct), _) => match ct.microfacet.ndf() {
+                    lobe::Ndf::Ggx => "ggx",
+                    lobe::Ndf::Beckmann => "beckmann",
+                    lobe::Ndf::BlinnPhong => "microfacet",
+                },
                 _ => "other",
             };
             let mut intro = format!(
@@ -1280,7 +1284,7 @@ fn warp_note(model: &Model, s: BsdfStrategy) -> &'static str {
              Jacobian 1/(4&thinsp;ω<sub>o</sub>·h) of the reflection. Without it the right map \
              would not match the left one."
         }
-        ("ggx", BsdfStrategy::Vndf) => {
+        ("ggx" | "beckmann", BsdfStrategy::Vndf) => {
             " VNDF draws only normals that face the viewer, so fewer of its samples are lost \
              than with <code>brdf</code> (the tables give the lost fraction at every view)."
         }
@@ -1406,8 +1410,8 @@ fn page(
 fn reference_methods(results: &[ModelResult]) -> String {
     let mut v: Vec<&str> = Vec::new();
     for p in results.iter().flat_map(|r| &r.points) {
-        if !v.contains(&p.table.reference_method) {
-            v.push(p.table.reference_method);
+        if !v.contains(&p.table.reference_method.as_str()) {
+            v.push(&p.table.reference_method);
         }
     }
     esc(&v.join("; "))

@@ -252,21 +252,38 @@ fn sample_block<L: Lanes, const NDF: u8, const STRAT: u8>(
         assert_eq!(o.len(), n);
     }
     assert_eq!(valid.len(), n);
+    // The whole vectors through pointers taken once: slices re-read from
+    // `out` and bounds-checked at every vector cost about 110 instructions
+    // per 8-lane vector of GGX brdf (callgrind, AVX2), a sixth of its work.
+    let ip = inp.map(<[f32]>::as_ptr);
+    let op = out.each_mut().map(|o| o.as_mut_ptr());
+    let vp = valid.as_mut_ptr();
+    let two = p.two_lobes();
     let mut k = 0;
     while k + L::N <= n {
-        let s = run_sample::<L, NDF, STRAT>(
-            l,
-            p,
-            [
-                &inp[0][k..],
-                &inp[1][k..],
-                &inp[2][k..],
-                &inp[3][k..],
-                &inp[4][k..],
-                &inp[5][k..],
-            ],
-        );
-        store_sampled(l, &s, out, valid, k);
+        // SAFETY: every input and output holds `n` values (asserted above)
+        // and `k + L::N <= n`; the outputs are distinct `&mut` slices.
+        unsafe {
+            let x = |i: usize| l.load_ptr(ip[i].add(k));
+            let uc = if two { x(5) } else { l.splat(0.5) };
+            let s = p.sample::<L, NDF, STRAT>(l, [x(0), x(1), x(2)], x(3), x(4), uc);
+            let values = [
+                s.wi[0],
+                s.wi[1],
+                s.wi[2],
+                s.f[0],
+                s.f[1],
+                s.f[2],
+                s.pdf,
+                s.weight[0],
+                s.weight[1],
+                s.weight[2],
+            ];
+            for (o, v) in op.iter().zip(values) {
+                l.store_ptr(v, o.add(k));
+            }
+            l.store_mask_ptr(s.valid, vp.add(k));
+        }
         k += L::N;
     }
     if k < n {
@@ -314,17 +331,25 @@ fn eval_pdf_block<L: Lanes, const NDF: u8, const STRAT: u8>(
         let written = if i == 3 { writes.1 } else { writes.0 };
         assert!(!written || o.len() == n);
     }
+    // Pointers taken once, as in `sample_block`.
+    let ip = inp.map(<[f32]>::as_ptr);
+    let op = out.each_mut().map(|o| o.as_mut_ptr());
     let mut k = 0;
     while k + L::N <= n {
-        let x = [
-            &inp[0][k..],
-            &inp[1][k..],
-            &inp[2][k..],
-            &inp[3][k..],
-            &inp[4][k..],
-            &inp[5][k..],
-        ];
-        run_eval_pdf::<L, NDF, STRAT>(l, p, x, out, k, writes);
+        // SAFETY: every input holds `n` values, every output written holds
+        // `n` (asserted above), and `k + L::N <= n`.
+        unsafe {
+            let x = |i: usize| l.load_ptr(ip[i].add(k));
+            let (f, pdf) = p.eval_pdf::<L, NDF, STRAT>(l, [x(0), x(1), x(2)], [x(3), x(4), x(5)]);
+            if writes.0 {
+                l.store_ptr(f[0], op[0].add(k));
+                l.store_ptr(f[1], op[1].add(k));
+                l.store_ptr(f[2], op[2].add(k));
+            }
+            if writes.1 {
+                l.store_ptr(pdf, op[3].add(k));
+            }
+        }
         k += L::N;
     }
     if k < n {

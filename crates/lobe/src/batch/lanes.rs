@@ -34,13 +34,43 @@ pub(crate) trait Lanes: Copy {
     type M: Copy + BitAnd<Output = Self::M> + BitOr<Output = Self::M> + Not<Output = Self::M>;
 
     fn splat(self, x: f32) -> Self::F;
+    /// The `N` values at `p`.
+    ///
+    /// # Safety
+    /// `p` points at `N` readable `f32`.
+    unsafe fn load_ptr(self, p: *const f32) -> Self::F;
+    /// Into the `N` values at `p`.
+    ///
+    /// # Safety
+    /// `p` points at `N` writable `f32`.
+    unsafe fn store_ptr(self, v: Self::F, p: *mut f32);
+    /// `1` where the mask is set, `0` elsewhere, into the `N` bytes at `p`.
+    ///
+    /// # Safety
+    /// `p` points at `N` writable bytes.
+    unsafe fn store_mask_ptr(self, m: Self::M, p: *mut u8);
     /// The first `N` values of `s` (panics if shorter; the kernels never
     /// pass a shorter slice).
-    fn load(self, s: &[f32]) -> Self::F;
+    #[inline(always)]
+    fn load(self, s: &[f32]) -> Self::F {
+        let s = &s[..Self::N];
+        // SAFETY: `s` holds `N` readable f32.
+        unsafe { self.load_ptr(s.as_ptr()) }
+    }
     /// Into the first `N` values of `s`.
-    fn store(self, v: Self::F, s: &mut [f32]);
+    #[inline(always)]
+    fn store(self, v: Self::F, s: &mut [f32]) {
+        let s = &mut s[..Self::N];
+        // SAFETY: `s` holds `N` writable f32.
+        unsafe { self.store_ptr(v, s.as_mut_ptr()) }
+    }
     /// `1` where the mask is set, `0` elsewhere, into the first `N` bytes.
-    fn store_mask(self, m: Self::M, s: &mut [u8]);
+    #[inline(always)]
+    fn store_mask(self, m: Self::M, s: &mut [u8]) {
+        let s = &mut s[..Self::N];
+        // SAFETY: `s` holds `N` writable bytes.
+        unsafe { self.store_mask_ptr(m, s.as_mut_ptr()) }
+    }
     /// `a · b + c`, rounded once.
     fn mul_add(self, a: Self::F, b: Self::F, c: Self::F) -> Self::F;
     fn sqrt(self, a: Self::F) -> Self::F;
@@ -99,16 +129,19 @@ impl Lanes for Scalar {
         x
     }
     #[inline(always)]
-    fn load(self, s: &[f32]) -> f32 {
-        s[0]
+    unsafe fn load_ptr(self, p: *const f32) -> f32 {
+        // SAFETY: the caller's contract.
+        unsafe { *p }
     }
     #[inline(always)]
-    fn store(self, v: f32, s: &mut [f32]) {
-        s[0] = v;
+    unsafe fn store_ptr(self, v: f32, p: *mut f32) {
+        // SAFETY: the caller's contract.
+        unsafe { *p = v }
     }
     #[inline(always)]
-    fn store_mask(self, m: bool, s: &mut [u8]) {
-        s[0] = u8::from(m);
+    unsafe fn store_mask_ptr(self, m: bool, p: *mut u8) {
+        // SAFETY: the caller's contract.
+        unsafe { *p = u8::from(m) }
     }
     #[inline(always)]
     fn mul_add(self, a: f32, b: f32, c: f32) -> f32 {
@@ -255,21 +288,18 @@ mod x86 {
             F8(unsafe { _mm256_set1_ps(x) })
         }
         #[inline(always)]
-        fn load(self, s: &[f32]) -> F8 {
-            let s = &s[..8];
-            // SAFETY: the token proves AVX2; `s` holds 8 readable f32.
-            F8(unsafe { _mm256_loadu_ps(s.as_ptr()) })
+        unsafe fn load_ptr(self, p: *const f32) -> F8 {
+            // SAFETY: the token proves AVX2; the caller, that `p` holds 8 readable f32.
+            F8(unsafe { _mm256_loadu_ps(p) })
         }
         #[inline(always)]
-        fn store(self, v: F8, s: &mut [f32]) {
-            let s = &mut s[..8];
-            // SAFETY: the token proves AVX2; `s` holds 8 writable f32.
-            unsafe { _mm256_storeu_ps(s.as_mut_ptr(), v.0) }
+        unsafe fn store_ptr(self, v: F8, p: *mut f32) {
+            // SAFETY: the token proves AVX2; the caller, that `p` holds 8 writable f32.
+            unsafe { _mm256_storeu_ps(p, v.0) }
         }
         #[inline(always)]
-        fn store_mask(self, m: M8, s: &mut [u8]) {
-            let s = &mut s[..8];
-            // SAFETY: the token proves AVX2; `s` holds 8 writable bytes. A
+        unsafe fn store_mask_ptr(self, m: M8, p: *mut u8) {
+            // SAFETY: the token proves AVX2; the caller, that `p` holds 8 writable bytes. A
             // mask lane is all ones or all zeros (compares and their bitwise
             // combinations), so the saturating packs give −1 or 0 per byte.
             unsafe {
@@ -277,7 +307,7 @@ mod x86 {
                 let w =
                     _mm_packs_epi32(_mm256_castsi256_si128(v), _mm256_extracti128_si256::<1>(v));
                 let b = _mm_and_si128(_mm_packs_epi16(w, w), _mm_set1_epi8(1));
-                _mm_storel_epi64(s.as_mut_ptr().cast(), b);
+                _mm_storel_epi64(p.cast(), b);
             }
         }
         #[inline(always)]
@@ -454,25 +484,22 @@ mod x86 {
             F16(unsafe { _mm512_set1_ps(x) })
         }
         #[inline(always)]
-        fn load(self, s: &[f32]) -> F16 {
-            let s = &s[..16];
-            // SAFETY: the token proves AVX-512F; `s` holds 16 readable f32.
-            F16(unsafe { _mm512_loadu_ps(s.as_ptr()) })
+        unsafe fn load_ptr(self, p: *const f32) -> F16 {
+            // SAFETY: the token proves AVX-512F; the caller, that `p` holds 16 readable f32.
+            F16(unsafe { _mm512_loadu_ps(p) })
         }
         #[inline(always)]
-        fn store(self, v: F16, s: &mut [f32]) {
-            let s = &mut s[..16];
-            // SAFETY: the token proves AVX-512F; `s` holds 16 writable f32.
-            unsafe { _mm512_storeu_ps(s.as_mut_ptr(), v.0) }
+        unsafe fn store_ptr(self, v: F16, p: *mut f32) {
+            // SAFETY: the token proves AVX-512F; the caller, that `p` holds 16 writable f32.
+            unsafe { _mm512_storeu_ps(p, v.0) }
         }
         #[inline(always)]
-        fn store_mask(self, m: M16, s: &mut [u8]) {
-            let s = &mut s[..16];
-            // SAFETY: the token proves AVX-512BW and VL; `s` holds 16
-            // writable bytes.
+        unsafe fn store_mask_ptr(self, m: M16, p: *mut u8) {
+            // SAFETY: the token proves AVX-512BW and VL; the caller, that
+            // `p` holds 16 writable bytes.
             unsafe {
                 let v = _mm_maskz_mov_epi8(m.0, _mm_set1_epi8(1));
-                _mm_storeu_si128(s.as_mut_ptr().cast(), v);
+                _mm_storeu_si128(p.cast(), v);
             }
         }
         #[inline(always)]
@@ -628,18 +655,25 @@ impl<L: Lanes> Lanes for X2<L> {
         Pair(v, v)
     }
     #[inline(always)]
-    fn load(self, s: &[f32]) -> Self::F {
-        Pair(self.0.load(s), self.0.load(&s[L::N..]))
+    unsafe fn load_ptr(self, p: *const f32) -> Self::F {
+        // SAFETY: the caller's `2 L::N` values are two runs of `L::N`.
+        unsafe { Pair(self.0.load_ptr(p), self.0.load_ptr(p.add(L::N))) }
     }
     #[inline(always)]
-    fn store(self, v: Self::F, s: &mut [f32]) {
-        self.0.store(v.0, s);
-        self.0.store(v.1, &mut s[L::N..]);
+    unsafe fn store_ptr(self, v: Self::F, p: *mut f32) {
+        // SAFETY: as for `load_ptr`.
+        unsafe {
+            self.0.store_ptr(v.0, p);
+            self.0.store_ptr(v.1, p.add(L::N));
+        }
     }
     #[inline(always)]
-    fn store_mask(self, m: Self::M, s: &mut [u8]) {
-        self.0.store_mask(m.0, s);
-        self.0.store_mask(m.1, &mut s[L::N..]);
+    unsafe fn store_mask_ptr(self, m: Self::M, p: *mut u8) {
+        // SAFETY: as for `load_ptr`.
+        unsafe {
+            self.0.store_mask_ptr(m.0, p);
+            self.0.store_mask_ptr(m.1, p.add(L::N));
+        }
     }
     #[inline(always)]
     fn mul_add(self, a: Self::F, b: Self::F, c: Self::F) -> Self::F {

@@ -98,7 +98,7 @@ pub struct Table {
     /// `L_o` by deterministic quadrature (RGB, f64).
     pub reference: [f64; 3],
     /// How the reference was computed, in words.
-    pub reference_method: &'static str,
+    pub reference_method: String,
     /// The sequence's name.
     pub sequence: String,
     /// How the standard errors were computed.
@@ -113,19 +113,28 @@ pub struct Table {
     pub strategies: Vec<Row>,
 }
 
-/// How [`run_table`] computes its reference, in words.
+/// How [`run_table`] computes its reference, in words, with the
+/// tolerances it uses ([`REFERENCE_TOLERANCE`]; for a measured table
+/// [`crate::estimator::TABLE_REFERENCE_TOLERANCE`] within
+/// [`crate::estimator::TABLE_REFERENCE_MAX_EVALS`]).
 #[must_use]
-pub fn reference_method(m: &Material, light: &Light) -> &'static str {
+pub fn reference_method(m: &Material, light: &Light) -> String {
+    use crate::estimator::{TABLE_REFERENCE_MAX_EVALS, TABLE_REFERENCE_TOLERANCE};
+    let rel = REFERENCE_TOLERANCE;
     match (light, m.measured().is_some()) {
-        (Light::Env(_), _) => {
-            "a sum over the map's texels of radiance × ∫ f cos dω (4×4 Gauss-Legendre per texel, refined to 1e-9 relative, f64)"
-        }
+        (Light::Env(_), _) => format!(
+            "a sum over the map's texels of radiance × ∫ f cos dω (4×4 Gauss-Legendre per texel, refined to {rel:e} relative, f64)"
+        ),
         (_, false) => {
-            "deterministic adaptive quadrature (Gauss-Kronrod, f64, relative tolerance 1e-9)"
+            format!(
+                "deterministic adaptive quadrature (Gauss-Kronrod, f64, relative tolerance {rel:e})"
+            )
         }
-        (_, true) => {
-            "deterministic adaptive quadrature (Gauss-Kronrod, f64, relative tolerance 1e-6 within 2·10⁶ evaluations per channel: a measured table is piecewise smooth)"
-        }
+        (_, true) => format!(
+            "deterministic adaptive quadrature (Gauss-Kronrod, f64, relative tolerance {:e} within {} evaluations per channel: a measured table is piecewise smooth)",
+            rel.max(TABLE_REFERENCE_TOLERANCE),
+            TABLE_REFERENCE_MAX_EVALS
+        ),
     }
 }
 
@@ -329,6 +338,26 @@ mod tests {
             samples,
             seed: 1,
         }
+    }
+
+    /// The method's words carry the tolerances the reference is computed
+    /// with, not numbers of their own.
+    #[test]
+    fn reference_method_names_the_tolerances_used() {
+        use crate::estimator::{TABLE_REFERENCE_MAX_EVALS, TABLE_REFERENCE_TOLERANCE};
+        use crate::models::measured::{Measured, merl::Merl};
+        let lambert = Material::lambert(Rgb::splat(0.8)).unwrap();
+        let text = reference_method(&lambert, &Light::Constant(Rgb::ONE));
+        assert!(text.contains(&format!("{REFERENCE_TOLERANCE:e}")), "{text}");
+        let bytes = Merl::from_fn(|o, i| lambert.eval(o, i), |_| false).to_bytes();
+        let table = Measured::from_bytes(&bytes, std::path::Path::new("t.binary"), None).unwrap();
+        let m = Material::with_diffuse(Rgb::ZERO, crate::Glossy::Measured(table)).unwrap();
+        let text = reference_method(&m, &Light::Constant(Rgb::ONE));
+        let tol = REFERENCE_TOLERANCE.max(TABLE_REFERENCE_TOLERANCE);
+        assert!(
+            text.contains(&format!("{tol:e} within {TABLE_REFERENCE_MAX_EVALS}")),
+            "{text}"
+        );
     }
 
     /// A Lambert furnace: `L_o` is the albedo, cosine sampling has zero
