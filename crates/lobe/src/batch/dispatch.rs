@@ -167,75 +167,78 @@ pub(crate) type EvalIn<'a> = [&'a [f32]; 6];
 /// may be empty).
 pub(crate) type EvalOut<'a, 'b> = &'b mut [&'a mut [f32]; 4];
 
+/// One vector of `sample` from the `L::N` values at `ip[i] + k`, stored at
+/// `op[j] + k` and `vp + k` (`uc`, `ip[5]`, read only where `two`).
+///
+/// # Safety
+/// Each `ip[i]`, `op[j]` and `vp` points at `k + L::N` values; the outputs
+/// do not overlap each other or the inputs.
 #[inline(always)]
-fn store_sampled<L: Lanes>(
-    l: L,
-    s: &Sampled<L>,
-    out: &mut [&mut [f32]; 10],
-    valid: &mut [u8],
-    k: usize,
-) {
-    let values = [
-        s.wi[0],
-        s.wi[1],
-        s.wi[2],
-        s.f[0],
-        s.f[1],
-        s.f[2],
-        s.pdf,
-        s.weight[0],
-        s.weight[1],
-        s.weight[2],
-    ];
-    for (o, v) in out.iter_mut().zip(values) {
-        l.store(v, &mut o[k..]);
-    }
-    l.store_mask(s.valid, &mut valid[k..]);
-}
-
-/// One vector of samples from the first `L::N` values of each input.
-#[inline(always)]
-fn run_sample<L: Lanes, const NDF: u8, const STRAT: u8>(
+unsafe fn sample_vector<L: Lanes, const NDF: u8, const STRAT: u8>(
     l: L,
     p: &impl VecKernel,
-    x: [&[f32]; 6],
-) -> Sampled<L> {
-    p.sample::<L, NDF, STRAT>(
-        l,
-        [l.load(x[0]), l.load(x[1]), l.load(x[2])],
-        l.load(x[3]),
-        l.load(x[4]),
-        if p.two_lobes() {
-            l.load(x[5])
-        } else {
-            l.splat(0.5)
-        },
-    )
+    two: bool,
+    (ip, op, vp): (&[*const f32; 6], &[*mut f32; 10], *mut u8),
+    k: usize,
+) {
+    // SAFETY: the caller's contract.
+    unsafe {
+        let x = |i: usize| l.load_ptr(ip[i].add(k));
+        let uc = if two { x(5) } else { l.splat(0.5) };
+        let s = p.sample::<L, NDF, STRAT>(l, [x(0), x(1), x(2)], x(3), x(4), uc);
+        let values = [
+            s.wi[0],
+            s.wi[1],
+            s.wi[2],
+            s.f[0],
+            s.f[1],
+            s.f[2],
+            s.pdf,
+            s.weight[0],
+            s.weight[1],
+            s.weight[2],
+        ];
+        for (o, v) in op.iter().zip(values) {
+            l.store_ptr(v, o.add(k));
+        }
+        l.store_mask_ptr(s.valid, vp.add(k));
+    }
 }
 
-/// One vector of `eval_pdf`, stored at `k` (`f` if `wf`, the pdf if `wp`).
+/// One vector of `eval_pdf` from the `L::N` values at `ip[i] + k`: `f` at
+/// `op[0..3] + k` if `writes.0`, the pdf at `op[3] + k` if `writes.1`.
+///
+/// # Safety
+/// Each `ip[i]` and each `op[j]` written points at `k + L::N` values; the
+/// outputs do not overlap each other or the inputs.
 #[inline(always)]
-fn run_eval_pdf<L: Lanes, const NDF: u8, const STRAT: u8>(
+unsafe fn eval_pdf_vector<L: Lanes, const NDF: u8, const STRAT: u8>(
     l: L,
     p: &impl VecKernel,
-    x: [&[f32]; 6],
-    out: &mut [&mut [f32]; 4],
+    (ip, op): (&[*const f32; 6], &[*mut f32; 4]),
+    writes: (bool, bool),
     k: usize,
-    (wf, wp): (bool, bool),
 ) {
-    let wo = [l.load(x[0]), l.load(x[1]), l.load(x[2])];
-    let wi = [l.load(x[3]), l.load(x[4]), l.load(x[5])];
-    let (f, pdf) = p.eval_pdf::<L, NDF, STRAT>(l, wo, wi);
-    if wf {
-        l.store(f[0], &mut out[0][k..]);
-        l.store(f[1], &mut out[1][k..]);
-        l.store(f[2], &mut out[2][k..]);
-    }
-    if wp {
-        l.store(pdf, &mut out[3][k..]);
+    // SAFETY: the caller's contract.
+    unsafe {
+        let x = |i: usize| l.load_ptr(ip[i].add(k));
+        let (f, pdf) = p.eval_pdf::<L, NDF, STRAT>(l, [x(0), x(1), x(2)], [x(3), x(4), x(5)]);
+        if writes.0 {
+            l.store_ptr(f[0], op[0].add(k));
+            l.store_ptr(f[1], op[1].add(k));
+            l.store_ptr(f[2], op[2].add(k));
+        }
+        if writes.1 {
+            l.store_ptr(pdf, op[3].add(k));
+        }
     }
 }
 
+/// `sample` over a block: whole vectors straight from and into the slices,
+/// through pointers taken once (slices re-read from `out` and
+/// bounds-checked at every vector cost about 110 instructions per 8-lane
+/// vector of GGX brdf, callgrind, AVX2: a sixth of its work); the last,
+/// partial vector through padded stack buffers.
 #[inline(always)]
 fn sample_block<L: Lanes, const NDF: u8, const STRAT: u8>(
     l: L,
@@ -244,7 +247,6 @@ fn sample_block<L: Lanes, const NDF: u8, const STRAT: u8>(
     (out, valid): SampleOut<'_, '_>,
 ) {
     let n = inp[0].len();
-    // Equal lengths, stated once: the bounds checks in the loop fold away.
     for s in &inp {
         assert_eq!(s.len(), n);
     }
@@ -252,38 +254,17 @@ fn sample_block<L: Lanes, const NDF: u8, const STRAT: u8>(
         assert_eq!(o.len(), n);
     }
     assert_eq!(valid.len(), n);
-    // The whole vectors through pointers taken once: slices re-read from
-    // `out` and bounds-checked at every vector cost about 110 instructions
-    // per 8-lane vector of GGX brdf (callgrind, AVX2), a sixth of its work.
-    let ip = inp.map(<[f32]>::as_ptr);
-    let op = out.each_mut().map(|o| o.as_mut_ptr());
-    let vp = valid.as_mut_ptr();
     let two = p.two_lobes();
+    let ptrs = (
+        &inp.map(<[f32]>::as_ptr),
+        &out.each_mut().map(|o| o.as_mut_ptr()),
+        valid.as_mut_ptr(),
+    );
     let mut k = 0;
     while k + L::N <= n {
         // SAFETY: every input and output holds `n` values (asserted above)
         // and `k + L::N <= n`; the outputs are distinct `&mut` slices.
-        unsafe {
-            let x = |i: usize| l.load_ptr(ip[i].add(k));
-            let uc = if two { x(5) } else { l.splat(0.5) };
-            let s = p.sample::<L, NDF, STRAT>(l, [x(0), x(1), x(2)], x(3), x(4), uc);
-            let values = [
-                s.wi[0],
-                s.wi[1],
-                s.wi[2],
-                s.f[0],
-                s.f[1],
-                s.f[2],
-                s.pdf,
-                s.weight[0],
-                s.weight[1],
-                s.weight[2],
-            ];
-            for (o, v) in op.iter().zip(values) {
-                l.store_ptr(v, o.add(k));
-            }
-            l.store_mask_ptr(s.valid, vp.add(k));
-        }
+        unsafe { sample_vector::<L, NDF, STRAT>(l, p, two, ptrs, k) };
         k += L::N;
     }
     if k < n {
@@ -300,13 +281,15 @@ fn sample_block<L: Lanes, const NDF: u8, const STRAT: u8>(
         for (b, s) in ib.iter_mut().zip(inp) {
             b[..rem].copy_from_slice(&s[k..]);
         }
-        let s = run_sample::<L, NDF, STRAT>(l, p, [&ib[0], &ib[1], &ib[2], &ib[3], &ib[4], &ib[5]]);
         let mut ob = [[0.0f32; MAX_LANES]; 10];
         let mut vb = [0u8; MAX_LANES];
-        {
-            let mut refs = ob.each_mut().map(|a| &mut a[..]);
-            store_sampled(l, &s, &mut refs, &mut vb, 0);
-        }
+        let bptrs = (
+            &ib.each_ref().map(|b| b.as_ptr()),
+            &ob.each_mut().map(|b| b.as_mut_ptr()),
+            vb.as_mut_ptr(),
+        );
+        // SAFETY: the buffers hold `MAX_LANES ≥ L::N` values each.
+        unsafe { sample_vector::<L, NDF, STRAT>(l, p, two, bptrs, 0) };
         for (o, b) in out.iter_mut().zip(&ob) {
             o[k..].copy_from_slice(&b[..rem]);
         }
@@ -314,6 +297,7 @@ fn sample_block<L: Lanes, const NDF: u8, const STRAT: u8>(
     }
 }
 
+/// `eval_pdf` over a block, as [`sample_block`], writing what `mode` names.
 #[inline(always)]
 fn eval_pdf_block<L: Lanes, const NDF: u8, const STRAT: u8>(
     l: L,
@@ -327,33 +311,24 @@ fn eval_pdf_block<L: Lanes, const NDF: u8, const STRAT: u8>(
         assert_eq!(s.len(), n);
     }
     let writes = (mode != PDF_ONLY, mode != F_ONLY);
+    let written = |i: usize| if i == 3 { writes.1 } else { writes.0 };
     for (i, o) in out.iter().enumerate() {
-        let written = if i == 3 { writes.1 } else { writes.0 };
-        assert!(!written || o.len() == n);
+        assert!(!written(i) || o.len() == n);
     }
-    // Pointers taken once, as in `sample_block`.
-    let ip = inp.map(<[f32]>::as_ptr);
-    let op = out.each_mut().map(|o| o.as_mut_ptr());
+    let ptrs = (
+        &inp.map(<[f32]>::as_ptr),
+        &out.each_mut().map(|o| o.as_mut_ptr()),
+    );
     let mut k = 0;
     while k + L::N <= n {
         // SAFETY: every input holds `n` values, every output written holds
         // `n` (asserted above), and `k + L::N <= n`.
-        unsafe {
-            let x = |i: usize| l.load_ptr(ip[i].add(k));
-            let (f, pdf) = p.eval_pdf::<L, NDF, STRAT>(l, [x(0), x(1), x(2)], [x(3), x(4), x(5)]);
-            if writes.0 {
-                l.store_ptr(f[0], op[0].add(k));
-                l.store_ptr(f[1], op[1].add(k));
-                l.store_ptr(f[2], op[2].add(k));
-            }
-            if writes.1 {
-                l.store_ptr(pdf, op[3].add(k));
-            }
-        }
+        unsafe { eval_pdf_vector::<L, NDF, STRAT>(l, p, ptrs, writes, k) };
         k += L::N;
     }
     if k < n {
         let rem = n - k;
+        // Padding: wo = wi = +z.
         let mut ib = [[0.0f32; MAX_LANES]; 6];
         ib[2] = [1.0; MAX_LANES];
         ib[5] = [1.0; MAX_LANES];
@@ -361,20 +336,14 @@ fn eval_pdf_block<L: Lanes, const NDF: u8, const STRAT: u8>(
             b[..rem].copy_from_slice(&s[k..]);
         }
         let mut ob = [[0.0f32; MAX_LANES]; 4];
-        {
-            let mut refs = ob.each_mut().map(|a| &mut a[..]);
-            let x = [
-                &ib[0][..],
-                &ib[1][..],
-                &ib[2][..],
-                &ib[3][..],
-                &ib[4][..],
-                &ib[5][..],
-            ];
-            run_eval_pdf::<L, NDF, STRAT>(l, p, x, &mut refs, 0, (true, true));
-        }
+        let bptrs = (
+            &ib.each_ref().map(|b| b.as_ptr()),
+            &ob.each_mut().map(|b| b.as_mut_ptr()),
+        );
+        // SAFETY: the buffers hold `MAX_LANES ≥ L::N` values each.
+        unsafe { eval_pdf_vector::<L, NDF, STRAT>(l, p, bptrs, writes, 0) };
         for (i, (o, b)) in out.iter_mut().zip(&ob).enumerate() {
-            if (i == 3 && writes.1) || (i < 3 && writes.0) {
+            if written(i) {
                 o[k..].copy_from_slice(&b[..rem]);
             }
         }

@@ -49,27 +49,23 @@ pub(crate) trait Lanes: Copy {
     /// # Safety
     /// `p` points at `N` writable bytes.
     unsafe fn store_mask_ptr(self, m: Self::M, p: *mut u8);
-    /// The first `N` values of `s` (panics if shorter; the kernels never
-    /// pass a shorter slice).
+    /// The first `N` values of `s` (panics if shorter). The block loops
+    /// use [`Lanes::load_ptr`]; this checked form serves the accuracy tests.
+    #[cfg(test)]
     #[inline(always)]
     fn load(self, s: &[f32]) -> Self::F {
         let s = &s[..Self::N];
         // SAFETY: `s` holds `N` readable f32.
         unsafe { self.load_ptr(s.as_ptr()) }
     }
-    /// Into the first `N` values of `s`.
+    /// Into the first `N` values of `s` (panics if shorter; for the tests,
+    /// as [`Lanes::load`]).
+    #[cfg(test)]
     #[inline(always)]
     fn store(self, v: Self::F, s: &mut [f32]) {
         let s = &mut s[..Self::N];
         // SAFETY: `s` holds `N` writable f32.
         unsafe { self.store_ptr(v, s.as_mut_ptr()) }
-    }
-    /// `1` where the mask is set, `0` elsewhere, into the first `N` bytes.
-    #[inline(always)]
-    fn store_mask(self, m: Self::M, s: &mut [u8]) {
-        let s = &mut s[..Self::N];
-        // SAFETY: `s` holds `N` writable bytes.
-        unsafe { self.store_mask_ptr(m, s.as_mut_ptr()) }
     }
     /// `a · b + c`, rounded once.
     fn mul_add(self, a: Self::F, b: Self::F, c: Self::F) -> Self::F;
