@@ -144,6 +144,9 @@ def test_failed_samples_are_zero_and_evaluate_to_zero():
     assert np.all(s.wi[~s.valid] == 0) and np.all(s.pdf[~s.valid] == 0)
     f, p = m.eval_pdf(wo, s.wi, "brdf")
     assert np.all(p[~s.valid] == 0) and np.all(f[~s.valid] == 0)
+    # eval and pdf alone too (each its own kernel call).
+    assert np.all(m.eval(wo, s.wi)[~s.valid] == 0) and np.all(m.pdf(wo, s.wi, "brdf")[~s.valid] == 0)
+    assert np.array_equal(m.pdf(wo, s.wi, "brdf"), p)
 
 
 def test_errors_name_the_field():

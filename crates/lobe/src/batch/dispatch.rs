@@ -161,6 +161,16 @@ impl Backend {
 pub(crate) type SampleIn<'a> = [&'a [f32]; 6];
 /// Outputs of `sample`: `wi.xyz, f.rgb, pdf, weight.rgb`, and the mask.
 pub(crate) type SampleOut<'a, 'b> = (&'b mut [&'a mut [f32]; 10], &'b mut [u8]);
+/// How `sample` writes its outputs: `f` at all (its slices may be empty
+/// when not), and with streaming stores ([`Lanes::stream_ptr`]) or plain
+/// ones (a block streams only where every output it writes is aligned for
+/// the level). One branch a vector for each, not one per output: per-output
+/// choices cost GGX brdf's `eval_pdf` about 14 instructions per AVX2 vector.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct SampleWrites {
+    pub f: bool,
+    pub stream: bool,
+}
 /// Inputs of `eval_pdf`: `wo.xyz, wi.xyz`.
 pub(crate) type EvalIn<'a> = [&'a [f32]; 6];
 /// Outputs of `eval_pdf`: `f.rgb, pdf` (the ones the mode does not write
@@ -168,17 +178,20 @@ pub(crate) type EvalIn<'a> = [&'a [f32]; 6];
 pub(crate) type EvalOut<'a, 'b> = &'b mut [&'a mut [f32]; 4];
 
 /// One vector of `sample` from the `L::N` values at `ip[i] + k`, stored at
-/// `op[j] + k` and `vp + k` (`uc`, `ip[5]`, read only where `two`).
+/// `op[j] + k` (`f`, `op[3..6]`, only if `w.f`; streamed if `w.stream`) and
+/// `vp + k` (`uc`, `ip[5]`, read only where `two`).
 ///
 /// # Safety
-/// Each `ip[i]`, `op[j]` and `vp` points at `k + L::N` values; the outputs
-/// do not overlap each other or the inputs.
+/// Each `ip[i]`, `vp` and each `op[j]` written points at `k + L::N`
+/// values; the outputs do not overlap each other or the inputs; if
+/// `w.stream`, each `op[j] + k` written is aligned to `L::ALIGN` bytes.
 #[inline(always)]
 unsafe fn sample_vector<L: Lanes, const NDF: u8, const STRAT: u8>(
     l: L,
     p: &impl VecKernel,
     two: bool,
     (ip, op, vp): (&[*const f32; 6], &[*mut f32; 10], *mut u8),
+    w: SampleWrites,
     k: usize,
 ) {
     // SAFETY: the caller's contract.
@@ -186,33 +199,51 @@ unsafe fn sample_vector<L: Lanes, const NDF: u8, const STRAT: u8>(
         let x = |i: usize| l.load_ptr(ip[i].add(k));
         let uc = if two { x(5) } else { l.splat(0.5) };
         let s = p.sample::<L, NDF, STRAT>(l, [x(0), x(1), x(2)], x(3), x(4), uc);
-        let values = [
-            s.wi[0],
-            s.wi[1],
-            s.wi[2],
-            s.f[0],
-            s.f[1],
-            s.f[2],
-            s.pdf,
-            s.weight[0],
-            s.weight[1],
-            s.weight[2],
+        let main = [
+            (0, s.wi[0]),
+            (1, s.wi[1]),
+            (2, s.wi[2]),
+            (6, s.pdf),
+            (7, s.weight[0]),
+            (8, s.weight[1]),
+            (9, s.weight[2]),
         ];
-        for (o, v) in op.iter().zip(values) {
-            l.store_ptr(v, o.add(k));
+        let f = [(3, s.f[0]), (4, s.f[1]), (5, s.f[2])];
+        if w.stream {
+            for (j, v) in main {
+                l.stream_ptr(v, op[j].add(k));
+            }
+            if w.f {
+                for (j, v) in f {
+                    l.stream_ptr(v, op[j].add(k));
+                }
+            }
+        } else {
+            for (j, v) in main {
+                l.store_ptr(v, op[j].add(k));
+            }
+            if w.f {
+                for (j, v) in f {
+                    l.store_ptr(v, op[j].add(k));
+                }
+            }
         }
         l.store_mask_ptr(s.valid, vp.add(k));
     }
 }
 
 /// One vector of `eval_pdf` from the `L::N` values at `ip[i] + k`: `f` at
-/// `op[0..3] + k` if `writes.0`, the pdf at `op[3] + k` if `writes.1`.
+/// `op[0..3] + k` if `writes.0`, the pdf at `op[3] + k` if `writes.1`,
+/// streamed if `STREAM` (a const parameter: a run-time branch here cost
+/// GGX vndf's `eval_pdf` about 4% more instructions; the kernel is small
+/// enough to compile twice).
 ///
 /// # Safety
 /// Each `ip[i]` and each `op[j]` written points at `k + L::N` values; the
-/// outputs do not overlap each other or the inputs.
+/// outputs do not overlap each other or the inputs; if `STREAM`, each
+/// `op[j] + k` written is aligned to `L::ALIGN` bytes.
 #[inline(always)]
-unsafe fn eval_pdf_vector<L: Lanes, const NDF: u8, const STRAT: u8>(
+unsafe fn eval_pdf_vector<L: Lanes, const NDF: u8, const STRAT: u8, const STREAM: bool>(
     l: L,
     p: &impl VecKernel,
     (ip, op): (&[*const f32; 6], &[*mut f32; 4]),
@@ -223,35 +254,57 @@ unsafe fn eval_pdf_vector<L: Lanes, const NDF: u8, const STRAT: u8>(
     unsafe {
         let x = |i: usize| l.load_ptr(ip[i].add(k));
         let (f, pdf) = p.eval_pdf::<L, NDF, STRAT>(l, [x(0), x(1), x(2)], [x(3), x(4), x(5)]);
-        if writes.0 {
-            l.store_ptr(f[0], op[0].add(k));
-            l.store_ptr(f[1], op[1].add(k));
-            l.store_ptr(f[2], op[2].add(k));
-        }
-        if writes.1 {
-            l.store_ptr(pdf, op[3].add(k));
+        let f = [(0, f[0]), (1, f[1]), (2, f[2])];
+        if STREAM {
+            if writes.0 {
+                for (j, v) in f {
+                    l.stream_ptr(v, op[j].add(k));
+                }
+            }
+            if writes.1 {
+                l.stream_ptr(pdf, op[3].add(k));
+            }
+        } else {
+            if writes.0 {
+                for (j, v) in f {
+                    l.store_ptr(v, op[j].add(k));
+                }
+            }
+            if writes.1 {
+                l.store_ptr(pdf, op[3].add(k));
+            }
         }
     }
+}
+
+/// Whether `p` is aligned for [`Lanes::stream_ptr`] at `L`.
+#[inline(always)]
+fn aligned<L: Lanes>(p: *mut f32) -> bool {
+    (p as usize).is_multiple_of(L::ALIGN)
 }
 
 /// `sample` over a block: whole vectors straight from and into the slices,
 /// through pointers taken once (slices re-read from `out` and
 /// bounds-checked at every vector cost about 110 instructions per 8-lane
 /// vector of GGX brdf, callgrind, AVX2: a sixth of its work); the last,
-/// partial vector through padded stack buffers.
+/// partial vector through padded stack buffers. `f` is written only if
+/// `w.f`; the outputs are streamed (then fenced) if `w.stream` and every
+/// one written is aligned for `L`.
 #[inline(always)]
 fn sample_block<L: Lanes, const NDF: u8, const STRAT: u8>(
     l: L,
     p: &impl VecKernel,
     inp: SampleIn<'_>,
     (out, valid): SampleOut<'_, '_>,
+    w: SampleWrites,
 ) {
     let n = inp[0].len();
     for s in &inp {
         assert_eq!(s.len(), n);
     }
-    for o in out.iter() {
-        assert_eq!(o.len(), n);
+    let is_f = |j: usize| (3..6).contains(&j);
+    for (j, o) in out.iter().enumerate() {
+        assert!(o.len() == n || (!w.f && is_f(j)));
     }
     assert_eq!(valid.len(), n);
     let two = p.two_lobes();
@@ -260,12 +313,22 @@ fn sample_block<L: Lanes, const NDF: u8, const STRAT: u8>(
         &out.each_mut().map(|o| o.as_mut_ptr()),
         valid.as_mut_ptr(),
     );
+    let w = SampleWrites {
+        f: w.f,
+        stream: w.stream && (0..10).all(|j| (!w.f && is_f(j)) || aligned::<L>(ptrs.1[j])),
+    };
     let mut k = 0;
     while k + L::N <= n {
-        // SAFETY: every input and output holds `n` values (asserted above)
-        // and `k + L::N <= n`; the outputs are distinct `&mut` slices.
-        unsafe { sample_vector::<L, NDF, STRAT>(l, p, two, ptrs, k) };
+        // SAFETY: every input and every output written holds `n` values
+        // (asserted above) and `k + L::N <= n`; the outputs are distinct
+        // `&mut` slices; if streamed, each output written starts aligned
+        // to `L::ALIGN` bytes, and `k` is a multiple of `L::N` (`L::ALIGN`
+        // divides `4 L::N`).
+        unsafe { sample_vector::<L, NDF, STRAT>(l, p, two, ptrs, w, k) };
         k += L::N;
+    }
+    if w.stream {
+        l.fence();
     }
     if k < n {
         let rem = n - k;
@@ -289,15 +352,22 @@ fn sample_block<L: Lanes, const NDF: u8, const STRAT: u8>(
             vb.as_mut_ptr(),
         );
         // SAFETY: the buffers hold `MAX_LANES ≥ L::N` values each.
-        unsafe { sample_vector::<L, NDF, STRAT>(l, p, two, bptrs, 0) };
-        for (o, b) in out.iter_mut().zip(&ob) {
-            o[k..].copy_from_slice(&b[..rem]);
+        let plain = SampleWrites {
+            f: w.f,
+            stream: false,
+        };
+        unsafe { sample_vector::<L, NDF, STRAT>(l, p, two, bptrs, plain, 0) };
+        for (j, (o, b)) in out.iter_mut().zip(&ob).enumerate() {
+            if w.f || !is_f(j) {
+                o[k..].copy_from_slice(&b[..rem]);
+            }
         }
         valid[k..].copy_from_slice(&vb[..rem]);
     }
 }
 
-/// `eval_pdf` over a block, as [`sample_block`], writing what `mode` names.
+/// `eval_pdf` over a block, as [`sample_block`], writing what `mode` names
+/// (streamed if `stream` and every output written is aligned for `L`).
 #[inline(always)]
 fn eval_pdf_block<L: Lanes, const NDF: u8, const STRAT: u8>(
     l: L,
@@ -305,6 +375,7 @@ fn eval_pdf_block<L: Lanes, const NDF: u8, const STRAT: u8>(
     mode: u8,
     inp: EvalIn<'_>,
     out: EvalOut<'_, '_>,
+    stream: bool,
 ) {
     let n = inp[0].len();
     for s in &inp {
@@ -319,12 +390,24 @@ fn eval_pdf_block<L: Lanes, const NDF: u8, const STRAT: u8>(
         &inp.map(<[f32]>::as_ptr),
         &out.each_mut().map(|o| o.as_mut_ptr()),
     );
+    let stream = stream && (0..4).all(|j| !written(j) || aligned::<L>(ptrs.1[j]));
     let mut k = 0;
-    while k + L::N <= n {
-        // SAFETY: every input holds `n` values, every output written holds
-        // `n` (asserted above), and `k + L::N <= n`.
-        unsafe { eval_pdf_vector::<L, NDF, STRAT>(l, p, ptrs, writes, k) };
-        k += L::N;
+    if stream {
+        while k + L::N <= n {
+            // SAFETY: every input holds `n` values, every output written
+            // holds `n` (asserted above), and `k + L::N <= n`; every output
+            // written starts aligned to `L::ALIGN` bytes and `k` is a
+            // multiple of `L::N` (`L::ALIGN` divides `4 L::N`).
+            unsafe { eval_pdf_vector::<L, NDF, STRAT, true>(l, p, ptrs, writes, k) };
+            k += L::N;
+        }
+        l.fence();
+    } else {
+        while k + L::N <= n {
+            // SAFETY: as above, with plain stores.
+            unsafe { eval_pdf_vector::<L, NDF, STRAT, false>(l, p, ptrs, writes, k) };
+            k += L::N;
+        }
     }
     if k < n {
         let rem = n - k;
@@ -341,7 +424,7 @@ fn eval_pdf_block<L: Lanes, const NDF: u8, const STRAT: u8>(
             &ob.each_mut().map(|b| b.as_mut_ptr()),
         );
         // SAFETY: the buffers hold `MAX_LANES ≥ L::N` values each.
-        unsafe { eval_pdf_vector::<L, NDF, STRAT>(l, p, bptrs, writes, 0) };
+        unsafe { eval_pdf_vector::<L, NDF, STRAT, false>(l, p, bptrs, writes, 0) };
         for (i, (o, b)) in out.iter_mut().zip(&ob).enumerate() {
             if written(i) {
                 o[k..].copy_from_slice(&b[..rem]);
@@ -365,8 +448,9 @@ macro_rules! instance_fns {
             p: &P,
             inp: SampleIn<'_>,
             out: SampleOut<'_, '_>,
+            w: SampleWrites,
         ) {
-            sample_block::<L, NDF, STRAT>(l, p, inp, out)
+            sample_block::<L, NDF, STRAT>(l, p, inp, out, w)
         }
 
         $(#[target_feature(enable = $feat)])?
@@ -377,8 +461,9 @@ macro_rules! instance_fns {
             mode: u8,
             inp: EvalIn<'_>,
             out: EvalOut<'_, '_>,
+            stream: bool,
         ) {
-            eval_pdf_block::<L, NDF, STRAT>(l, p, mode, inp, out)
+            eval_pdf_block::<L, NDF, STRAT>(l, p, mode, inp, out, stream)
         }
     };
 }
@@ -395,8 +480,9 @@ fn sample_inl<L: Lanes, P: VecKernel, const NDF: u8, const STRAT: u8>(
     p: &P,
     inp: SampleIn<'_>,
     out: SampleOut<'_, '_>,
+    w: SampleWrites,
 ) {
-    sample_block::<L, NDF, STRAT>(l, p, inp, out)
+    sample_block::<L, NDF, STRAT>(l, p, inp, out, w)
 }
 #[cfg(target_arch = "x86_64")]
 instance_fns!(sample_one_avx2, eval_pdf_one_avx2, "avx2,fma");
@@ -458,8 +544,14 @@ macro_rules! instances_x2 {
 
 /// `sample` at a portable level `L` (the scalar level; `X2<Scalar>` in the
 /// tests).
-pub(super) fn sample_level<L: Lanes>(l: L, k: &Kernel, inp: SampleIn<'_>, out: SampleOut<'_, '_>) {
-    instances!(k, sample_one, l, inp, out)
+pub(super) fn sample_level<L: Lanes>(
+    l: L,
+    k: &Kernel,
+    inp: SampleIn<'_>,
+    out: SampleOut<'_, '_>,
+    w: SampleWrites,
+) {
+    instances!(k, sample_one, l, inp, out, w)
 }
 
 /// `eval_pdf` at a portable level `L`, writing what `mode` names.
@@ -469,8 +561,9 @@ pub(super) fn eval_pdf_level<L: Lanes>(
     mode: u8,
     inp: EvalIn<'_>,
     out: EvalOut<'_, '_>,
+    stream: bool,
 ) {
-    instances!(k, eval_pdf_one, l, mode, inp, out)
+    instances!(k, eval_pdf_one, l, mode, inp, out, stream)
 }
 
 /// Whether the AVX-512 and AVX2 levels run `k`'s `sample` (`eval = false`) or
@@ -491,8 +584,14 @@ pub(super) fn runs_x2(k: &Kernel, eval: bool) -> bool {
 /// The [`runs_x2`] instances at a portable level, two vectors of `L` at a
 /// time (for the tests).
 #[cfg(test)]
-pub(super) fn sample_x2<L: Lanes>(l: L, k: &Kernel, inp: SampleIn<'_>, out: SampleOut<'_, '_>) {
-    instances_x2!(k, sample_one, l, inp, out)
+pub(super) fn sample_x2<L: Lanes>(
+    l: L,
+    k: &Kernel,
+    inp: SampleIn<'_>,
+    out: SampleOut<'_, '_>,
+    w: SampleWrites,
+) {
+    instances_x2!(k, sample_one, l, inp, out, w)
 }
 
 /// As [`sample_x2`], for `eval_pdf`.
@@ -503,81 +602,115 @@ pub(super) fn eval_pdf_x2<L: Lanes>(
     mode: u8,
     inp: EvalIn<'_>,
     out: EvalOut<'_, '_>,
+    stream: bool,
 ) {
-    instances_x2!(k, eval_pdf_one, l, mode, inp, out)
+    instances_x2!(k, eval_pdf_one, l, mode, inp, out, stream)
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
-fn sample_avx2(l: Avx2, k: &Kernel, inp: SampleIn<'_>, out: SampleOut<'_, '_>) {
+fn sample_avx2(l: Avx2, k: &Kernel, inp: SampleIn<'_>, out: SampleOut<'_, '_>, w: SampleWrites) {
     if runs_x2(k, false) {
-        instances_x2!(k, sample_one_avx2, l, inp, out)
+        instances_x2!(k, sample_one_avx2, l, inp, out, w)
     } else {
-        instances!(k, sample_one_avx2, l, inp, out)
+        instances!(k, sample_one_avx2, l, inp, out, w)
     }
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,avx512dq,avx512bw,avx512vl,avx2,fma")]
-fn sample_avx512(l: Avx512, k: &Kernel, inp: SampleIn<'_>, out: SampleOut<'_, '_>) {
+fn sample_avx512(
+    l: Avx512,
+    k: &Kernel,
+    inp: SampleIn<'_>,
+    out: SampleOut<'_, '_>,
+    w: SampleWrites,
+) {
     if runs_x2(k, false) {
-        instances_x2!(k, sample_inl, l, inp, out)
+        instances_x2!(k, sample_inl, l, inp, out, w)
     } else {
-        instances!(k, sample_one_avx512, l, inp, out)
+        instances!(k, sample_one_avx512, l, inp, out, w)
     }
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
-fn eval_pdf_avx2(l: Avx2, k: &Kernel, mode: u8, inp: EvalIn<'_>, out: EvalOut<'_, '_>) {
+fn eval_pdf_avx2(
+    l: Avx2,
+    k: &Kernel,
+    mode: u8,
+    inp: EvalIn<'_>,
+    out: EvalOut<'_, '_>,
+    stream: bool,
+) {
     if runs_x2(k, true) {
-        instances_x2!(k, eval_pdf_one_avx2, l, mode, inp, out)
+        instances_x2!(k, eval_pdf_one_avx2, l, mode, inp, out, stream)
     } else {
-        instances!(k, eval_pdf_one_avx2, l, mode, inp, out)
+        instances!(k, eval_pdf_one_avx2, l, mode, inp, out, stream)
     }
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,avx512dq,avx512bw,avx512vl,avx2,fma")]
-fn eval_pdf_avx512(l: Avx512, k: &Kernel, mode: u8, inp: EvalIn<'_>, out: EvalOut<'_, '_>) {
+fn eval_pdf_avx512(
+    l: Avx512,
+    k: &Kernel,
+    mode: u8,
+    inp: EvalIn<'_>,
+    out: EvalOut<'_, '_>,
+    stream: bool,
+) {
     if runs_x2(k, true) {
-        instances_x2!(k, eval_pdf_one_avx512, l, mode, inp, out)
+        instances_x2!(k, eval_pdf_one_avx512, l, mode, inp, out, stream)
     } else {
-        instances!(k, eval_pdf_one_avx512, l, mode, inp, out)
+        instances!(k, eval_pdf_one_avx512, l, mode, inp, out, stream)
     }
 }
 
 /// Run `sample` over a block (lengths already checked equal).
-pub(crate) fn sample(b: Backend, k: &Kernel, inp: SampleIn<'_>, out: SampleOut<'_, '_>) {
+pub(crate) fn sample(
+    b: Backend,
+    k: &Kernel,
+    inp: SampleIn<'_>,
+    out: SampleOut<'_, '_>,
+    w: SampleWrites,
+) {
     if let Kernel::Measured(m) = k {
         return super::measured::sample_block(m, inp, out);
     }
     match b {
-        Backend::Scalar(l) => sample_level(l, k, inp, out),
+        Backend::Scalar(l) => sample_level(l, k, inp, out, w),
         // SAFETY: an `Avx2` token exists only if the CPU has AVX2 and FMA.
         #[cfg(target_arch = "x86_64")]
-        Backend::Avx2(l) => unsafe { sample_avx2(l, k, inp, out) },
+        Backend::Avx2(l) => unsafe { sample_avx2(l, k, inp, out, w) },
         // SAFETY: an `Avx512` token exists only if the CPU has AVX-512F/DQ/BW/VL and FMA
         // (AVX2 is implied by AVX-512F).
         #[cfg(target_arch = "x86_64")]
-        Backend::Avx512(l) => unsafe { sample_avx512(l, k, inp, out) },
+        Backend::Avx512(l) => unsafe { sample_avx512(l, k, inp, out, w) },
     }
 }
 
 /// Run `eval_pdf` over a block (lengths already checked equal), writing
 /// the outputs `mode` names ([`BOTH`], [`F_ONLY`], [`PDF_ONLY`]).
-pub(crate) fn eval_pdf(b: Backend, k: &Kernel, mode: u8, inp: EvalIn<'_>, out: EvalOut<'_, '_>) {
+pub(crate) fn eval_pdf(
+    b: Backend,
+    k: &Kernel,
+    mode: u8,
+    inp: EvalIn<'_>,
+    out: EvalOut<'_, '_>,
+    stream: bool,
+) {
     if let Kernel::Measured(m) = k {
         return super::measured::eval_pdf_block(m, mode, inp, out);
     }
     match b {
-        Backend::Scalar(l) => eval_pdf_level(l, k, mode, inp, out),
+        Backend::Scalar(l) => eval_pdf_level(l, k, mode, inp, out, stream),
         // SAFETY: an `Avx2` token exists only if the CPU has AVX2 and FMA.
         #[cfg(target_arch = "x86_64")]
-        Backend::Avx2(l) => unsafe { eval_pdf_avx2(l, k, mode, inp, out) },
+        Backend::Avx2(l) => unsafe { eval_pdf_avx2(l, k, mode, inp, out, stream) },
         // SAFETY: an `Avx512` token exists only if the CPU has AVX-512F/DQ/BW/VL and FMA.
         #[cfg(target_arch = "x86_64")]
-        Backend::Avx512(l) => unsafe { eval_pdf_avx512(l, k, mode, inp, out) },
+        Backend::Avx512(l) => unsafe { eval_pdf_avx512(l, k, mode, inp, out, stream) },
     }
 }
 

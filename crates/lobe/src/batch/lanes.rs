@@ -23,6 +23,8 @@ use std::ops::{Add, BitAnd, BitOr, Div, Mul, Neg, Not, Sub};
 pub(crate) trait Lanes: Copy {
     /// Number of lanes.
     const N: usize;
+    /// The alignment in bytes that [`Lanes::stream_ptr`] needs.
+    const ALIGN: usize;
     /// A vector of `N` `f32`.
     type F: Copy
         + Add<Output = Self::F>
@@ -49,6 +51,19 @@ pub(crate) trait Lanes: Copy {
     /// # Safety
     /// `p` points at `N` writable bytes.
     unsafe fn store_mask_ptr(self, m: Self::M, p: *mut u8);
+    /// Into the `N` values at `p`, as [`Lanes::store_ptr`], with a
+    /// streaming (non-temporal) store where the level has one: the line
+    /// goes to memory without being read first and without taking a place
+    /// in the caches. For outputs far larger than the caches; the stores
+    /// are ordered by [`Lanes::fence`].
+    ///
+    /// # Safety
+    /// `p` points at `N` writable `f32` and is aligned to [`Lanes::ALIGN`]
+    /// bytes.
+    unsafe fn stream_ptr(self, v: Self::F, p: *mut f32);
+    /// Orders this thread's streaming stores before its later stores (a
+    /// store fence where [`Lanes::stream_ptr`] streams).
+    fn fence(self);
     /// The first `N` values of `s` (panics if shorter). The block loops
     /// use [`Lanes::load_ptr`]; this checked form serves the accuracy tests.
     #[cfg(test)]
@@ -117,6 +132,7 @@ pub(crate) struct Scalar;
 
 impl Lanes for Scalar {
     const N: usize = 1;
+    const ALIGN: usize = 4;
     type F = f32;
     type M = bool;
 
@@ -139,6 +155,14 @@ impl Lanes for Scalar {
         // SAFETY: the caller's contract.
         unsafe { *p = u8::from(m) }
     }
+    #[inline(always)]
+    unsafe fn stream_ptr(self, v: f32, p: *mut f32) {
+        // A plain store: the portable level has no streaming store.
+        // SAFETY: the caller's contract.
+        unsafe { *p = v }
+    }
+    #[inline(always)]
+    fn fence(self) {}
     #[inline(always)]
     fn mul_add(self, a: f32, b: f32, c: f32) -> f32 {
         // Fused, as at the SIMD levels (bit-identical results).
@@ -275,6 +299,7 @@ mod x86 {
 
     impl Lanes for Avx2 {
         const N: usize = 8;
+        const ALIGN: usize = 32;
         type F = F8;
         type M = M8;
 
@@ -292,6 +317,17 @@ mod x86 {
         unsafe fn store_ptr(self, v: F8, p: *mut f32) {
             // SAFETY: the token proves AVX2; the caller, that `p` holds 8 writable f32.
             unsafe { _mm256_storeu_ps(p, v.0) }
+        }
+        #[inline(always)]
+        unsafe fn stream_ptr(self, v: F8, p: *mut f32) {
+            // SAFETY: the token proves AVX2; the caller, that `p` holds 8
+            // writable f32 and is 32-byte aligned.
+            unsafe { _mm256_stream_ps(p, v.0) }
+        }
+        #[inline(always)]
+        fn fence(self) {
+            // SAFETY: SSE is part of the x86-64 baseline.
+            unsafe { _mm_sfence() }
         }
         #[inline(always)]
         unsafe fn store_mask_ptr(self, m: M8, p: *mut u8) {
@@ -471,6 +507,7 @@ mod x86 {
 
     impl Lanes for Avx512 {
         const N: usize = 16;
+        const ALIGN: usize = 64;
         type F = F16;
         type M = M16;
 
@@ -488,6 +525,17 @@ mod x86 {
         unsafe fn store_ptr(self, v: F16, p: *mut f32) {
             // SAFETY: the token proves AVX-512F; the caller, that `p` holds 16 writable f32.
             unsafe { _mm512_storeu_ps(p, v.0) }
+        }
+        #[inline(always)]
+        unsafe fn stream_ptr(self, v: F16, p: *mut f32) {
+            // SAFETY: the token proves AVX-512F; the caller, that `p` holds
+            // 16 writable f32 and is 64-byte aligned.
+            unsafe { _mm512_stream_ps(p, v.0) }
+        }
+        #[inline(always)]
+        fn fence(self) {
+            // SAFETY: SSE is part of the x86-64 baseline.
+            unsafe { _mm_sfence() }
         }
         #[inline(always)]
         unsafe fn store_mask_ptr(self, m: M16, p: *mut u8) {
@@ -642,6 +690,7 @@ impl<T: Not<Output = T>> Not for Pair<T> {
 
 impl<L: Lanes> Lanes for X2<L> {
     const N: usize = 2 * L::N;
+    const ALIGN: usize = L::ALIGN;
     type F = Pair<L::F>;
     type M = Pair<L::M>;
 
@@ -670,6 +719,19 @@ impl<L: Lanes> Lanes for X2<L> {
             self.0.store_mask_ptr(m.0, p);
             self.0.store_mask_ptr(m.1, p.add(L::N));
         }
+    }
+    #[inline(always)]
+    unsafe fn stream_ptr(self, v: Self::F, p: *mut f32) {
+        // SAFETY: as for `load_ptr`; `p` is aligned to `L::ALIGN` bytes,
+        // and so is `p + L::N` (`L::ALIGN` divides `4 L::N`).
+        unsafe {
+            self.0.stream_ptr(v.0, p);
+            self.0.stream_ptr(v.1, p.add(L::N));
+        }
+    }
+    #[inline(always)]
+    fn fence(self) {
+        self.0.fence();
     }
     #[inline(always)]
     fn mul_add(self, a: Self::F, b: Self::F, c: Self::F) -> Self::F {

@@ -154,8 +154,9 @@ fn sample_loop<const S: u8>(d: &MeasuredData, inp: SampleIn<'_>, (out, valid): S
     for s in &inp {
         assert_eq!(s.len(), n);
     }
-    for o in out.iter() {
-        assert_eq!(o.len(), n);
+    // `f` (outputs 3 to 5) may be empty: not wanted.
+    for (j, o) in out.iter().enumerate() {
+        assert!(o.len() == n || (o.is_empty() && (3..6).contains(&j)));
     }
     assert_eq!(valid.len(), n);
     for i in 0..n {
@@ -184,13 +185,17 @@ fn sample_loop<const S: u8>(d: &MeasuredData, inp: SampleIn<'_>, (out, valid): S
         match s {
             Some(v) => {
                 for (o, x) in out.iter_mut().zip(v) {
-                    o[i] = x;
+                    if let Some(o) = o.get_mut(i) {
+                        *o = x;
+                    }
                 }
                 valid[i] = 1;
             }
             None => {
                 for o in out.iter_mut() {
-                    o[i] = 0.0;
+                    if let Some(o) = o.get_mut(i) {
+                        *o = 0.0;
+                    }
                 }
                 valid[i] = 0;
             }
@@ -264,7 +269,9 @@ pub(crate) fn eval_pdf_block(k: &MeasuredKernel, mode: u8, inp: EvalIn<'_>, out:
 
 #[cfg(test)]
 mod tests {
-    use super::super::{BatchSampler, Dirs, EvalPdfBuffers, SampleBuffers, SampleInput, SimdLevel};
+    use super::super::{
+        BatchSampler, Dirs, EvalPdfBuffers, RgbMut, SampleBuffers, SampleInput, SimdLevel, Store,
+    };
     use crate::models::measured::Measured;
     use crate::models::measured::merl::Merl;
     use crate::models::measured::rgl::Rgl;
@@ -368,6 +375,26 @@ mod tests {
                         out.output(),
                     )
                     .unwrap();
+                    // Without `f` (empty: not wanted), streamed: the rest
+                    // the same bits.
+                    let mut no_f = SampleBuffers::new(n);
+                    {
+                        let mut o = no_f.output();
+                        o.f = RgbMut {
+                            r: &mut [],
+                            g: &mut [],
+                            b: &mut [],
+                        };
+                        let input = SampleInput {
+                            wo: dirs(&wo),
+                            u1: &u1,
+                            u2: &u2,
+                            uc: None,
+                        };
+                        b.sample_with(input, o, Store::Streamed).unwrap();
+                    }
+                    no_f.f = out.f.clone();
+                    assert_eq!(no_f, out, "{name} {s} {level}: sample without f");
                     let mut ep = EvalPdfBuffers::new(n);
                     b.eval_pdf(dirs(&wo), dirs(&wi), ep.output()).unwrap();
                     // eval and pdf alone: the same bits as eval_pdf.

@@ -447,6 +447,22 @@ pub struct EvalPdfOutput<'a> {
     pub pdf: &'a mut [f32],
 }
 
+/// How a batch kernel writes an output: through the caches (the default),
+/// or with streaming (non-temporal) stores, which send each line to memory
+/// without reading it first and without evicting anything from the caches:
+/// for outputs far larger than the caches that are not read again soon
+/// (about a third less memory traffic; `lobe-py` writes its NumPy results
+/// so). The same values either way. A block streams an output only where
+/// its slice starts aligned to the level's vector (32 bytes at `avx2`, 64
+/// at `avx512`); otherwise, and at the portable level, and for measured
+/// materials, the store is plain.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Store {
+    #[default]
+    Cached,
+    Streamed,
+}
+
 /// Owned output arrays for blocks of `n` samples, allocated once.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SampleBuffers {
@@ -588,10 +604,25 @@ impl BatchSampler {
 
     /// Sample a block: for each `i`, `wi`, `f` (no cosine), `pdf` (solid
     /// angle), `weight = f·cos θi/pdf` and `valid` for `(wo[i], u1[i],
-    /// u2[i])`. Every slice must have the length of `input.wo.x`; otherwise
-    /// a [`BatchError::Length`] names the first that does not, and nothing
-    /// is written.
+    /// u2[i])`. Every slice must have the length of `input.wo.x` (`f`'s
+    /// three may instead all be empty: not wanted); otherwise a
+    /// [`BatchError::Length`] names the first that does not, and nothing is
+    /// written.
     pub fn sample(&self, input: SampleInput<'_>, out: SampleOutput<'_>) -> Result<(), BatchError> {
+        self.sample_with(input, out, Store::Cached)
+    }
+
+    /// [`BatchSampler::sample`] with the outputs stored as `store` says
+    /// (the same values; `valid`, one byte a sample, always through the
+    /// caches), and `f` optional: three empty slices there mean it is not
+    /// wanted (`weight` and `pdf` hold what most callers need of it), and
+    /// nothing is written for it.
+    pub fn sample_with(
+        &self,
+        input: SampleInput<'_>,
+        out: SampleOutput<'_>,
+        store: Store,
+    ) -> Result<(), BatchError> {
         let n = input.wo.x.len();
         let check = |slice: &'static str, found: usize| {
             if found == n {
@@ -614,9 +645,12 @@ impl BatchSampler {
         check("wi.x", out.wi.x.len())?;
         check("wi.y", out.wi.y.len())?;
         check("wi.z", out.wi.z.len())?;
-        check("f.r", out.f.r.len())?;
-        check("f.g", out.f.g.len())?;
-        check("f.b", out.f.b.len())?;
+        let want_f = !(out.f.r.is_empty() && out.f.g.is_empty() && out.f.b.is_empty());
+        if want_f || n == 0 {
+            check("f.r", out.f.r.len())?;
+            check("f.g", out.f.g.len())?;
+            check("f.b", out.f.b.len())?;
+        }
         check("pdf", out.pdf.len())?;
         check("weight.r", out.weight.r.len())?;
         check("weight.g", out.weight.g.len())?;
@@ -643,7 +677,11 @@ impl BatchSampler {
             out.weight.g,
             out.weight.b,
         ];
-        dispatch::sample(self.backend, &self.kernel, inp, (&mut o, out.valid));
+        let w = dispatch::SampleWrites {
+            f: want_f,
+            stream: store == Store::Streamed,
+        };
+        dispatch::sample(self.backend, &self.kernel, inp, (&mut o, out.valid), w);
         Ok(())
     }
 
@@ -657,23 +695,51 @@ impl BatchSampler {
         wi: Dirs<'_>,
         out: EvalPdfOutput<'_>,
     ) -> Result<(), BatchError> {
-        check_pairs(
-            wo,
-            wi,
-            &[
-                ("f.r", out.f.r.len()),
-                ("f.g", out.f.g.len()),
-                ("f.b", out.f.b.len()),
-                ("pdf", out.pdf.len()),
-            ],
-        )?;
-        let mut o = [out.f.r, out.f.g, out.f.b, out.pdf];
+        self.eval_pdf_with(wo, wi, out, Store::Cached)
+    }
+
+    /// [`BatchSampler::eval_pdf`] with both outputs stored as `store` says
+    /// (the same values).
+    pub fn eval_pdf_with(
+        &self,
+        wo: Dirs<'_>,
+        wi: Dirs<'_>,
+        out: EvalPdfOutput<'_>,
+        store: Store,
+    ) -> Result<(), BatchError> {
+        let o = [out.f.r, out.f.g, out.f.b, out.pdf];
+        self.run_eval_pdf(wo, wi, dispatch::BOTH, o, store)
+    }
+
+    /// `eval_pdf` writing what `mode` names into `o` (`f.rgb`, `pdf`; the
+    /// ones not written empty), after checking the lengths.
+    fn run_eval_pdf(
+        &self,
+        wo: Dirs<'_>,
+        wi: Dirs<'_>,
+        mode: u8,
+        mut o: [&mut [f32]; 4],
+        store: Store,
+    ) -> Result<(), BatchError> {
+        let lens = [
+            ("f.r", o[0].len()),
+            ("f.g", o[1].len()),
+            ("f.b", o[2].len()),
+            ("pdf", o[3].len()),
+        ];
+        let written = match mode {
+            dispatch::F_ONLY => &lens[..3],
+            dispatch::PDF_ONLY => &lens[3..],
+            _ => &lens[..],
+        };
+        check_pairs(wo, wi, written)?;
         dispatch::eval_pdf(
             self.backend,
             &self.kernel,
-            dispatch::BOTH,
+            mode,
             [wo.x, wo.y, wo.z, wi.x, wi.y, wi.z],
             &mut o,
+            store == Store::Streamed,
         );
         Ok(())
     }
@@ -681,36 +747,44 @@ impl BatchSampler {
     /// `f(wo[i], wi[i])` without the cosine, zero below the horizon: the
     /// `f` of [`BatchSampler::eval_pdf`] (the same bits) without its pdf.
     pub fn eval(&self, wo: Dirs<'_>, wi: Dirs<'_>, f: RgbMut<'_>) -> Result<(), BatchError> {
-        check_pairs(
-            wo,
-            wi,
-            &[("f.r", f.r.len()), ("f.g", f.g.len()), ("f.b", f.b.len())],
-        )?;
-        let mut o: [&mut [f32]; 4] = [f.r, f.g, f.b, &mut []];
-        dispatch::eval_pdf(
-            self.backend,
-            &self.kernel,
-            dispatch::F_ONLY,
-            [wo.x, wo.y, wo.z, wi.x, wi.y, wi.z],
-            &mut o,
-        );
-        Ok(())
+        self.eval_with(wo, wi, f, Store::Cached)
+    }
+
+    /// [`BatchSampler::eval`] with `f` stored as `store` says (the same
+    /// values).
+    pub fn eval_with(
+        &self,
+        wo: Dirs<'_>,
+        wi: Dirs<'_>,
+        f: RgbMut<'_>,
+        store: Store,
+    ) -> Result<(), BatchError> {
+        self.run_eval_pdf(wo, wi, dispatch::F_ONLY, [f.r, f.g, f.b, &mut []], store)
     }
 
     /// The pdf (solid angle) of this sampler's strategy at `(wo[i], wi[i])`,
     /// zero below the horizon: the pdf of [`BatchSampler::eval_pdf`] (the
     /// same bits) without `f`.
     pub fn pdf(&self, wo: Dirs<'_>, wi: Dirs<'_>, pdf: &mut [f32]) -> Result<(), BatchError> {
-        check_pairs(wo, wi, &[("pdf", pdf.len())])?;
-        let mut o: [&mut [f32]; 4] = [&mut [], &mut [], &mut [], pdf];
-        dispatch::eval_pdf(
-            self.backend,
-            &self.kernel,
+        self.pdf_with(wo, wi, pdf, Store::Cached)
+    }
+
+    /// [`BatchSampler::pdf`] with the pdf stored as `store` says (the same
+    /// values).
+    pub fn pdf_with(
+        &self,
+        wo: Dirs<'_>,
+        wi: Dirs<'_>,
+        pdf: &mut [f32],
+        store: Store,
+    ) -> Result<(), BatchError> {
+        self.run_eval_pdf(
+            wo,
+            wi,
             dispatch::PDF_ONLY,
-            [wo.x, wo.y, wo.z, wi.x, wi.y, wi.z],
-            &mut o,
-        );
-        Ok(())
+            [&mut [], &mut [], &mut [], pdf],
+            store,
+        )
     }
 }
 

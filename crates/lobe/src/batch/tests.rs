@@ -928,10 +928,14 @@ fn two_vectors_at_a_time_give_the_same_bits() {
             let mut ev: [Vec<f32>; 4] = std::array::from_fn(|_| vec![0.0; n]);
             {
                 let mut o = out.each_mut().map(|v| &mut v[..]);
+                let plain = d::SampleWrites {
+                    f: true,
+                    stream: false,
+                };
                 if x2 {
-                    d::sample_x2(Scalar, k, ins, (&mut o, &mut valid));
+                    d::sample_x2(Scalar, k, ins, (&mut o, &mut valid), plain);
                 } else {
-                    d::sample_level(Scalar, k, ins, (&mut o, &mut valid));
+                    d::sample_level(Scalar, k, ins, (&mut o, &mut valid), plain);
                 }
             }
             {
@@ -945,9 +949,9 @@ fn two_vectors_at_a_time_give_the_same_bits() {
                 ];
                 let mut e = ev.each_mut().map(|v| &mut v[..]);
                 if x2 && d::runs_x2(k, true) {
-                    d::eval_pdf_x2(Scalar, k, d::BOTH, ein, &mut e);
+                    d::eval_pdf_x2(Scalar, k, d::BOTH, ein, &mut e, false);
                 } else {
-                    d::eval_pdf_level(Scalar, k, d::BOTH, ein, &mut e);
+                    d::eval_pdf_level(Scalar, k, d::BOTH, ein, &mut e, false);
                 }
             }
             (out, valid, ev)
@@ -977,3 +981,168 @@ fn two_vectors_at_a_time_give_the_same_bits() {
 /// The whole model × strategy × Fresnel × shadowing grid.
 #[path = "tests_grid.rs"]
 mod grid;
+
+/// A zeroed `n`-value slice of `v` starting at a 128-byte boundary plus
+/// `shift` values.
+fn aligned_part(v: &mut Vec<f32>, n: usize, shift: usize) -> &mut [f32] {
+    v.clear();
+    v.resize(n + 32 + shift, 0.0);
+    let a = v.as_ptr().align_offset(128);
+    &mut v[a + shift..a + shift + n]
+}
+
+/// Copies of the [`aligned_part`]s of `bufs`.
+fn aligned_parts(bufs: &[Vec<f32>], n: usize, shift: usize) -> Vec<Vec<f32>> {
+    bufs.iter()
+        .map(|v| {
+            let o = v.as_ptr().align_offset(128) + shift;
+            v[o..o + n].to_vec()
+        })
+        .collect()
+}
+
+/// `sample_with` into buffers at a 128-byte boundary plus `shift` values:
+/// `wi`, `f` (if `with_f`; else not wanted), `pdf`, `weight`, and `valid`.
+fn sample_aligned(
+    b: &BatchSampler,
+    input: SampleInput<'_>,
+    shift: usize,
+    with_f: bool,
+    store: Store,
+) -> (Vec<Vec<f32>>, Vec<u8>) {
+    let n = input.wo.x.len();
+    let mut bufs: Vec<Vec<f32>> = (0..if with_f { 10 } else { 7 })
+        .map(|_| Vec::new())
+        .collect();
+    let mut valid = vec![0u8; n];
+    {
+        let mut it = bufs.iter_mut().map(|v| aligned_part(v, n, shift));
+        let mut next = || it.next().expect("enough buffers");
+        let (x, y, z) = (next(), next(), next());
+        let f = if with_f {
+            let (r, g, b) = (next(), next(), next());
+            RgbMut { r, g, b }
+        } else {
+            RgbMut {
+                r: &mut [],
+                g: &mut [],
+                b: &mut [],
+            }
+        };
+        let pdf = next();
+        let (r, g, bl) = (next(), next(), next());
+        let out = SampleOutput {
+            wi: DirsMut { x, y, z },
+            f,
+            pdf,
+            weight: RgbMut { r, g, b: bl },
+            valid: &mut valid,
+        };
+        b.sample_with(input, out, store).unwrap();
+    }
+    (aligned_parts(&bufs, n, shift), valid)
+}
+
+/// `eval_pdf_with` into buffers as [`sample_aligned`]: `f`, `pdf`.
+fn eval_pdf_aligned(
+    b: &BatchSampler,
+    wo: Dirs<'_>,
+    wi: Dirs<'_>,
+    shift: usize,
+    store: Store,
+) -> Vec<Vec<f32>> {
+    let n = wo.x.len();
+    let mut bufs: Vec<Vec<f32>> = (0..4).map(|_| Vec::new()).collect();
+    {
+        let mut it = bufs.iter_mut().map(|v| aligned_part(v, n, shift));
+        let mut next = || it.next().expect("four buffers");
+        let (r, g, bl, pdf) = (next(), next(), next(), next());
+        let out = EvalPdfOutput {
+            f: RgbMut { r, g, b: bl },
+            pdf,
+        };
+        b.eval_pdf_with(wo, wi, out, store).unwrap();
+    }
+    aligned_parts(&bufs, n, shift)
+}
+
+/// Whether two lists of arrays hold the same bits.
+fn same_bits(a: &[Vec<f32>], b: &[&Vec<f32>]) -> bool {
+    a.len() == b.len()
+        && a.iter().zip(b).all(|(x, y)| {
+            x.len() == y.len()
+                && x.iter()
+                    .zip(y.iter())
+                    .all(|(p, q)| p.to_bits() == q.to_bits())
+        })
+}
+
+#[test]
+fn streamed_stores_give_the_same_bits() {
+    let mut rng = Pcg64::seed_from_u64(0x57_4ea3);
+    let n = 4096 + 37;
+    let inp = inputs(&mut rng, n);
+    let beckmann = Microfacet::new(Ndf::Beckmann, 0.3, 0.3).unwrap();
+    let cases = [
+        (ggx(0.2, 0.2, Fresnel::None, Rgb::ONE), BsdfStrategy::Vndf),
+        (ggx(0.2, 0.2, Fresnel::None, Rgb::ONE), BsdfStrategy::Brdf),
+        (
+            Material::with_diffuse(
+                Rgb::ZERO,
+                Glossy::CookTorrance(
+                    CookTorrance::new(
+                        Rgb::ONE,
+                        beckmann,
+                        Shadowing::SmithCorrelated,
+                        Fresnel::None,
+                    )
+                    .unwrap(),
+                ),
+            )
+            .unwrap(),
+            BsdfStrategy::Vndf,
+        ),
+    ];
+    for (m, s) in &cases {
+        for level in levels("streamed_stores") {
+            let b = BatchSampler::with_level(m, *s, level).unwrap();
+            let mut plain = SampleBuffers::new(n);
+            b.sample(inp.input(), plain.output()).unwrap();
+            let mut pe = EvalPdfBuffers::new(n);
+            b.eval_pdf(inp.input().wo, plain.wi(), pe.output()).unwrap();
+            let all: Vec<&Vec<f32>> = plain
+                .wi
+                .iter()
+                .chain(&plain.f)
+                .chain(std::iter::once(&plain.pdf))
+                .chain(&plain.weight)
+                .collect();
+            let no_f: Vec<&Vec<f32>> = plain
+                .wi
+                .iter()
+                .chain(std::iter::once(&plain.pdf))
+                .chain(&plain.weight)
+                .collect();
+            let ev: Vec<&Vec<f32>> = pe.f.iter().chain(std::iter::once(&pe.pdf)).collect();
+            // 128- and 64-byte aligned (streamed), one value off (plain
+            // stores); `f` wanted and not.
+            for shift in [0usize, 1, 16] {
+                for store in [Store::Streamed, Store::Cached] {
+                    let what = format!("{level} {s} shift {shift} {store:?}");
+                    let (got, valid) = sample_aligned(&b, inp.input(), shift, true, store);
+                    assert!(
+                        same_bits(&got, &all) && valid == plain.valid,
+                        "{what}: sample"
+                    );
+                    let (got, valid) = sample_aligned(&b, inp.input(), shift, false, store);
+                    assert!(
+                        same_bits(&got, &no_f) && valid == plain.valid,
+                        "{what}: no f"
+                    );
+                    let got = eval_pdf_aligned(&b, inp.input().wo, plain.wi(), shift, store);
+                    assert!(same_bits(&got, &ev), "{what}: eval_pdf");
+                }
+            }
+        }
+    }
+}
