@@ -234,20 +234,19 @@ unsafe fn sample_vector<L: Lanes, const NDF: u8, const STRAT: u8>(
 
 /// One vector of `eval_pdf` from the `L::N` values at `ip[i] + k`: `f` at
 /// `op[0..3] + k` if `writes.0`, the pdf at `op[3] + k` if `writes.1`,
-/// streamed if `STREAM` (a const parameter: a run-time branch here cost
-/// GGX vndf's `eval_pdf` about 4% more instructions; the kernel is small
-/// enough to compile twice).
+/// streamed if `stream` (one branch a vector; the kernel compiled once,
+/// for CI's compile time).
 ///
 /// # Safety
 /// Each `ip[i]` and each `op[j]` written points at `k + L::N` values; the
-/// outputs do not overlap each other or the inputs; if `STREAM`, each
+/// outputs do not overlap each other or the inputs; if `stream`, each
 /// `op[j] + k` written is aligned to `L::ALIGN` bytes.
 #[inline(always)]
-unsafe fn eval_pdf_vector<L: Lanes, const NDF: u8, const STRAT: u8, const STREAM: bool>(
+unsafe fn eval_pdf_vector<L: Lanes, const NDF: u8, const STRAT: u8>(
     l: L,
     p: &impl VecKernel,
     (ip, op): (&[*const f32; 6], &[*mut f32; 4]),
-    writes: (bool, bool),
+    (writes, stream): ((bool, bool), bool),
     k: usize,
 ) {
     // SAFETY: the caller's contract.
@@ -255,7 +254,7 @@ unsafe fn eval_pdf_vector<L: Lanes, const NDF: u8, const STRAT: u8, const STREAM
         let x = |i: usize| l.load_ptr(ip[i].add(k));
         let (f, pdf) = p.eval_pdf::<L, NDF, STRAT>(l, [x(0), x(1), x(2)], [x(3), x(4), x(5)]);
         let f = [(0, f[0]), (1, f[1]), (2, f[2])];
-        if STREAM {
+        if stream {
             if writes.0 {
                 for (j, v) in f {
                     l.stream_ptr(v, op[j].add(k));
@@ -392,22 +391,16 @@ fn eval_pdf_block<L: Lanes, const NDF: u8, const STRAT: u8>(
     );
     let stream = stream && (0..4).all(|j| !written(j) || aligned::<L>(ptrs.1[j]));
     let mut k = 0;
+    while k + L::N <= n {
+        // SAFETY: every input holds `n` values, every output written holds
+        // `n` (asserted above), and `k + L::N <= n`; if `stream`, every
+        // output written starts aligned to `L::ALIGN` bytes and `k` is a
+        // multiple of `L::N` (`L::ALIGN` divides `4 L::N`).
+        unsafe { eval_pdf_vector::<L, NDF, STRAT>(l, p, ptrs, (writes, stream), k) };
+        k += L::N;
+    }
     if stream {
-        while k + L::N <= n {
-            // SAFETY: every input holds `n` values, every output written
-            // holds `n` (asserted above), and `k + L::N <= n`; every output
-            // written starts aligned to `L::ALIGN` bytes and `k` is a
-            // multiple of `L::N` (`L::ALIGN` divides `4 L::N`).
-            unsafe { eval_pdf_vector::<L, NDF, STRAT, true>(l, p, ptrs, writes, k) };
-            k += L::N;
-        }
         l.fence();
-    } else {
-        while k + L::N <= n {
-            // SAFETY: as above, with plain stores.
-            unsafe { eval_pdf_vector::<L, NDF, STRAT, false>(l, p, ptrs, writes, k) };
-            k += L::N;
-        }
     }
     if k < n {
         let rem = n - k;
@@ -424,7 +417,7 @@ fn eval_pdf_block<L: Lanes, const NDF: u8, const STRAT: u8>(
             &ob.each_mut().map(|b| b.as_mut_ptr()),
         );
         // SAFETY: the buffers hold `MAX_LANES ≥ L::N` values each.
-        unsafe { eval_pdf_vector::<L, NDF, STRAT, false>(l, p, bptrs, writes, 0) };
+        unsafe { eval_pdf_vector::<L, NDF, STRAT>(l, p, bptrs, (writes, false), 0) };
         for (i, (o, b)) in out.iter_mut().zip(&ob).enumerate() {
             if written(i) {
                 o[k..].copy_from_slice(&b[..rem]);
