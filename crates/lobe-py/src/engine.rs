@@ -441,9 +441,11 @@ impl<'m> Engine<'m> {
         })
     }
 
-    /// For `eval` alone (no strategy): the batch kernels of any strategy
-    /// they cover (`f` does not depend on the strategy), else the scalar
-    /// path (`strategy` is then only a placeholder).
+    /// For `eval` alone (no strategy): the batch kernels of the first
+    /// strategy they cover (`f` does not depend on the strategy; the
+    /// kernels of different strategies compute it along different f32
+    /// paths, which agree within about 1e-6 relative, not bit for bit),
+    /// else the scalar path (`strategy` is then only a placeholder).
     #[must_use]
     pub fn for_eval(material: &'m Material, reference: bool) -> Self {
         let strategies = material.strategies();
