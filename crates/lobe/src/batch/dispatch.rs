@@ -544,6 +544,7 @@ macro_rules! instances_x2 {
         match (*ndf, *strat) {
             (GGX, VNDF) => $f::<_, _, GGX, VNDF>(X2($l), p, $($args),*),
             (BECKMANN, VNDF) => $f::<_, _, BECKMANN, VNDF>(X2($l), p, $($args),*),
+            (GGX, BRDF) => $f::<_, _, GGX, BRDF>(X2($l), p, $($args),*),
             _ => unreachable!("runs_x2 admits only these"),
         }
     }};
@@ -573,19 +574,26 @@ pub(super) fn eval_pdf_level<L: Lanes>(
     instances!(k, eval_pdf_one, l, mode, inp, out, stream)
 }
 
-/// Whether the AVX-512 and AVX2 levels run `k`'s `sample` (`eval = false`) or
-/// `eval_pdf` two vectors at a time ([`X2`]): the visible-normal samplers
-/// (GGX and Beckmann), whose long dependency chains (square root, division,
-/// reflection, square root, division; Beckmann's Newton steps) leave the
-/// pipelines idle one vector at a time, and Beckmann's evaluation. Where
-/// the chains are short (GGX brdf, GGX eval_pdf) two vectors only add
-/// register spills and run slower. Measured by `lobe bench` on Zen 4
-/// (BENCHMARKS.md), at both levels.
-pub(super) fn runs_x2(k: &Kernel, eval: bool) -> bool {
-    matches!(
-        k,
-        Kernel::CookTorrance { ndf, strat: VNDF, .. } if *ndf == BECKMANN || (*ndf == GGX && !eval)
-    )
+/// Whether the AVX-512 (`wide`) or AVX2 level runs `k`'s `sample`
+/// (`eval = false`) or `eval_pdf` two vectors at a time ([`X2`]): the
+/// visible-normal samplers (GGX and Beckmann), whose long dependency chains
+/// (square root, division, reflection, square root, division; Beckmann's
+/// Newton steps) leave the pipelines idle one vector at a time, and
+/// Beckmann's evaluation; at AVX2 also GGX's brdf sampler (its sample
+/// 20%, its s+e+p 12% faster on Zen 3, where AVX2 is the native level).
+/// Where the chains are short (GGX eval_pdf; GGX brdf at AVX-512, which
+/// has half as many vectors in flight for the same work) two vectors only
+/// add register spills and run slower: measured by `lobe bench` on Zen 4
+/// (BENCHMARKS.md). The numbers are the same bits either way.
+pub(super) fn runs_x2(k: &Kernel, eval: bool, wide: bool) -> bool {
+    match k {
+        Kernel::CookTorrance { ndf, strat, .. } => match *strat {
+            VNDF => *ndf == BECKMANN || (*ndf == GGX && !eval),
+            BRDF => *ndf == GGX && !eval && !wide,
+            _ => false,
+        },
+        _ => false,
+    }
 }
 
 /// The [`runs_x2`] instances at a portable level, two vectors of `L` at a
@@ -617,7 +625,7 @@ pub(super) fn eval_pdf_x2<L: Lanes>(
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
 fn sample_avx2(l: Avx2, k: &Kernel, inp: SampleIn<'_>, out: SampleOut<'_, '_>, w: SampleWrites) {
-    if runs_x2(k, false) {
+    if runs_x2(k, false, false) {
         instances_x2!(k, sample_one_avx2, l, inp, out, w)
     } else {
         instances!(k, sample_one_avx2, l, inp, out, w)
@@ -633,7 +641,7 @@ fn sample_avx512(
     out: SampleOut<'_, '_>,
     w: SampleWrites,
 ) {
-    if runs_x2(k, false) {
+    if runs_x2(k, false, true) {
         instances_x2!(k, sample_inl, l, inp, out, w)
     } else {
         instances!(k, sample_one_avx512, l, inp, out, w)
@@ -650,7 +658,7 @@ fn eval_pdf_avx2(
     out: EvalOut<'_, '_>,
     stream: bool,
 ) {
-    if runs_x2(k, true) {
+    if runs_x2(k, true, false) {
         instances_x2!(k, eval_pdf_one_avx2, l, mode, inp, out, stream)
     } else {
         instances!(k, eval_pdf_one_avx2, l, mode, inp, out, stream)
@@ -667,7 +675,7 @@ fn eval_pdf_avx512(
     out: EvalOut<'_, '_>,
     stream: bool,
 ) {
-    if runs_x2(k, true) {
+    if runs_x2(k, true, true) {
         instances_x2!(k, eval_pdf_one_avx512, l, mode, inp, out, stream)
     } else {
         instances!(k, eval_pdf_one_avx512, l, mode, inp, out, stream)

@@ -908,12 +908,32 @@ fn two_vectors_at_a_time_give_the_same_bits() {
             Rgb::ONE,
         ),
         beckmann,
+        ggx(0.2, 0.2, Fresnel::None, Rgb::ONE),
+        ggx(
+            0.05,
+            0.3,
+            Fresnel::Schlick {
+                f0: Rgb::new(0.9, 0.6, 0.3),
+            },
+            Rgb::splat(0.5),
+        ),
     ];
+    // The last two through GGX's brdf sampler, which X2 runs at AVX2.
+    let strategy = |mi: usize| {
+        if mi < 3 {
+            BsdfStrategy::Vndf
+        } else {
+            BsdfStrategy::Brdf
+        }
+    };
     let mut checked = 0;
     for (mi, m) in materials.iter().enumerate() {
-        let b = BatchSampler::with_level(m, BsdfStrategy::Vndf, SimdLevel::Scalar).unwrap();
+        let b = BatchSampler::with_level(m, strategy(mi), SimdLevel::Scalar).unwrap();
         let k: &Kernel = &b.kernel;
-        assert!(d::runs_x2(k, false), "material {mi}: a kernel that X2 runs");
+        assert!(
+            d::runs_x2(k, false, false),
+            "material {mi}: a kernel that X2 runs"
+        );
         let ins = [
             &inp[0][..],
             &inp[1][..],
@@ -948,7 +968,7 @@ fn two_vectors_at_a_time_give_the_same_bits() {
                     &out[2][..],
                 ];
                 let mut e = ev.each_mut().map(|v| &mut v[..]);
-                if x2 && d::runs_x2(k, true) {
+                if x2 && d::runs_x2(k, true, false) {
                     d::eval_pdf_x2(Scalar, k, d::BOTH, ein, &mut e, false);
                 } else {
                     d::eval_pdf_level(Scalar, k, d::BOTH, ein, &mut e, false);
