@@ -52,56 +52,100 @@ struct Files {
     rgl: PathBuf,
 }
 
-/// The directory with `t.binary` (MERL) and `t.bsdf` (RGL, 6 views, 24²),
-/// written once by `lobe tabulate`.
+/// The tables `t.binary` (MERL) and `t.bsdf` (RGL, 6 views, 24²), written
+/// by `lobe tabulate` once per build of `lobe`, and a fresh directory of
+/// this process's own for the commands' outputs (`dir`), beside them.
+///
+/// Test runners that give each test its own process (`cargo nextest`)
+/// share the tables: a process writes them into a directory of its own
+/// and renames it into place; the loser of a race drops its copy. Older
+/// builds' tables are removed, with the output directories beside them. (A shared directory removed and rewritten
+/// by every process made the others read half-written tables.)
 fn files() -> &'static Files {
     static F: OnceLock<Files> = OnceLock::new();
     F.get_or_init(|| {
         // Under target/, not /tmp, where each run's 35 MB table would stay.
-        let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("cli-measured");
+        let base = PathBuf::from(env!("CARGO_TARGET_TMPDIR"));
+        let bin = std::fs::metadata(env!("CARGO_BIN_EXE_lobe")).unwrap();
+        let stamp = bin
+            .modified()
+            .unwrap()
+            .duration_since(std::time::UNIX_EPOCH)
+            .unwrap()
+            .as_nanos() as u64
+            ^ bin.len();
+        let tables = base.join(format!("cli-measured-{stamp:016x}"));
+        if !tables.join("t.bsdf").exists() {
+            for e in std::fs::read_dir(&base).into_iter().flatten().flatten() {
+                let name = e.file_name().to_string_lossy().into_owned();
+                let stale = name == "cli-measured"
+                    || (name.starts_with("cli-measured-") && !name.starts_with("cli-measured-tmp"));
+                if stale && e.path() != tables {
+                    let _ = std::fs::remove_dir_all(e.path());
+                }
+            }
+            let tmp = base.join(format!("cli-measured-tmp-{}", std::process::id()));
+            let _ = std::fs::remove_dir_all(&tmp);
+            std::fs::create_dir_all(&tmp).unwrap();
+            tabulate(&tmp);
+            if std::fs::rename(&tmp, &tables).is_err() {
+                let _ = std::fs::remove_dir_all(&tmp);
+            }
+            assert!(tables.join("t.bsdf").exists(), "{}", tables.display());
+        }
+        let dir = tables.join(format!("run-{}", std::process::id()));
         let _ = std::fs::remove_dir_all(&dir);
         std::fs::create_dir_all(&dir).unwrap();
-        let (merl, rgl) = (dir.join("t.binary"), dir.join("t.bsdf"));
-        let o = lobe(
-            &[
-                "tabulate",
-                "-m",
-                ANALYTIC,
-                "--format",
-                "merl",
-                "--out",
-                merl.to_str().unwrap(),
-            ],
-            None,
-            "",
-        );
-        ok(&o, "tabulate merl");
-        let err = String::from_utf8_lossy(&o.stderr);
-        assert!(
-            err.contains("34992012 bytes, merl table of a cook-torrance material"),
-            "{err}"
-        );
-        assert_eq!(std::fs::metadata(&merl).unwrap().len(), 34_992_012);
-        let o = lobe(
-            &[
-                "tabulate",
-                "-m",
-                ANALYTIC,
-                "--format",
-                "rgl",
-                "--views",
-                "6",
-                "--grid",
-                "24",
-                "--out",
-                rgl.to_str().unwrap(),
-            ],
-            None,
-            "",
-        );
-        ok(&o, "tabulate rgl");
-        Files { dir, merl, rgl }
+        Files {
+            merl: tables.join("t.binary"),
+            rgl: tables.join("t.bsdf"),
+            dir,
+        }
     })
+}
+
+/// Write the MERL and RGL tables of [`ANALYTIC`] into `dir`, checking what
+/// `lobe tabulate` says.
+fn tabulate(dir: &Path) {
+    let (merl, rgl) = (dir.join("t.binary"), dir.join("t.bsdf"));
+    let o = lobe(
+        &[
+            "tabulate",
+            "-m",
+            ANALYTIC,
+            "--format",
+            "merl",
+            "--out",
+            merl.to_str().unwrap(),
+        ],
+        None,
+        "",
+    );
+    ok(&o, "tabulate merl");
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("34992012 bytes, merl table of a cook-torrance material"),
+        "{err}"
+    );
+    assert_eq!(std::fs::metadata(&merl).unwrap().len(), 34_992_012);
+    let o = lobe(
+        &[
+            "tabulate",
+            "-m",
+            ANALYTIC,
+            "--format",
+            "rgl",
+            "--views",
+            "6",
+            "--grid",
+            "24",
+            "--out",
+            rgl.to_str().unwrap(),
+        ],
+        None,
+        "",
+    );
+    ok(&o, "tabulate rgl");
 }
 
 fn measured(path: &Path) -> String {
@@ -491,8 +535,9 @@ fn render_and_compare_take_measured_tables() {
         r#"{ type = "cook-torrance", distribution = "ggx", alpha = 0.2, kd = [0.1, 0.15, 0.05], fresnel = { type = "schlick", f0 = [0.9, 0.6, 0.3] } }"#,
     );
     let want = mean(&analytic_scene, "analytic");
+    // The tables are one directory up from this process's `dir`.
     for table in ["t.binary", "t.bsdf"] {
-        let scene = table_scene(table);
+        let scene = table_scene(&format!("../{table}"));
         let got = mean(&scene, &format!("scene-{table}").replace('.', "-"));
         assert!(
             (got - want).abs() <= 0.05 * want,
@@ -500,7 +545,7 @@ fn render_and_compare_take_measured_tables() {
         );
     }
     let scene = f.dir.join("cmp.toml");
-    std::fs::write(&scene, table_scene("t.bsdf")).unwrap();
+    std::fs::write(&scene, table_scene("../t.bsdf")).unwrap();
     let o = lobe(
         &[
             "compare",
