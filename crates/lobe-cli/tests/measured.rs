@@ -59,8 +59,9 @@ struct Files {
 /// Test runners that give each test its own process (`cargo nextest`)
 /// share the tables: a process writes them into a directory of its own
 /// and renames it into place; the loser of a race drops its copy. Older
-/// builds' tables are removed, with the output directories beside them. (A shared directory removed and rewritten
-/// by every process made the others read half-written tables.)
+/// builds' tables are removed, with the output directories beside them.
+/// (A shared directory removed and rewritten by every process made the
+/// others read half-written tables.)
 fn files() -> &'static Files {
     static F: OnceLock<Files> = OnceLock::new();
     F.get_or_init(|| {
