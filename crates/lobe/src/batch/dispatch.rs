@@ -171,6 +171,15 @@ pub(crate) struct SampleWrites {
     pub f: bool,
     pub stream: bool,
 }
+/// An instance function of `sample` ([`instance_fns`]), which a block
+/// calls back for its last, partial vector (copied into padded buffers):
+/// the kernel is inlined once per instance, not twice (CI's time is mostly
+/// compiling these instances).
+///
+/// Safety: the CPU has the target features of the level `L` stands for.
+type SampleFn<L, P> = unsafe fn(L, &P, SampleIn<'_>, SampleOut<'_, '_>, SampleWrites);
+/// As [`SampleFn`], for `eval_pdf`.
+type EvalFn<L, P> = unsafe fn(L, &P, u8, EvalIn<'_>, EvalOut<'_, '_>, bool);
 /// Inputs of `eval_pdf`: `wo.xyz, wi.xyz`.
 pub(crate) type EvalIn<'a> = [&'a [f32]; 6];
 /// Outputs of `eval_pdf`: `f.rgb, pdf` (the ones the mode does not write
@@ -304,12 +313,13 @@ fn aligned<L: Lanes>(p: *mut f32) -> bool {
 /// `w.f`; the outputs are streamed (then fenced) if `w.stream` and every
 /// one written is aligned for `L`.
 #[inline(always)]
-fn sample_block<L: Lanes, const NDF: u8, const STRAT: u8>(
+fn sample_block<L: Lanes, P: VecKernel, const NDF: u8, const STRAT: u8>(
     l: L,
-    p: &impl VecKernel,
+    p: &P,
     inp: SampleIn<'_>,
     (out, valid): SampleOut<'_, '_>,
     w: SampleWrites,
+    tail: SampleFn<L, P>,
 ) {
     let n = inp[0].len();
     for s in &inp {
@@ -359,17 +369,17 @@ fn sample_block<L: Lanes, const NDF: u8, const STRAT: u8>(
         }
         let mut ob = [[0.0f32; MAX_LANES]; 10];
         let mut vb = [0u8; MAX_LANES];
-        let bptrs = (
-            &ib.each_ref().map(|b| b.as_ptr()),
-            &ob.each_mut().map(|b| b.as_mut_ptr()),
-            vb.as_mut_ptr(),
-        );
-        // SAFETY: the buffers hold `MAX_LANES ≥ L::N` values each.
-        let plain = SampleWrites {
-            f: w.f,
-            stream: false,
-        };
-        unsafe { sample_vector::<L, NDF, STRAT>(l, p, two, bptrs, plain, 0) };
+        {
+            let bi = ib.each_ref().map(|b| &b[..L::N]);
+            let mut bo = ob.each_mut().map(|b| &mut b[..L::N]);
+            let plain = SampleWrites {
+                f: w.f,
+                stream: false,
+            };
+            // SAFETY: `tail` is this instance's function (the caller's
+            // contract), at the level the caller runs at; one whole vector.
+            unsafe { tail(l, p, bi, (&mut bo, &mut vb[..L::N]), plain) };
+        }
         for (j, (o, b)) in out.iter_mut().zip(&ob).enumerate() {
             if w.f || !is_f(j) {
                 o[k..].copy_from_slice(&b[..rem]);
@@ -382,13 +392,14 @@ fn sample_block<L: Lanes, const NDF: u8, const STRAT: u8>(
 /// `eval_pdf` over a block, as [`sample_block`], writing what `mode` names
 /// (streamed if `stream` and every output written is aligned for `L`).
 #[inline(always)]
-fn eval_pdf_block<L: Lanes, const NDF: u8, const STRAT: u8>(
+fn eval_pdf_block<L: Lanes, P: VecKernel, const NDF: u8, const STRAT: u8>(
     l: L,
-    p: &impl VecKernel,
+    p: &P,
     mode: u8,
     inp: EvalIn<'_>,
     out: EvalOut<'_, '_>,
     stream: bool,
+    tail: EvalFn<L, P>,
 ) {
     let n = inp[0].len();
     for s in &inp {
@@ -426,12 +437,13 @@ fn eval_pdf_block<L: Lanes, const NDF: u8, const STRAT: u8>(
             b[..rem].copy_from_slice(&s[k..]);
         }
         let mut ob = [[0.0f32; MAX_LANES]; 4];
-        let bptrs = (
-            &ib.each_ref().map(|b| b.as_ptr()),
-            &ob.each_mut().map(|b| b.as_mut_ptr()),
-        );
-        // SAFETY: the buffers hold `MAX_LANES ≥ L::N` values each.
-        unsafe { eval_pdf_vector::<L, NDF, STRAT>(l, p, bptrs, (writes, false), 0) };
+        {
+            let bi = ib.each_ref().map(|b| &b[..L::N]);
+            let mut bo = ob.each_mut().map(|b| &mut b[..L::N]);
+            // SAFETY: `tail` is this instance's function (the caller's
+            // contract), at the level the caller runs at; one whole vector.
+            unsafe { tail(l, p, mode, bi, &mut bo, false) };
+        }
         for (i, (o, b)) in out.iter_mut().zip(&ob).enumerate() {
             if written(i) {
                 o[k..].copy_from_slice(&b[..rem]);
@@ -457,7 +469,7 @@ macro_rules! instance_fns {
             out: SampleOut<'_, '_>,
             w: SampleWrites,
         ) {
-            sample_block::<L, NDF, STRAT>(l, p, inp, out, w)
+            sample_block::<L, P, NDF, STRAT>(l, p, inp, out, w, $sample::<L, P, NDF, STRAT>)
         }
 
         $(#[target_feature(enable = $feat)])?
@@ -470,7 +482,15 @@ macro_rules! instance_fns {
             out: EvalOut<'_, '_>,
             stream: bool,
         ) {
-            eval_pdf_block::<L, NDF, STRAT>(l, p, mode, inp, out, stream)
+            eval_pdf_block::<L, P, NDF, STRAT>(
+                l,
+                p,
+                mode,
+                inp,
+                out,
+                stream,
+                $eval::<L, P, NDF, STRAT>,
+            )
         }
     };
 }
@@ -480,7 +500,10 @@ instance_fns!(sample_one, eval_pdf_one);
 /// An instance inlined into its caller: the AVX-512 level's [`X2`]
 /// samplers, which ran 8 to 12% slower as functions of their own (Beckmann
 /// vndf, `lobe bench`, Intel Xeon; at AVX2 and for the other kernels no
-/// difference was measured). Two instances, so the compile time stays small.
+/// difference was measured). Its last, partial vector goes to the instance
+/// function of its own (compiled once more, as the tail of the inlined loop
+/// was before).
+#[cfg(target_arch = "x86_64")]
 #[inline(always)]
 fn sample_inl<L: Lanes, P: VecKernel, const NDF: u8, const STRAT: u8>(
     l: L,
@@ -489,7 +512,7 @@ fn sample_inl<L: Lanes, P: VecKernel, const NDF: u8, const STRAT: u8>(
     out: SampleOut<'_, '_>,
     w: SampleWrites,
 ) {
-    sample_block::<L, NDF, STRAT>(l, p, inp, out, w)
+    sample_block::<L, P, NDF, STRAT>(l, p, inp, out, w, sample_one_avx512::<L, P, NDF, STRAT>)
 }
 #[cfg(target_arch = "x86_64")]
 instance_fns!(sample_one_avx2, eval_pdf_one_avx2, "avx2,fma");
