@@ -225,7 +225,8 @@ pub fn sidak(alpha: f64, tests: usize) -> f64 {
 /// For each `(weight, uc)` in `lobes`, runs `sample(uc, u)` on the midpoints
 /// `u = ((i + ½)/grid, (j + ½)/grid)` of a `grid × grid` lattice and returns
 /// `Σ weight × (fraction of lattice points where sample succeeds)`. Compare it
-/// with the pdf's integral over the sphere. `grid == 0` is read as one.
+/// with the pdf's integral over the sphere. `grid == 0` is read as one; a
+/// lobe of weight 0 is not run (it adds nothing).
 #[must_use]
 pub fn success_probability(
     sample: impl Fn(f64, DVec2) -> bool,
@@ -236,6 +237,7 @@ pub fn success_probability(
     let inv = 1.0 / g as f64;
     lobes
         .iter()
+        .filter(|&&(weight, _)| weight != 0.0)
         .map(|&(weight, uc)| {
             let mut hits = 0usize;
             for i in 0..g {
