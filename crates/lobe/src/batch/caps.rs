@@ -90,7 +90,7 @@ fn eval_at_caps<L: Lanes, const STRAT: u8>(
     oh: L::F,
     ih: L::F,
 ) -> Eval<L> {
-    let e = eval_at::<L, GGX, VNDF>(l, p, wo, wi, h, hh, oh, ih);
+    let e = eval_at::<L, GGX, VNDF>(l, p, wo, wi, h, hh, oh, ih, None);
     if STRAT != BOUNDED {
         return e;
     }
