@@ -183,6 +183,15 @@ fn beckmann_lambda1<L: Lanes>(l: L, p: &CtParams, w: V3<L>) -> L::F {
     let a = w[2] / r;
     let inv_a = r / w[2];
     let (erfc_a, e) = erfc_exp(l, a);
+    lambda1_from(l, erfc_a, e, inv_a)
+}
+
+/// `1 + Λ = 1 + max(0, (e^(−a²)/(a √π) − erfc a)/2)` of Beckmann from
+/// `erfc a`, `e^(−a²)` and `1/a` (`a = cot θ` in the stretched frame):
+/// shared by [`beckmann_lambda1`] and the visible-normal sampler, which has
+/// these terms from its normalization.
+#[inline(always)]
+fn lambda1_from<L: Lanes>(l: L, erfc_a: L::F, e: L::F, inv_a: L::F) -> L::F {
     let lam = l.splat(0.5) * l.mul_add(e * inv_a, l.splat(INV_SQRT_PI), -erfc_a);
     l.max(lam, l.splat(0.0)) + l.splat(1.0)
 }
@@ -773,10 +782,11 @@ fn beckmann_vndf_normal<L: Lanes>(
     let my = l.mul_add(sphi, sx, cphi * sy);
     let n = [-(ax * mx), -(ay * my), one];
     let inv = one / l.sqrt(dot(l, n, n));
-    // 1 + Λ(wo) = 1 + max(0, (e^(−cot²θ) tanθ/√π − erfc(cot θ))/2), from
-    // the terms of the normalization (as `beckmann_lambda1` has it).
-    let lam1o = l.max(l.splat(0.5) * l.mul_add(k, e_top, -erfc_cot), zero) + one;
-    ([n[0] * inv, n[1] * inv, inv], lam1o)
+    // 1 + Λ(wo) from the terms of the normalization.
+    (
+        [n[0] * inv, n[1] * inv, inv],
+        lambda1_from(l, erfc_cot, e_top, tan_t),
+    )
 }
 
 #[inline(always)]
