@@ -462,10 +462,15 @@ fn grid_eval_pdf_matches_scalar() {
 #[cfg(feature = "stats")]
 #[test]
 fn grid_chi2_batch_pdf() {
-    use crate::stats::chi2::{Chi2Config, chi2_test, sidak};
+    use crate::stats::chi2::{Chi2Config, chi2_test_many, sidak};
     use std::cell::Cell;
+    // The f32 pdf's rounding (≈1e-7 relative) is above the cubature's 1e-8
+    // relative goal, so cells would refine to the default budget (the θ = 89°
+    // Beckmann and Blinn cases took most of a minute); 2000 evaluations give
+    // each cell's probability far closer than 200 000 samples can resolve.
     let cfg = Chi2Config {
         samples: 200_000,
+        max_evals_per_cell: 2_000,
         ..Chi2Config::default()
     };
     let level = SimdLevel::best();
@@ -587,27 +592,37 @@ fn grid_chi2_batch_pdf() {
                         )
                     })
                 };
-                let pdf = |wi: DVec3| {
-                    let (x, y, z) = ([wi.x as f32], [wi.y as f32], [wi.z as f32]);
-                    let mut p = [0.0f32];
+                // The cubature's nodes a rectangle (225) at a time.
+                let pdf = |dirs: &[DVec3], p: &mut [f64]| {
+                    let k = dirs.len();
+                    let mut wi = [[0.0f32; 225]; 3];
+                    for (i, w) in dirs.iter().enumerate() {
+                        wi[0][i] = w.x as f32;
+                        wi[1][i] = w.y as f32;
+                        wi[2][i] = w.z as f32;
+                    }
+                    let mut p32 = [0.0f32; 225];
                     let o = Dirs {
-                        x: &wox[..1],
-                        y: &woy[..1],
-                        z: &woz[..1],
+                        x: &wox[..k],
+                        y: &woy[..k],
+                        z: &woz[..k],
                     };
+                    let [x, y, z] = &wi;
                     b.pdf(
                         o,
                         Dirs {
-                            x: &x,
-                            y: &y,
-                            z: &z,
+                            x: &x[..k],
+                            y: &y[..k],
+                            z: &z[..k],
                         },
-                        &mut p,
+                        &mut p32[..k],
                     )
                     .unwrap();
-                    f64::from(p[0])
+                    for (p, &q) in p.iter_mut().zip(&p32) {
+                        *p = f64::from(q);
+                    }
                 };
-                let r = chi2_test(&cfg, sample, pdf);
+                let r = chi2_test_many(&cfg, sample, pdf);
                 eprintln!(
                     "grid_chi2_batch_pdf {name} {s} θ={theta}: p = {:.3e}",
                     r.p_value

@@ -13,7 +13,7 @@
 //! and the statistic `Σ (O − E)² / E` is compared with a chi-square
 //! distribution with `bins − 1` degrees of freedom.
 
-use super::quadrature::{Estimate, Tolerance, integrate_sphere_region};
+use super::quadrature::{Estimate, Tolerance, integrate_sphere_region_many};
 use glam::{DVec2, DVec3};
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64;
@@ -278,23 +278,41 @@ pub fn chi2_test(
     sample: impl Fn(f64, DVec2) -> Option<DVec3>,
     pdf: impl Fn(DVec3) -> f64,
 ) -> Chi2Result {
+    chi2_test_many(cfg, sample, |dirs, out| {
+        for (p, &w) in out.iter_mut().zip(dirs) {
+            *p = pdf(w);
+        }
+    })
+}
+
+/// [`chi2_test`] with a pdf evaluated many directions at a time:
+/// `pdf(dirs, out)` sets `out[i]` to the density at `dirs[i]` (up to 225
+/// directions a call, the nodes of one cubature rectangle). Same test, same
+/// numbers; for batch kernels, whose cost per call is far above their cost
+/// per lane.
+#[must_use]
+pub fn chi2_test_many(
+    cfg: &Chi2Config,
+    sample: impl Fn(f64, DVec2) -> Option<DVec3>,
+    pdf: impl Fn(&[DVec3], &mut [f64]),
+) -> Chi2Result {
     let bad_pdf: Cell<Option<(DVec3, f64)>> = Cell::new(None);
-    let checked_pdf = |w: DVec3| {
-        let p = pdf(w);
-        if p >= 0.0 && p.is_finite() {
-            p
-        } else {
-            if bad_pdf.get().is_none() {
-                bad_pdf.set(Some((w, p)));
+    let checked_pdf = |dirs: &[DVec3], out: &mut [f64]| {
+        pdf(dirs, out);
+        for (p, &w) in out.iter_mut().zip(dirs) {
+            if !(*p >= 0.0 && p.is_finite()) {
+                if bad_pdf.get().is_none() {
+                    bad_pdf.set(Some((w, *p)));
+                }
+                *p = 0.0;
             }
-            0.0
         }
     };
     let tol = cell_tolerance(cfg.max_evals_per_cell);
     let mut result = chi2_test_cells(cfg, sample, |z0, z1, p0, p1| {
         // theta decreases with z.
         let theta = (z1.clamp(-1.0, 1.0).acos(), z0.clamp(-1.0, 1.0).acos());
-        integrate_sphere_region(checked_pdf, theta, (p0, p1), tol)
+        integrate_sphere_region_many(checked_pdf, theta, (p0, p1), tol)
     });
     if let Some((w, p)) = bad_pdf.get() {
         let msg = format!("pdf({w}) = {p} is not a finite non-negative number");

@@ -245,18 +245,57 @@ struct Spherical<F>(F);
 
 impl<F: Fn(DVec3) -> f64> GridIntegrand for Spherical<F> {
     fn eval_grid(&self, xs: &[f64; N1], ys: &[f64; N1], out: &mut [[f64; N1]; N1]) {
-        let st: [(f64, f64); N1] = std::array::from_fn(|i| xs[i].sin_cos());
-        for (row, &phi) in out.iter_mut().zip(ys) {
-            let (sp, cp) = phi.sin_cos();
-            for (v, &(s, c)) in row.iter_mut().zip(&st) {
-                *v = if s == 0.0 {
-                    // The Jacobian vanishes; do not evaluate f (it may be
-                    // singular at the pole, and the product is 0 anyway).
-                    0.0
-                } else {
-                    (self.0)(DVec3::new(s * cp, s * sp, c)) * s
-                };
+        spherical_grid(xs, ys, out, |dirs, vals| {
+            for (v, &w) in vals.iter_mut().zip(dirs) {
+                *v = (self.0)(w);
             }
+        });
+    }
+}
+
+/// [`Spherical`] with `f(dirs, out)` filling `out[i] = f(dirs[i])` for a
+/// whole node grid in one call.
+struct SphericalMany<F>(F);
+
+impl<F: Fn(&[DVec3], &mut [f64])> GridIntegrand for SphericalMany<F> {
+    fn eval_grid(&self, xs: &[f64; N1], ys: &[f64; N1], out: &mut [[f64; N1]; N1]) {
+        spherical_grid(xs, ys, out, &self.0);
+    }
+}
+
+/// Sets `out[j][i] = f(ω(xs[i], ys[j])) sin(xs[i])`, evaluating `f` on the
+/// nodes off the poles with one call of `many(dirs, values)`.
+fn spherical_grid(
+    xs: &[f64; N1],
+    ys: &[f64; N1],
+    out: &mut [[f64; N1]; N1],
+    many: impl Fn(&[DVec3], &mut [f64]),
+) {
+    let st: [(f64, f64); N1] = std::array::from_fn(|i| xs[i].sin_cos());
+    let mut dirs = [DVec3::ZERO; N1 * N1];
+    let mut n = 0;
+    for &phi in ys {
+        let (sp, cp) = phi.sin_cos();
+        for &(s, c) in &st {
+            // At a pole the Jacobian vanishes; f is not evaluated there (it
+            // may be singular, and the product is 0 anyway).
+            if s != 0.0 {
+                dirs[n] = DVec3::new(s * cp, s * sp, c);
+                n += 1;
+            }
+        }
+    }
+    let mut vals = [0.0; N1 * N1];
+    many(&dirs[..n], &mut vals[..n]);
+    let mut k = 0;
+    for row in out.iter_mut() {
+        for (v, &(s, _)) in row.iter_mut().zip(&st) {
+            *v = if s == 0.0 {
+                0.0
+            } else {
+                k += 1;
+                vals[k - 1] * s
+            };
         }
     }
 }
@@ -517,6 +556,20 @@ pub fn integrate_sphere_region(
     tol: Tolerance,
 ) -> Estimate {
     sphere_region(&f, theta, phi, tol, (1, 1))
+}
+
+/// [`integrate_sphere_region`] for an integrand evaluated many directions
+/// at a time: `f(dirs, out)` sets `out[i]` to the integrand at `dirs[i]`
+/// (up to 225 directions a call, the nodes of one cubature rectangle). For
+/// batch kernels, whose cost per call is far above their cost per lane.
+#[must_use]
+pub fn integrate_sphere_region_many(
+    f: impl Fn(&[DVec3], &mut [f64]),
+    theta: (f64, f64),
+    phi: (f64, f64),
+    tol: Tolerance,
+) -> Estimate {
+    integrate_2d_with_grid(&SphericalMany(f), theta, phi, tol, (1, 1))
 }
 
 fn sphere_region(
