@@ -793,4 +793,36 @@ mod tests {
         let d = spherical_direction(FRAC_PI_2, FRAC_PI_2);
         assert!((d - DVec3::Y).length() < 1e-15);
     }
+
+    /// The many-at-a-time integrand gives the pointwise integral exactly
+    /// (same nodes, same order, same sums), and is called once per
+    /// rectangle with at most its 225 nodes, none at a pole.
+    #[test]
+    fn many_at_a_time_matches_pointwise() {
+        use std::cell::Cell;
+        let axis = spherical_direction(0.7, 1.1);
+        let lobe = |w: DVec3| 31.0 / TAU * w.dot(axis).max(0.0).powi(30);
+        let tol = Tolerance::new(1e-12, 1e-9);
+        // A region touching the pole (theta from 0), where nodes are skipped.
+        for theta in [(0.0, 1.2), (0.3, 1.9)] {
+            let one = integrate_sphere_region(lobe, theta, (0.2, 4.0), tol);
+            let calls = Cell::new(0usize);
+            let many = integrate_sphere_region_many(
+                |dirs: &[DVec3], out: &mut [f64]| {
+                    assert!(!dirs.is_empty() && dirs.len() <= 225 && dirs.len() == out.len());
+                    assert!(dirs.iter().all(|w| w.x != 0.0 || w.y != 0.0));
+                    calls.set(calls.get() + 1);
+                    for (o, &w) in out.iter_mut().zip(dirs) {
+                        *o = lobe(w);
+                    }
+                },
+                theta,
+                (0.2, 4.0),
+                tol,
+            );
+            assert_eq!(one.value.to_bits(), many.value.to_bits(), "{one:?} {many:?}");
+            assert_eq!((one.evals, one.converged), (many.evals, many.converged));
+            assert!(calls.get() > 1 && calls.get() * 225 >= many.evals);
+        }
+    }
 }
