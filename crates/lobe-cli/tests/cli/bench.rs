@@ -1,7 +1,7 @@
 //! `lobe bench`: the JSON parses and has its fields; bad input is a
 //! one-line error. No timing assertions: speed claims never come from tests.
 
-mod common;
+use crate::common;
 
 use std::process::{Command, Output};
 

@@ -3,7 +3,7 @@
 //! finite positive RMSE, MIS is no worse than the worse of BSDF and light
 //! sampling, and bad input fails with one line.
 
-mod common;
+use crate::common;
 use common::one_line_error;
 
 use serde_json::Value;

@@ -5,7 +5,7 @@
 //! each command takes the material and gives sane numbers (the library's
 //! tests prove the sampler and the estimator).
 
-mod common;
+use crate::common;
 use common::one_line_error;
 
 use serde_json::Value;

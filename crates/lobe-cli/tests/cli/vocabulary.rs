@@ -2,7 +2,7 @@
 //! technique name, sample counts such as `1e6`), clear light errors, any
 //! case of map extensions, and warnings for energy gain and non-2:1 maps.
 
-mod common;
+use crate::common;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};

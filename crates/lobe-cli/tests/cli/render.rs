@@ -2,7 +2,7 @@
 //! image for any thread count, and one-line errors that name the file, the
 //! line and the field.
 
-mod common;
+use crate::common;
 use common::one_line_error;
 
 use std::path::{Path, PathBuf};
