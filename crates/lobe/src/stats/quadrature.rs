@@ -820,7 +820,11 @@ mod tests {
                 (0.2, 4.0),
                 tol,
             );
-            assert_eq!(one.value.to_bits(), many.value.to_bits(), "{one:?} {many:?}");
+            assert_eq!(
+                one.value.to_bits(),
+                many.value.to_bits(),
+                "{one:?} {many:?}"
+            );
             assert_eq!((one.evals, one.converged), (many.evals, many.converged));
             assert!(calls.get() > 1 && calls.get() * 225 >= many.evals);
         }
