@@ -1,7 +1,7 @@
 //! Warps from the unit square to directions, in pairs as in Nori:
 //! `square_to_x(u)` draws a direction and `square_to_x_pdf(w)` is its density
 //! in solid angle (the disk's: in area). Each pair is chi-square tested in
-//! `tests/chi2.rs` (`chi2_warps`; the disk lifted onto the hemisphere), and
+//! `tests/integration/chi2.rs` (`chi2_warps`; the disk lifted onto the hemisphere), and
 //! the samplers use the `_pdf` partners as their densities: the material's
 //! `uniform` and `cosine` strategies, Lambert's `brdf`, the Phong and
 //! Blinn-Phong lobes ([`cos_power_pdf`]) and the constant and beam lights.

@@ -268,7 +268,7 @@ pub(crate) fn eval_pdf_block(k: &MeasuredKernel, mode: u8, inp: EvalIn<'_>, out:
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::super::{
         BatchSampler, Dirs, EvalPdfBuffers, RgbMut, SampleBuffers, SampleInput, SimdLevel, Store,
     };
@@ -279,7 +279,7 @@ mod tests {
     use glam::{DVec2, DVec3};
 
     /// A GGX + Lambert material to tabulate.
-    fn analytic() -> Material {
+    pub(in crate::batch) fn analytic() -> Material {
         let lobe = crate::models::CookTorrance::new(
             Rgb::new(0.9, 0.7, 0.5),
             crate::Microfacet::new(crate::Ndf::Ggx, 0.2, 0.2).unwrap(),
@@ -290,7 +290,7 @@ mod tests {
         Material::with_diffuse(Rgb::splat(0.1), Glossy::CookTorrance(lobe)).unwrap()
     }
 
-    fn measured(
+    pub(in crate::batch) fn measured(
         bytes: &[u8],
         name: &str,
         interp: Option<crate::models::measured::Interpolation>,

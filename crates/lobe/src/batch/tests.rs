@@ -492,26 +492,111 @@ pub(super) fn bits(b: &SampleBuffers) -> Vec<u32> {
     v
 }
 
-/// The same bits whatever the block size, the thread split and the level.
+/// The materials and strategies of the determinism test: one of each
+/// kernel family (GGX's two samplers, Beckmann's per-lane Newton iteration,
+/// the Blinn-Phong NDF, spherical caps, a two-lobe mixture that reads `uc`,
+/// Phong and Blinn-Phong, Lambert, a measured table).
+fn determinism_cases() -> Vec<(String, Material, BsdfStrategy)> {
+    use crate::models::{BlinnPhong, Phong};
+    let ct = |ndf: Ndf, ax: f64, ay: f64, kd: Rgb| {
+        let mf = Microfacet::new(ndf, ax, ay).unwrap();
+        let f = Fresnel::Schlick {
+            f0: Rgb::new(0.9, 0.5, 0.2),
+        };
+        let lobe = CookTorrance::new(Rgb::ONE, mf, Shadowing::SmithCorrelated, f).unwrap();
+        Material::with_diffuse(kd, Glossy::CookTorrance(lobe)).unwrap()
+    };
+    let kd = Rgb::new(0.4, 0.3, 0.2);
+    let phong = Glossy::Phong(Phong::new(Rgb::ONE, 30.0, true).unwrap());
+    let blinn = Glossy::BlinnPhong(BlinnPhong::new(Rgb::ONE, 200.0, true).unwrap());
+    let mut v = vec![
+        (
+            "ggx".to_string(),
+            ct(Ndf::Ggx, 0.05, 0.5, Rgb::ZERO),
+            BsdfStrategy::Vndf,
+        ),
+        (
+            "ggx".into(),
+            ct(Ndf::Ggx, 0.05, 0.5, Rgb::ZERO),
+            BsdfStrategy::Brdf,
+        ),
+        (
+            "ggx".into(),
+            ct(Ndf::Ggx, 0.3, 0.1, Rgb::ZERO),
+            BsdfStrategy::SphericalCaps,
+        ),
+        (
+            "ggx + lambert".into(),
+            ct(Ndf::Ggx, 0.2, 0.2, kd),
+            BsdfStrategy::Vndf,
+        ),
+        (
+            "beckmann".into(),
+            ct(Ndf::Beckmann, 0.4, 0.1, Rgb::ZERO),
+            BsdfStrategy::Vndf,
+        ),
+        (
+            "beckmann + lambert".into(),
+            ct(Ndf::Beckmann, 0.3, 0.3, kd),
+            BsdfStrategy::Brdf,
+        ),
+        (
+            "blinn-phong ndf".into(),
+            ct(Ndf::BlinnPhong, 0.2, 0.2, Rgb::ZERO),
+            BsdfStrategy::Brdf,
+        ),
+        (
+            "phong + lambert".into(),
+            Material::with_diffuse(kd, phong).unwrap(),
+            BsdfStrategy::Brdf,
+        ),
+        (
+            "blinn-phong".into(),
+            Material::with_diffuse(Rgb::ZERO, blinn).unwrap(),
+            BsdfStrategy::Brdf,
+        ),
+        (
+            "lambert".into(),
+            Material::lambert(kd).unwrap(),
+            BsdfStrategy::Cosine,
+        ),
+    ];
+    // An RGL table of a GGX + Lambert material (per-lane f64 kernels).
+    let a = super::measured::tests::analytic();
+    let rgl = crate::models::measured::rgl::Rgl::write(|o, i| a.eval(o, i), 6, 24, "determinism");
+    let table = super::measured::tests::measured(&rgl, "t.bsdf", None);
+    v.push(("measured".into(), table, BsdfStrategy::Brdf));
+    v
+}
+
+/// The same bits whatever the block size, the thread split and the level,
+/// for every kernel family (`determinism_cases`), `uc` included.
 #[test]
 fn batch_same_numbers_for_any_block_thread_and_level() {
     let mut rng = Pcg64::seed_from_u64(0xb10c);
-    let m = ggx(
-        0.05,
-        0.5,
-        Fresnel::Schlick {
-            f0: Rgb::new(0.9, 0.5, 0.2),
-        },
-        Rgb::ONE,
-    );
     let n = 10_007;
     let inp = inputs(&mut rng, n);
-    for s in [BsdfStrategy::Vndf, BsdfStrategy::Brdf] {
+    // The inputs of `range`, `uc` included (the one-lobe kernels ignore it).
+    let part = |r: std::ops::Range<usize>| SampleInput {
+        wo: Dirs {
+            x: &inp.wo[0][r.clone()],
+            y: &inp.wo[1][r.clone()],
+            z: &inp.wo[2][r.clone()],
+        },
+        u1: &inp.u1[r.clone()],
+        u2: &inp.u2[r.clone()],
+        uc: Some(&inp.uc[r]),
+    };
+    for (name, m, s) in determinism_cases() {
         let mut reference: Option<Vec<u32>> = None;
         for level in levels("batch_same_numbers") {
             let b = BatchSampler::with_level(&m, s, level).unwrap();
             let mut whole = SampleBuffers::new(n);
             b.sample(inp.input(), whole.output()).unwrap();
+            assert!(
+                whole.valid.iter().filter(|&&v| v == 1).count() > n / 4,
+                "{name} {s} {level}: too few valid samples for the test to mean anything"
+            );
             let whole = bits(&whole);
             // Blocks of odd sizes, one after the other.
             for block in [1usize, 3, 7, 15, 17, 100, 4097] {
@@ -521,17 +606,7 @@ fn batch_same_numbers_for_any_block_thread_and_level() {
                     let end = (start + block).min(n);
                     let r = start..end;
                     let mut one = SampleBuffers::new(end - start);
-                    let input = SampleInput {
-                        wo: Dirs {
-                            x: &inp.wo[0][r.clone()],
-                            y: &inp.wo[1][r.clone()],
-                            z: &inp.wo[2][r.clone()],
-                        },
-                        u1: &inp.u1[r.clone()],
-                        u2: &inp.u2[r.clone()],
-                        uc: None,
-                    };
-                    b.sample(input, one.output()).unwrap();
+                    b.sample(part(r.clone()), one.output()).unwrap();
                     for (d, s) in parts.wi.iter_mut().zip(&one.wi) {
                         d[r.clone()].copy_from_slice(s);
                     }
@@ -545,7 +620,10 @@ fn batch_same_numbers_for_any_block_thread_and_level() {
                     parts.valid[r.clone()].copy_from_slice(&one.valid);
                     start = end;
                 }
-                assert!(bits(&parts) == whole, "{level} {s}: block {block} differs");
+                assert!(
+                    bits(&parts) == whole,
+                    "{name} {level} {s}: block {block} differs"
+                );
             }
             // Two and three threads, each on its own part.
             for threads in [2usize, 3] {
@@ -554,20 +632,10 @@ fn batch_same_numbers_for_any_block_thread_and_level() {
                     let handles: Vec<_> = (0..threads)
                         .map(|t| {
                             let r = (t * chunk).min(n)..((t + 1) * chunk).min(n);
-                            let inp = &inp;
+                            let (b, part) = (&b, &part);
                             scope.spawn(move || {
                                 let mut one = SampleBuffers::new(r.len());
-                                let input = SampleInput {
-                                    wo: Dirs {
-                                        x: &inp.wo[0][r.clone()],
-                                        y: &inp.wo[1][r.clone()],
-                                        z: &inp.wo[2][r.clone()],
-                                    },
-                                    u1: &inp.u1[r.clone()],
-                                    u2: &inp.u2[r.clone()],
-                                    uc: None,
-                                };
-                                b.sample(input, one.output()).unwrap();
+                                b.sample(part(r), one.output()).unwrap();
                                 one
                             })
                         })
@@ -583,11 +651,17 @@ fn batch_same_numbers_for_any_block_thread_and_level() {
                         joined.extend_from_slice(&p[k * len..(k + 1) * len]);
                     }
                 }
-                assert!(joined == whole, "{level} {s}: {threads} threads differ");
+                assert!(
+                    joined == whole,
+                    "{name} {level} {s}: {threads} threads differ"
+                );
             }
             match &reference {
                 None => reference = Some(whole),
-                Some(r) => assert!(*r == whole, "{level} {s}: differs from the first level"),
+                Some(r) => assert!(
+                    *r == whole,
+                    "{name} {level} {s}: differs from the first level"
+                ),
             }
         }
     }

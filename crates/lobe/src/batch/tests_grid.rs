@@ -453,12 +453,20 @@ fn grid_eval_pdf_matches_scalar() {
     );
 }
 
+/// `wo` as the batch API's slices.
+fn o_dirs<'a>(x: &'a [f32], y: &'a [f32], z: &'a [f32]) -> Dirs<'a> {
+    Dirs { x, y, z }
+}
+
 /// Chi-square of the batch samples against the batch pdf (evaluated by
-/// `BatchSampler::pdf`, one direction at a time) over every batched
+/// `BatchSampler::pdf`, a cubature rectangle at a time) over every batched
 /// (distribution, strategy) pair, an isotropic and an anisotropic alpha,
-/// and views at 0°, 60° and 89°, at the best level (the others give the
-/// same bits: `grid_sample_matches_scalar`). The Fresnel and shadowing
-/// terms do not enter the pdf. Cost: about 20 s of CPU in release.
+/// and views at 0°, 60° and 89°, at every level the CPU has: the test runs
+/// at the best level, and every other level must draw the same bits from
+/// the same uniforms (wi, f, pdf, weight, mask) and give the same pdf bits
+/// at the drawn directions, so that its chi-square is the same test with
+/// the same statistic. The Fresnel and shadowing terms do not enter the
+/// pdf. Cost: about 20 s of CPU in release.
 #[cfg(feature = "stats")]
 #[test]
 fn grid_chi2_batch_pdf() {
@@ -580,6 +588,48 @@ fn grid_chi2_batch_pdf() {
                     uc: Some(&uc),
                 };
                 b.sample(input, out.output()).unwrap();
+                // Every other level: the same samples, and the same pdf at
+                // the sampled directions (the chi-square's histogram and
+                // the density it is tested against).
+                let drawn = super::tests::bits(&out);
+                let mut pdf_best = vec![0.0f32; n];
+                b.pdf(
+                    o_dirs(&wox, &woy, &woz),
+                    super::tests::dirs(&out.wi),
+                    &mut pdf_best,
+                )
+                .unwrap();
+                for other in super::tests::levels("grid_chi2_batch_pdf") {
+                    if other == level {
+                        continue;
+                    }
+                    let bo = BatchSampler::with_level(&m, s, other).unwrap();
+                    let mut again = SampleBuffers::new(n);
+                    let input = SampleInput {
+                        wo: o_dirs(&wox, &woy, &woz),
+                        u1: &u1,
+                        u2: &u2,
+                        uc: Some(&uc),
+                    };
+                    bo.sample(input, again.output()).unwrap();
+                    let mut pdf_other = vec![0.0f32; n];
+                    bo.pdf(
+                        o_dirs(&wox, &woy, &woz),
+                        super::tests::dirs(&out.wi),
+                        &mut pdf_other,
+                    )
+                    .unwrap();
+                    let same_pdf = pdf_best
+                        .iter()
+                        .zip(&pdf_other)
+                        .all(|(a, b)| a.to_bits() == b.to_bits());
+                    if super::tests::bits(&again) != drawn || !same_pdf {
+                        failures.push(format!(
+                            "{name} {s} θ={theta}: level {other} differs from {level} (samples equal: {}, pdf equal: {same_pdf})",
+                            super::tests::bits(&again) == drawn
+                        ));
+                    }
+                }
                 let next = Cell::new(0usize);
                 let sample = |_uc: f64, _u: DVec2| {
                     let i = next.get();

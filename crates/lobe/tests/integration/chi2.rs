@@ -5,7 +5,7 @@
 //! Significance 0.01 over the whole grid (Šidák). A failure writes the
 //! observed and expected tables to `target/tmp/chi2-failures/<case>.csv`.
 
-mod common;
+use crate::common;
 
 use common::{Case, plan};
 use glam::DVec2;

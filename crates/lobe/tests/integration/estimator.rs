@@ -2,7 +2,7 @@
 //! view and light; importance sampling cuts the variance where the lecture
 //! says it does.
 
-mod common;
+use crate::common;
 
 use glam::DVec3;
 use lobe::estimator::{Plan, ShadingPoint, estimate, reference};

@@ -6,7 +6,7 @@
 //! heavy-tailed estimator's sample variance can be far too small); and the
 //! estimator is unbiased and its sample variance is the one predicted.
 
-mod common;
+use crate::common;
 
 use glam::DVec3;
 use lobe::estimator::{Allocation, Plan, ShadingPoint, Strategy, estimate, reference};

@@ -8,10 +8,10 @@
 //! evaluated; every 100th accepted file (10th in the long run) also builds
 //! the tabulated sampler, which is drawn from and evaluated.
 //!
-//! `cargo test -p lobe --test measured_fuzz` runs a short round (a few s);
-//! the long run is `LOBE_FUZZ_SECONDS=600 cargo test -p lobe --release
-//! --test measured_fuzz -- --ignored --nocapture` (crashers are written to
-//! `target/fuzz-crashers/`).
+//! `cargo test -p lobe --test integration measured_fuzz::` runs a short
+//! round (a few s); the long run is `LOBE_FUZZ_SECONDS=600 cargo test -p
+//! lobe --release --test integration measured_fuzz:: -- --ignored
+//! --nocapture` (crashers are written to `target/fuzz-crashers/`).
 
 use glam::{DVec2, DVec3};
 use lobe::models::measured::merl::Interpolation;

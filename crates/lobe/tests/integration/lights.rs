@@ -2,7 +2,7 @@
 //! (chi-square, integral), and MIS against BSDF-only and light-only sampling
 //! on a map with a sun.
 
-mod common;
+use crate::common;
 
 use glam::DVec3;
 use lobe::envmap::EnvMap;

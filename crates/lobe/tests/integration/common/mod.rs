@@ -1,7 +1,6 @@
 //! The parameter grid shared by the statistical tests: every model and
 //! strategy over exponents 1 to 10⁴, alphas 0.02 to 1, anisotropy and view
 //! angles 0 to 89°.
-#![allow(dead_code)]
 
 use glam::DVec3;
 use lobe::{BsdfStrategy, Material, MaterialDesc};

@@ -3,7 +3,7 @@
 //! unbiasedness (Student t-test against quadrature), no NaN under extreme
 //! inputs, and bad parameters refused.
 
-mod common;
+use crate::common;
 
 use glam::{DVec2, DVec3};
 use lobe::math::{Rgb, luminance};

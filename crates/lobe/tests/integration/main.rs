@@ -1,0 +1,16 @@
+//! lobe's integration tests, in one test binary: each file is a module, so
+//! the binary links lobe and its dependencies once instead of seven times
+//! (CI's budget is mostly compile and link time). `cargo test -p lobe
+//! --test integration chi2::` runs one module.
+
+// Each module uses a part of the shared helpers.
+#[allow(dead_code)]
+mod common;
+
+mod adaptive_mis;
+mod chi2;
+mod estimator;
+mod lights;
+mod measured;
+mod measured_fuzz;
+mod properties;
