@@ -49,6 +49,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 
 BECKMANN = '{"type":"cook-torrance","distribution":"beckmann","alpha":0.2}'
+GGX = '{"type":"cook-torrance","distribution":"ggx","alpha":0.2}'
 
 
 def die(msg):
@@ -88,8 +89,21 @@ def run_json(cmd, env=None, side=None, threads=1):
 
 
 def key(material, strategy):
-    """Canonical (material, strategy) key: the material JSON with sorted keys."""
-    return (json.dumps(json.loads(material), sort_keys=True), strategy)
+    """Canonical (material, strategy) key: the material JSON with sorted keys,
+    without lobe's `shadowing` (Mitsuba's results name lobe's default
+    material; `--shadowing` says which term lobe ran)."""
+    m = json.loads(material)
+    m.pop("shadowing", None)
+    return (json.dumps(m, sort_keys=True), strategy)
+
+
+def with_shadowing(material, shadowing):
+    """`material` with lobe's `shadowing` key set (None: lobe's default)."""
+    if shadowing is None:
+        return material
+    m = json.loads(material)
+    m["shadowing"] = shadowing
+    return json.dumps(m, separators=(",", ":"))
 
 
 def label(material):
@@ -109,6 +123,9 @@ def main():
     p.add_argument("--samples", "-n", type=int, default=1 << 22, help="samples per run (default 2^22)")
     p.add_argument("--reps", type=int, default=10, help="warm runs per figure, median (default 10)")
     p.add_argument("--json-out", help="also write every raw JSON result to this file")
+    p.add_argument("--shadowing", choices=["smith-correlated", "smith-separable"],
+                   help="lobe's Smith term (default: lobe's default, smith-correlated); "
+                        "smith-separable is the term Mitsuba's roughconductor evaluates")
     args = p.parse_args()
     try:
         threads = [int(t) for t in args.threads.split(",")]
@@ -143,10 +160,19 @@ def main():
 
     def lobe_runs(t):
         base = [args.lobe, "bench", "--json", "--threads", str(t)] + common
-        for extra in ([], ["--material", BECKMANN, "--strategy", "vndf"]):
+        # (key of the run's results if it fails, extra arguments)
+        if args.shadowing is None:
+            runs = ((("lobe default table", ""), []),
+                    (key(BECKMANN, "vndf"), ["--material", BECKMANN, "--strategy", "vndf"]))
+        else:
+            runs = ((("lobe GGX runs", ""),
+                     ["--material", with_shadowing(GGX, args.shadowing), "--strategy", "vndf,brdf"]),
+                    (key(BECKMANN, "vndf"),
+                     ["--material", with_shadowing(BECKMANN, args.shadowing), "--strategy", "vndf"]))
+        for fail_key, extra in runs:
             out, err = run_json(base + extra, side="lobe", threads=t)
             if out is None:
-                k = key(BECKMANN, "vndf") if extra else ("lobe default table", "")
+                k = fail_key
                 notes[(k, t)] = err if err.startswith("lobe") else f"lobe: {err}"
                 figures.setdefault((k, t), {})
                 continue
@@ -199,7 +225,8 @@ def main():
           f"{mt.get('simd', '?')}).  ")
     print(f"lobe commit {commit}; {datetime.datetime.now(datetime.timezone.utc):%Y-%m-%d %H:%M} UTC; "
           f"load average at the end {load}; {args.samples} samples, median of {args.reps} warm runs "
-          f"per round, median of {args.rounds} alternating rounds; M samples/s.  ")
+          f"per round, median of {args.rounds} alternating rounds; M samples/s; lobe's shadowing: "
+          f"{args.shadowing or 'smith-correlated (its default)'}, Mitsuba's: separable Smith.  ")
     share = {k: f"{100 * statistics.median(v):.0f}%" if v else "?" for k, v in SHARE.items()}
     print(f"Share of its T cores each process got (CPU time / (wall time × T), median over the runs; "
           f"about 100% on an idle machine, less when other work competes): lobe {share['lobe']}, "

@@ -25,6 +25,10 @@ const DEFAULT_TABLE: [(&str, BsdfStrategy); 3] = [
 /// Samples per call of the batch API: the outputs stay in the L1/L2 caches.
 const BLOCK: usize = 4096;
 
+/// The fewest samples for a figure worth quoting (issue 9: at least 2²²;
+/// the inputs, 20 bytes a sample, then far exceed the caches).
+const QUOTABLE_SAMPLES: usize = 1 << 22;
+
 #[derive(Args, Debug)]
 #[command(
     about = "Throughput of the batch (SIMD) kernels, with the scalar f64 path as a peer",
@@ -289,6 +293,13 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     }
     if args.samples == 0 || args.reps == 0 {
         bail!("--samples and --reps must be at least 1");
+    }
+    if args.samples < QUOTABLE_SAMPLES {
+        eprintln!(
+            "lobe bench: note: --samples {} is below 2^22 = {QUOTABLE_SAMPLES}: more of the inputs \
+             stay in the caches, so these figures are not comparable with the README's",
+            args.samples
+        );
     }
     // (material text, material, strategy) rows.
     let mut rows: Vec<(String, Material, BsdfStrategy)> = Vec::new();

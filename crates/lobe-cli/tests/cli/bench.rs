@@ -24,6 +24,9 @@ fn bench_json_parses() {
     assert!(!v["cpu"].as_str().unwrap().is_empty());
     assert_eq!(v["threads"], 1);
     assert_eq!(v["samples"], 65536);
+    // Fewer samples than a quotable figure needs: said on stderr, not stdout.
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("below 2^22"), "{err}");
     let r = v["results"].as_array().unwrap();
     let names: Vec<&str> = r.iter().map(|x| x["strategy"].as_str().unwrap()).collect();
     // The README's table: GGX vndf, GGX brdf, Beckmann vndf.

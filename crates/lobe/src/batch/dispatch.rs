@@ -299,6 +299,44 @@ unsafe fn put<L: Lanes, const M: usize>(
     }
 }
 
+// The helpers below are not generic over the level or the kernel, so they
+// are compiled once, not once per kernel instance: written inline as array
+// `map`s in the block loops (126 instances), their iterator machinery was
+// 15% of lobe's LLVM IR (`cargo llvm-lines`), for nothing the optimizer
+// kept.
+
+/// The inputs' data pointers.
+#[inline]
+fn in_ptrs(inp: &[&[f32]; 6]) -> [*const f32; 6] {
+    let mut p = [std::ptr::null(); 6];
+    for (d, s) in p.iter_mut().zip(inp) {
+        *d = s.as_ptr();
+    }
+    p
+}
+
+/// The outputs' data pointers.
+#[inline]
+fn out_ptrs<const M: usize>(out: &mut [&mut [f32]; M]) -> [*mut f32; M] {
+    let mut p = [std::ptr::null_mut(); M];
+    for (d, s) in p.iter_mut().zip(out.iter_mut()) {
+        *d = s.as_mut_ptr();
+    }
+    p
+}
+
+/// The first `n` values of each tail buffer.
+#[inline]
+fn heads<const M: usize>(b: &[[f32; MAX_LANES]; M], n: usize) -> [&[f32]; M] {
+    b.each_ref().map(|b| &b[..n])
+}
+
+/// The first `n` values of each tail buffer, to write.
+#[inline]
+fn heads_mut<const M: usize>(b: &mut [[f32; MAX_LANES]; M], n: usize) -> [&mut [f32]; M] {
+    b.each_mut().map(|b| &mut b[..n])
+}
+
 /// Whether `p` is aligned for [`Lanes::stream_ptr`] at `L`.
 #[inline(always)]
 fn aligned<L: Lanes>(p: *mut f32) -> bool {
@@ -331,11 +369,7 @@ fn sample_block<L: Lanes, P: VecKernel, const NDF: u8, const STRAT: u8>(
     }
     assert_eq!(valid.len(), n);
     let two = p.two_lobes();
-    let ptrs = (
-        &inp.map(<[f32]>::as_ptr),
-        &out.each_mut().map(|o| o.as_mut_ptr()),
-        valid.as_mut_ptr(),
-    );
+    let ptrs = (&in_ptrs(&inp), &out_ptrs(out), valid.as_mut_ptr());
     let w = SampleWrites {
         f: w.f,
         stream: w.stream && (0..10).all(|j| (!w.f && is_f(j)) || aligned::<L>(ptrs.1[j])),
@@ -370,8 +404,8 @@ fn sample_block<L: Lanes, P: VecKernel, const NDF: u8, const STRAT: u8>(
         let mut ob = [[0.0f32; MAX_LANES]; 10];
         let mut vb = [0u8; MAX_LANES];
         {
-            let bi = ib.each_ref().map(|b| &b[..L::N]);
-            let mut bo = ob.each_mut().map(|b| &mut b[..L::N]);
+            let bi = heads(&ib, L::N);
+            let mut bo = heads_mut(&mut ob, L::N);
             let plain = SampleWrites {
                 f: w.f,
                 stream: false,
@@ -410,10 +444,7 @@ fn eval_pdf_block<L: Lanes, P: VecKernel, const NDF: u8, const STRAT: u8>(
     for (i, o) in out.iter().enumerate() {
         assert!(!written(i) || o.len() == n);
     }
-    let ptrs = (
-        &inp.map(<[f32]>::as_ptr),
-        &out.each_mut().map(|o| o.as_mut_ptr()),
-    );
+    let ptrs = (&in_ptrs(&inp), &out_ptrs(out));
     let stream = stream && (0..4).all(|j| !written(j) || aligned::<L>(ptrs.1[j]));
     let mut k = 0;
     while k + L::N <= n {
@@ -438,8 +469,8 @@ fn eval_pdf_block<L: Lanes, P: VecKernel, const NDF: u8, const STRAT: u8>(
         }
         let mut ob = [[0.0f32; MAX_LANES]; 4];
         {
-            let bi = ib.each_ref().map(|b| &b[..L::N]);
-            let mut bo = ob.each_mut().map(|b| &mut b[..L::N]);
+            let bi = heads(&ib, L::N);
+            let mut bo = heads_mut(&mut ob, L::N);
             // SAFETY: `tail` is this instance's function (the caller's
             // contract), at the level the caller runs at; one whole vector.
             unsafe { tail(l, p, mode, bi, &mut bo, false) };
