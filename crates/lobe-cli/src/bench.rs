@@ -294,13 +294,6 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     if args.samples == 0 || args.reps == 0 {
         bail!("--samples and --reps must be at least 1");
     }
-    if args.samples < QUOTABLE_SAMPLES {
-        eprintln!(
-            "lobe bench: note: --samples {} is below 2^22 = {QUOTABLE_SAMPLES}: more of the inputs \
-             stay in the caches, so these figures are not comparable with the README's",
-            args.samples
-        );
-    }
     // (material text, material, strategy) rows.
     let mut rows: Vec<(String, Material, BsdfStrategy)> = Vec::new();
     match &args.material {
@@ -337,6 +330,14 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         })
         .collect::<Result<_>>()?;
     let level = samplers.first().map(BatchSampler::level);
+    // After every argument is checked: an error stays one line.
+    if args.samples < QUOTABLE_SAMPLES {
+        eprintln!(
+            "lobe bench: note: --samples {} is below 2^22 = {QUOTABLE_SAMPLES}: more of the inputs \
+             stay in the caches, so these figures are not comparable with the README's",
+            args.samples
+        );
+    }
     let inputs = Inputs::new(args.samples);
     let msps = |d: Duration| args.samples as f64 / d.as_secs_f64() / 1e6;
     let mut results = Vec::new();

@@ -206,13 +206,29 @@ fn lecture_allowance(w: &mut Worst, exempt: &mut usize) {
     *exempt += before - w.bad.len();
 }
 
+/// `LOBE_TEST_SCALE=k` (an integer, default 1) runs the two grid
+/// comparisons with k times the inputs per material: CI runs k = 1 (about
+/// 9·10⁴ samples per pair); `LOBE_TEST_SCALE=16` gives about 1.5·10⁶ per
+/// pair (a few minutes).
+fn test_scale() -> usize {
+    match std::env::var("LOBE_TEST_SCALE") {
+        Err(_) => 1,
+        Ok(v) => v
+            .trim()
+            .parse::<usize>()
+            .ok()
+            .filter(|&k| k >= 1)
+            .unwrap_or_else(|| panic!("LOBE_TEST_SCALE={v:?}: not an integer >= 1")),
+    }
+}
+
 /// Samples of every batched pair, every shadowing × Fresnel, iso and
 /// aniso, at every level, against the scalar path. Cost: about 15 s of
-/// CPU in release.
+/// CPU in release (times `LOBE_TEST_SCALE`).
 #[test]
 fn grid_sample_matches_scalar() {
     let mut rng = Pcg64::seed_from_u64(0x9a1d);
-    let n = 2_053;
+    let n = 2_053 * test_scale();
     let mut summary = Vec::new();
     for (name, mats, s) in groups(&mut rng, 16) {
         let mut sets: Vec<Inputs> = mats.iter().map(|_| inputs(&mut rng, n)).collect();
@@ -267,16 +283,20 @@ fn grid_sample_matches_scalar() {
                 ),
             }
             let line = format!(
-                "{} {s} {level}: {} samples, {} valid; mask differs near the horizon: {}; max |Δwi| {:.2e}; \
-                 max rel f {:.2e}, pdf {:.2e}, weight {:.2e}; ill-conditioned {} (worst {:.2e}); beyond 1e-4: {}",
+                "{} {s} {level}: {} samples, {} valid; mask differs near the horizon: {}; max |Δwi| {:.2e} \
+                 ({} beyond 1e-5 within what the inputs' rounding explains, {} beyond it, to {:.2e}); max rel f {:.2e}, pdf {:.2e}, weight {:.2e} (less twice what |Δwi| explains: {:.2e}); ill-conditioned {} (worst {:.2e}); beyond 1e-4: {}",
                 name,
                 w.count,
                 w.valid,
                 w.mask_exempt,
                 w.wi_abs,
+                w.wi_explained,
+                w.wi_bad.len(),
+                w.wi_bad_max,
                 w.f_rel,
                 w.pdf_rel,
                 w.weight_rel,
+                w.excess,
                 w.ill_conditioned,
                 w.ill_rel,
                 w.beyond_rel
@@ -297,20 +317,16 @@ fn grid_sample_matches_scalar() {
                 );
             }
             let show = |v: &[String]| v.iter().take(4).cloned().collect::<Vec<_>>().join("\n");
-            // Beckmann vndf: wi within 1e-4 (not 1e-5) where the slope CDF is
-            // inverted within 6e-8 of 1 at grazing views (measured: 10 samples
-            // in 8e4, |Δwi| ≤ 7.3e-5; see the module doc).
+            // wi within 1e-5, or within 1e-5 + twice what the uniforms' and
+            // the view's f32 rounding moves the scalar wi by (counted:
+            // Beckmann vndf where the slope CDF is inverted within 6e-8 of
+            // 1 at grazing views; the caps' point near −wh at the rim). The
+            // caps and the bounded VNDF at the rim (u2 → 1) of a grazing
+            // view, where `point + wh` cancels in f32, may differ by more
+            // than that explains, within 2e-5 (1 sample in 10⁶ at
+            // LOBE_TEST_SCALE=16, |Δwi| = 1.6e-5; module doc).
             let caps = matches!(s, BsdfStrategy::SphericalCaps | BsdfStrategy::BoundedVndf);
-            let wi_ok = if name == "beckmann" && s == BsdfStrategy::Vndf {
-                w.wi_abs < 1e-4
-            } else if caps {
-                // The caps' point near −wh (the rim, u2 → 1, at grazing
-                // views) makes `point + wh` cancel in f32: |Δwi| up to
-                // 1.4e-5 there (measured: 1 sample in 6·10⁴; module doc).
-                w.wi_abs < 2e-5
-            } else {
-                w.wi_bad.is_empty()
-            };
+            let wi_ok = w.wi_bad.is_empty() || (caps && w.wi_bad_max < 2e-5);
             // Where f and pdf are evaluated at h = wo + wi (uniform, cosine,
             // the diffuse lobe's samples) and wi is nearly −wo mirrored at a
             // grazing wo, the f32 sum loses bits no sampler can restore: at
@@ -336,8 +352,7 @@ fn grid_sample_matches_scalar() {
             let ok = bad_ok
                 && w.mask_bad.is_empty()
                 && wi_ok
-                && w.f_rel.max(w.pdf_rel).max(w.weight_rel)
-                    < if w.bad.is_empty() { REL } else { 1e-3 };
+                && w.excess < if w.bad.is_empty() { REL } else { 1e-3 };
             if !ok {
                 summary.push(format!(
                     "{line}\n bad: {}\n mask: {} {}\n wi: {} {}",
@@ -355,15 +370,18 @@ fn grid_sample_matches_scalar() {
 
 /// `eval_pdf`, `eval` and `pdf` of every batched pair against the scalar
 /// `eval_pdf` on random and sampled pairs (`eval` and `pdf` give the same
-/// bits as `eval_pdf`). Cost: about 3 s in release.
+/// bits as `eval_pdf`). Cost: about 3 s in release (times
+/// `LOBE_TEST_SCALE`).
 #[test]
 fn grid_eval_pdf_matches_scalar() {
     let mut rng = Pcg64::seed_from_u64(0xe7a2);
-    let n = 1_027;
+    let n = 1_027 * test_scale();
     let mut failures = Vec::new();
     for (name, mats, s) in groups(&mut rng, 8) {
         for level in levels("grid_eval_pdf_matches_scalar") {
             let (mut f_rel, mut pdf_rel, mut exempt) = (0.0f64, 0.0f64, 0usize);
+            let (mut ill, mut ill_rel) = (0usize, 0.0f64);
+            let mut worst_pair = String::new();
             for m in &mats {
                 let sp = m.sampler(s).unwrap();
                 let mut wo = [vec![], vec![], vec![]];
@@ -422,24 +440,38 @@ fn grid_eval_pdf_matches_scalar() {
                         }
                         continue;
                     }
-                    for c in 0..3 {
-                        f_rel = f_rel.max(rel_err(fb[c].into(), f[c]));
-                        if rel_err(fb[c].into(), f[c]) > 1e-3 && std::env::var("DBG").is_ok() {
-                            eprintln!(
-                                "DBG {level} {m:?} {s} wo {o} wi {i}: f {} vs {}",
-                                fb[c], f[c]
-                            );
+                    let ef = (0..3)
+                        .map(|c| rel_err(fb[c].into(), f[c]))
+                        .fold(0.0, f64::max);
+                    let ep = rel_err(pb.into(), pdf);
+                    if ef.max(ep) > REL {
+                        // Beyond the tolerance: counted, not failed, where
+                        // the inputs' own length rounding explains it (as the
+                        // sample comparison's `1e-4 + twice what Δwi explains`).
+                        let got = [fb[0], fb[1], fb[2], pb].map(f64::from);
+                        let want = [f[0], f[1], f[2], pdf];
+                        let change = length_rounding_change(&sp, o, i);
+                        if (0..4).all(|k| rel_err(got[k], want[k]) <= REL + 2.0 * change[k]) {
+                            ill += 1;
+                            ill_rel = ill_rel.max(ef.max(ep));
+                            continue;
                         }
                     }
-                    pdf_rel = pdf_rel.max(rel_err(pb.into(), pdf));
+                    if ef.max(ep) > f_rel.max(pdf_rel) {
+                        worst_pair =
+                            format!("{m:?} wo {o} wi {i}: f {fb:?} vs {f}, pdf {pb} vs {pdf}");
+                    }
+                    f_rel = f_rel.max(ef);
+                    pdf_rel = pdf_rel.max(ep);
                 }
             }
             eprintln!(
-                "grid_eval_pdf_matches_scalar {name} {s} {level}: max rel f {f_rel:.2e}, pdf {pdf_rel:.2e}; zero on one side within 1e-5 of the horizon: {exempt}"
+                "grid_eval_pdf_matches_scalar {name} {s} {level}: max rel f {f_rel:.2e}, pdf {pdf_rel:.2e}; zero on one side within 1e-5 of the horizon: {exempt}; \
+                 beyond 1e-4 but within the inputs' length rounding: {ill} (worst {ill_rel:.2e})"
             );
             if !(f_rel < REL && pdf_rel < REL) {
                 failures.push(format!(
-                    "{name} {s} {level}: f {f_rel:.2e} pdf {pdf_rel:.2e}"
+                    "{name} {s} {level}: f {f_rel:.2e} pdf {pdf_rel:.2e}; worst at {worst_pair}"
                 ));
             }
         }

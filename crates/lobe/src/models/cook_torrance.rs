@@ -280,9 +280,10 @@ impl Bxdf for CookTorrance {
     #[inline]
     fn pdf(&self, strategy: BsdfStrategy, wo: DVec3, wi: DVec3) -> f64 {
         let mf = &self.microfacet;
-        if strategy == BsdfStrategy::BoundedVndf {
-            return mf.pdf_reflect_bounded(wo, wi);
-        }
+        // Every strategy draws `wi` by reflecting `wo` about a normal `wm`
+        // with `wo·wm > 0`, so no strategy's density reaches a pair whose
+        // half vector faces away from `wo` (for unit vectors only
+        // `wi = −wo`; for vectors rounded to f32, pairs near it).
         let Some(h) = (wo + wi).try_normalize() else {
             return 0.0;
         };
@@ -291,6 +292,7 @@ impl Bxdf for CookTorrance {
             return 0.0;
         }
         let p = match strategy {
+            BsdfStrategy::BoundedVndf => mf.pdf_reflect_bounded(wo, wi),
             BsdfStrategy::Vndf | BsdfStrategy::SphericalCaps => {
                 Microfacet::pdf_visible_reflect(mf.d(h), mf.lambda(wo), wo)
             }
@@ -304,22 +306,13 @@ impl Bxdf for CookTorrance {
     #[inline]
     fn eval_pdf(&self, strategy: BsdfStrategy, wo: DVec3, wi: DVec3) -> (Rgb, f64) {
         let mf = &self.microfacet;
+        // As `pdf`: no strategy reaches a pair with `wo·h <= 0`.
         let Some(h) = (wo + wi).try_normalize() else {
-            let p = if strategy == BsdfStrategy::BoundedVndf {
-                mf.pdf_reflect_bounded(wo, wi)
-            } else {
-                0.0
-            };
-            return (Rgb::ZERO, p);
+            return (Rgb::ZERO, 0.0);
         };
         let cos_oh = wo.dot(h);
         if cos_oh <= 0.0 {
-            let p = if strategy == BsdfStrategy::BoundedVndf {
-                mf.pdf_reflect_bounded(wo, wi)
-            } else {
-                0.0
-            };
-            return (Rgb::ZERO, p);
+            return (Rgb::ZERO, 0.0);
         }
         let d = mf.d(h);
         let lo = mf.lambda(wo);
