@@ -115,8 +115,7 @@ def test_result_memory_is_reused_only_after_the_array_dies():
 def test_batched_and_out():
     m = lobe.load_dict(GGX)
     assert m.batched("vndf") and m.batched("brdf")
-    # Every analytic model is batched (only a measured table with a diffuse
-    # term, which load_dict cannot build, runs on the scalar path).
+    # Every model and strategy is batched.
     assert lobe.load_dict({"type": "phong", "kd": 0.2}).batched("brdf")
     with pytest.raises(ValueError):
         lobe.load_dict({"type": "phong"}).batched("vndf")

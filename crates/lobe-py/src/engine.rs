@@ -1366,9 +1366,9 @@ mod tests {
     }
 
     #[test]
-    fn scalar_fallback_for_what_the_kernels_lack() {
-        // The kernels cover every analytic model; a measured table with a
-        // diffuse term is what they lack.
+    fn measured_table_with_a_diffuse_term_runs_on_the_batch_path() {
+        // The kernels cover every model; a measured table with a diffuse
+        // term runs lane by lane through the scalar mixture, with `uc`.
         let g = Material::load(r#"{"type":"cook-torrance","alpha":0.3}"#).unwrap();
         let dir = std::env::temp_dir().join(format!("lobe-py-engine-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
@@ -1384,9 +1384,9 @@ mod tests {
         ))
         .unwrap();
         let m = Material::with_diffuse(lobe::Rgb::splat(0.3), table.glossy).unwrap();
-        assert!(BatchSampler::new(&m, BsdfStrategy::Brdf).is_err());
+        assert!(BatchSampler::new(&m, BsdfStrategy::Brdf).is_ok());
         let e = Engine::new(&m, BsdfStrategy::Brdf, false).unwrap();
-        assert!(e.batch.is_none());
+        assert!(e.batch.is_some());
         let n = 1000;
         let (wo, u) = inputs(n);
         let uc = Array1::from_shape_fn(n, |i| (i as f64 * 0.618).fract());
@@ -1397,13 +1397,16 @@ mod tests {
             Some(&In1::F64(uc.view())),
         )
         .unwrap();
+        // The batch path's numbers are the scalar path's at the f32 inputs
+        // (the directions renormalized in f64), rounded once.
+        let r32 = |x: f64| f64::from(x as f32);
         for i in 0..n {
-            let w = DVec3::new(wo[[i, 0]], wo[[i, 1]], wo[[i, 2]]);
+            let w = DVec3::new(r32(wo[[i, 0]]), r32(wo[[i, 1]]), r32(wo[[i, 2]])).normalize();
             let r = m.sample(
                 BsdfStrategy::Brdf,
                 w,
-                uc[i],
-                DVec2::new(u[[i, 0]], u[[i, 1]]),
+                r32(uc[i]),
+                DVec2::new(r32(u[[i, 0]]), r32(u[[i, 1]])),
             );
             assert_eq!(r.is_some(), s.valid[i] == 1);
             if let Some(r) = r {

@@ -67,7 +67,7 @@ impl Material {
         self.glossy.model_name()
     }
 
-    fn has_diffuse(&self) -> bool {
+    pub(crate) fn has_diffuse(&self) -> bool {
         self.diffuse.albedo != Rgb::ZERO
     }
 

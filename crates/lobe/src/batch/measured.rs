@@ -20,7 +20,7 @@
 
 use super::dispatch::{BOTH, EvalIn, EvalOut, F_ONLY, PDF_ONLY, SampleIn, SampleOut};
 use crate::models::measured::{Measured, MeasuredData, Table};
-use crate::{BsdfStrategy, Rgb, warp};
+use crate::{BsdfStrategy, Material, Rgb, warp};
 use glam::{DVec2, DVec3};
 
 /// `STRAT`: uniform hemisphere.
@@ -37,16 +37,22 @@ const VNDF: u8 = 3;
 pub(crate) struct MeasuredKernel {
     data: &'static MeasuredData,
     strat: u8,
+    /// With a diffuse term: the material and strategy, run lane by lane
+    /// through [`Material::sample`] and [`Material::eval_pdf`] (the
+    /// mixture: `uc` chooses the lobe, the pdf is the mixture density, `f`
+    /// the sum).
+    mixture: Option<(Material, BsdfStrategy)>,
 }
 
 impl std::fmt::Debug for MeasuredKernel {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(
             f,
-            "MeasuredKernel {{ path: {:?}, format: {}, strat: {} }}",
+            "MeasuredKernel {{ path: {:?}, format: {}, strat: {}, diffuse: {:?} }}",
             self.data.path,
             self.data.table.format(),
-            self.strat
+            self.strat,
+            self.mixture.map(|(m, _)| m.diffuse.albedo)
         )
     }
 }
@@ -54,14 +60,21 @@ impl std::fmt::Debug for MeasuredKernel {
 impl PartialEq for MeasuredKernel {
     /// The same table (read once per file) and strategy.
     fn eq(&self, other: &Self) -> bool {
-        std::ptr::eq(self.data, other.data) && self.strat == other.strat
+        std::ptr::eq(self.data, other.data)
+            && self.strat == other.strat
+            && self.mixture.map(|(m, _)| m.diffuse.albedo)
+                == other.mixture.map(|(m, _)| m.diffuse.albedo)
     }
 }
 
 impl MeasuredKernel {
-    /// The kernel of `lobe` for `strategy` (which the caller has checked
-    /// applies: `Material::check`).
-    pub(crate) fn new(lobe: Measured, strategy: BsdfStrategy) -> Option<MeasuredKernel> {
+    /// The kernel of the measured material `m` (glossy lobe `lobe`) for
+    /// `strategy` (which the caller has checked applies: `Material::check`).
+    pub(crate) fn new(
+        m: &Material,
+        lobe: Measured,
+        strategy: BsdfStrategy,
+    ) -> Option<MeasuredKernel> {
         let strat = match (strategy, &lobe.data.table) {
             (BsdfStrategy::Uniform, _) => UNIFORM,
             (BsdfStrategy::Cosine, _) => COSINE,
@@ -72,7 +85,13 @@ impl MeasuredKernel {
         Some(MeasuredKernel {
             data: lobe.data,
             strat,
+            mixture: m.has_diffuse().then_some((*m, strategy)),
         })
+    }
+
+    /// Whether `sample` reads `uc` ([`Material::chooses_lobe`]).
+    pub(crate) fn chooses_lobe(&self) -> bool {
+        self.mixture.is_some_and(|(m, s)| m.chooses_lobe(s))
     }
 }
 
@@ -162,43 +181,81 @@ fn sample_loop<const S: u8>(d: &MeasuredData, inp: SampleIn<'_>, (out, valid): S
     for i in 0..n {
         let wo = dvec3([inp[0], inp[1], inp[2]], i);
         let u = DVec2::new(f64::from(inp[3][i]), f64::from(inp[4][i]));
-        let s = sample_one::<S>(d, wo, u).and_then(|(wi, f, pdf)| {
-            // As the scalar path's `finish`, then in f32.
-            if !(pdf > 0.0 && pdf.is_finite()) {
-                return None;
-            }
-            let weight = f * (wi.z / pdf);
-            let v = [
-                wi.x as f32,
-                wi.y as f32,
-                wi.z as f32,
-                f.x as f32,
-                f.y as f32,
-                f.z as f32,
-                pdf as f32,
-                weight.x as f32,
-                weight.y as f32,
-                weight.z as f32,
-            ];
-            (v[6] > 0.0 && v.iter().all(|x| x.is_finite())).then_some(v)
-        });
-        match s {
-            Some(v) => {
-                for (o, x) in out.iter_mut().zip(v) {
-                    if let Some(o) = o.get_mut(i) {
-                        *o = x;
-                    }
+        store_lane(i, sample_one::<S>(d, wo, u), out, valid);
+    }
+}
+
+/// `sample` of a measured material with a diffuse term, lane by lane
+/// through the scalar mixture (`uc`, `inp[5]`, chooses the lobe).
+fn sample_loop_mixture(
+    m: &Material,
+    s: BsdfStrategy,
+    inp: SampleIn<'_>,
+    (out, valid): SampleOut<'_, '_>,
+) {
+    let n = inp[0].len();
+    for x in &inp {
+        assert_eq!(x.len(), n);
+    }
+    for (j, o) in out.iter().enumerate() {
+        assert!(o.len() == n || (o.is_empty() && (3..6).contains(&j)));
+    }
+    assert_eq!(valid.len(), n);
+    for i in 0..n {
+        let wo = dvec3([inp[0], inp[1], inp[2]], i);
+        let u = DVec2::new(f64::from(inp[3][i]), f64::from(inp[4][i]));
+        let x = m
+            .sample(s, wo, f64::from(inp[5][i]), u)
+            .map(|x| (x.wi, x.f, x.pdf));
+        store_lane(i, x, out, valid);
+    }
+}
+
+/// Lane `i` of a sample's outputs from the f64 `(wi, f, pdf)`: the weight
+/// as the scalar path's `finish` computes it, then everything in f32;
+/// zeros and mask 0 for a failed sample or one that f32 cannot carry.
+#[inline(always)]
+fn store_lane(
+    i: usize,
+    x: Option<(DVec3, Rgb, f64)>,
+    out: &mut [&mut [f32]; 10],
+    valid: &mut [u8],
+) {
+    let s = x.and_then(|(wi, f, pdf)| {
+        if !(pdf > 0.0 && pdf.is_finite()) {
+            return None;
+        }
+        let weight = f * (wi.z / pdf);
+        let v = [
+            wi.x as f32,
+            wi.y as f32,
+            wi.z as f32,
+            f.x as f32,
+            f.y as f32,
+            f.z as f32,
+            pdf as f32,
+            weight.x as f32,
+            weight.y as f32,
+            weight.z as f32,
+        ];
+        (v[6] > 0.0 && v.iter().all(|x| x.is_finite())).then_some(v)
+    });
+    match s {
+        Some(v) => {
+            for (o, x) in out.iter_mut().zip(v) {
+                if let Some(o) = o.get_mut(i) {
+                    *o = x;
                 }
-                valid[i] = 1;
             }
-            None => {
-                for o in out.iter_mut() {
-                    if let Some(o) = o.get_mut(i) {
-                        *o = 0.0;
-                    }
+            valid[i] = 1;
+        }
+        None => {
+            for o in out.iter_mut() {
+                if let Some(o) = o.get_mut(i) {
+                    *o = 0.0;
                 }
-                valid[i] = 0;
             }
+            valid[i] = 0;
         }
     }
 }
@@ -238,8 +295,49 @@ fn eval_pdf_loop<const S: u8, const MODE: u8>(
     }
 }
 
+/// `eval_pdf` of a measured material with a diffuse term, lane by lane
+/// through the scalar mixture.
+fn eval_pdf_loop_mixture(
+    m: &Material,
+    s: BsdfStrategy,
+    mode: u8,
+    inp: EvalIn<'_>,
+    out: EvalOut<'_, '_>,
+) {
+    let n = inp[0].len();
+    for x in &inp {
+        assert_eq!(x.len(), n);
+    }
+    if mode != PDF_ONLY {
+        for o in &out[..3] {
+            assert_eq!(o.len(), n);
+        }
+    }
+    if mode != F_ONLY {
+        assert_eq!(out[3].len(), n);
+    }
+    #[allow(clippy::needless_range_loop)] // `i` indexes ten slices
+    for i in 0..n {
+        let wo = dvec3([inp[0], inp[1], inp[2]], i);
+        let wi = dvec3([inp[3], inp[4], inp[5]], i);
+        let (f, pdf) = m.eval_pdf(s, wo, wi);
+        if mode != PDF_ONLY {
+            let ok = f.is_finite();
+            out[0][i] = if ok { f.x as f32 } else { 0.0 };
+            out[1][i] = if ok { f.y as f32 } else { 0.0 };
+            out[2][i] = if ok { f.z as f32 } else { 0.0 };
+        }
+        if mode != F_ONLY {
+            out[3][i] = if pdf.is_finite() { pdf as f32 } else { 0.0 };
+        }
+    }
+}
+
 /// `sample` over a block (lengths checked equal by the caller).
 pub(crate) fn sample_block(k: &MeasuredKernel, inp: SampleIn<'_>, out: SampleOut<'_, '_>) {
+    if let Some((m, s)) = &k.mixture {
+        return sample_loop_mixture(m, *s, inp, out);
+    }
     match k.strat {
         UNIFORM => sample_loop::<UNIFORM>(k.data, inp, out),
         COSINE => sample_loop::<COSINE>(k.data, inp, out),
@@ -250,6 +348,9 @@ pub(crate) fn sample_block(k: &MeasuredKernel, inp: SampleIn<'_>, out: SampleOut
 
 /// `eval_pdf` over a block, writing the outputs `mode` names.
 pub(crate) fn eval_pdf_block(k: &MeasuredKernel, mode: u8, inp: EvalIn<'_>, out: EvalOut<'_, '_>) {
+    if let Some((m, s)) = &k.mixture {
+        return eval_pdf_loop_mixture(m, *s, mode, inp, out);
+    }
     macro_rules! by_mode {
         ($s:ident) => {
             match mode {
@@ -300,8 +401,10 @@ pub(super) mod tests {
     }
 
     /// Every level gives the same bits, and they are the scalar path's
-    /// numbers at the f32 inputs (renormalized in f64) rounded to f32 (the same computation), for
-    /// MERL (nearest and linear) and RGL tables and every strategy.
+    /// numbers at the f32 inputs (renormalized in f64) rounded to f32 (the
+    /// same computation), for MERL (nearest and linear) and RGL tables,
+    /// alone and with a diffuse term (`uc` chooses the lobe), and every
+    /// strategy.
     fn dirs(w: &[Vec<f32>; 3]) -> Dirs<'_> {
         Dirs {
             x: &w[0],
@@ -327,6 +430,20 @@ pub(super) mod tests {
             ),
             ("rgl", measured(&rgl, "t.bsdf", None)),
         ];
+        // The same tables with a diffuse term: the two-lobe mixture, `uc`
+        // choosing the lobe where the strategy samples both.
+        let with_kd = |m: &Material| {
+            let mut m = *m;
+            m.diffuse = crate::models::Lambert::new(Rgb::new(0.3, 0.2, 0.1)).unwrap();
+            m
+        };
+        let cases = [
+            cases[0],
+            cases[1],
+            cases[2],
+            ("merl-nearest + kd", with_kd(&cases[0].1)),
+            ("rgl + kd", with_kd(&cases[2].1)),
+        ];
         let n = 3001;
         // Inputs in f32: views with grazing ones, uniforms.
         let mut state = 0x9e37_79b9_7f4a_7c15u64;
@@ -338,7 +455,7 @@ pub(super) mod tests {
         };
         let mut wo = [vec![0f32; n], vec![0f32; n], vec![0f32; n]];
         let mut wi = [vec![0f32; n], vec![0f32; n], vec![0f32; n]];
-        let (mut u1, mut u2) = (vec![0f32; n], vec![0f32; n]);
+        let (mut u1, mut u2, mut uc) = (vec![0f32; n], vec![0f32; n], vec![0f32; n]);
         for k in 0..n {
             for w in [&mut wo, &mut wi] {
                 let z = if k % 10 == 0 {
@@ -354,6 +471,7 @@ pub(super) mod tests {
             }
             u1[k] = next();
             u2[k] = next();
+            uc[k] = next();
         }
         let d = |w: &[Vec<f32>; 3], k: usize| {
             DVec3::new(w[0][k].into(), w[1][k].into(), w[2][k].into()).normalize_or_zero()
@@ -363,14 +481,29 @@ pub(super) mod tests {
                 let mut first: Option<(SampleBuffers, EvalPdfBuffers)> = None;
                 for level in SimdLevel::ALL.into_iter().filter(|l| l.is_available()) {
                     let b = BatchSampler::with_level(m, s, level).unwrap();
-                    assert!(!b.chooses_lobe());
+                    assert_eq!(b.chooses_lobe(), m.chooses_lobe(s), "{name} {s}");
                     let mut out = SampleBuffers::new(n);
+                    if b.chooses_lobe() {
+                        let r = b.sample(
+                            SampleInput {
+                                wo: dirs(&wo),
+                                u1: &u1,
+                                u2: &u2,
+                                uc: None,
+                            },
+                            out.output(),
+                        );
+                        assert!(
+                            matches!(r, Err(super::super::BatchError::MissingUc)),
+                            "{name} {s}: {r:?}"
+                        );
+                    }
                     b.sample(
                         SampleInput {
                             wo: dirs(&wo),
                             u1: &u1,
                             u2: &u2,
-                            uc: None,
+                            uc: Some(&uc),
                         },
                         out.output(),
                     )
@@ -389,7 +522,7 @@ pub(super) mod tests {
                             wo: dirs(&wo),
                             u1: &u1,
                             u2: &u2,
-                            uc: None,
+                            uc: Some(&uc),
                         };
                         b.sample_with(input, o, Store::Streamed).unwrap();
                     }
@@ -423,7 +556,7 @@ pub(super) mod tests {
                 let mut valid = 0;
                 for k in 0..n {
                     let o = d(&wo, k);
-                    let r = m.sample(s, o, 0.5, DVec2::new(u1[k].into(), u2[k].into()));
+                    let r = m.sample(s, o, uc[k].into(), DVec2::new(u1[k].into(), u2[k].into()));
                     match r {
                         None => assert_eq!(out.valid[k], 0, "{name} {s} #{k}"),
                         Some(r) => {
@@ -460,7 +593,10 @@ pub(super) mod tests {
                 assert!(valid > n / 2, "{name} {s}: {valid} valid samples of {n}");
             }
         }
-        // MERL tables have no vndf; RGL files do.
+        // MERL tables have no vndf; RGL files do; with kd the brdf (and
+        // RGL's vndf) strategies choose a lobe.
+        assert!(cases[3].1.chooses_lobe(BsdfStrategy::Brdf));
+        assert!(cases[4].1.chooses_lobe(BsdfStrategy::Vndf));
         assert_eq!(cases[0].1.strategies().len(), 3);
         assert!(cases[2].1.strategies().contains(&BsdfStrategy::Vndf));
     }

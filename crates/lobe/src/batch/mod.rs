@@ -45,14 +45,14 @@
 //!   there is [`BatchError::MissingUc`]);
 //! * the **Lambertian** material (`uniform`, `cosine`, `brdf`);
 //! * **measured** materials (MERL and RGL tables: `uniform`, `cosine`,
-//!   `brdf`, and `vndf` for RGL files), lane by lane in f64 over the f32
-//!   tables (see `batch/measured.rs`: a table lookup, discontinuous for
-//!   MERL's nearest entry, is not an f32 computation): the scalar path's
-//!   numbers at the f32 inputs, rounded once, the same at every level.
+//!   `brdf`, and `vndf` for RGL files), alone or with a diffuse term, lane
+//!   by lane in f64 over the f32 tables (see `batch/measured.rs`: a table
+//!   lookup, discontinuous for MERL's nearest entry, is not an f32
+//!   computation): the scalar path's numbers at the f32 inputs, rounded
+//!   once, the same at every level; with a diffuse term `uc` chooses the
+//!   lobe as in the scalar mixture.
 //!
-//! Not yet (the scalar path, [`crate::Material`], serves it;
-//! [`BatchSampler::new`] returns [`BatchError::Unsupported`]): a measured
-//! table with a diffuse term (`kd > 0`). The test
+//! Every model and strategy the scalar path has is batched. The test
 //! `grid_every_supported_combination_builds` walks every combination of the
 //! analytic models the scalar path has and checks that none is refused. (A
 //! lecture-form `ks` whose `ks · K` is beyond f32's range is refused with
@@ -602,7 +602,7 @@ impl BatchSampler {
     pub fn chooses_lobe(&self) -> bool {
         match self.kernel {
             Kernel::CookTorrance { p, .. } => p.two_lobes,
-            Kernel::Measured(_) => false,
+            Kernel::Measured(k) => k.chooses_lobe(),
             Kernel::Lecture { p, .. } => p.two_lobes,
         }
     }
@@ -876,8 +876,8 @@ fn kernel_for(m: &Material, strategy: BsdfStrategy) -> Result<Kernel, BatchError
                 },
             });
         }
-        Glossy::Measured(lobe) if kd == Rgb::ZERO => {
-            return match measured::MeasuredKernel::new(lobe, strategy) {
+        Glossy::Measured(lobe) => {
+            return match measured::MeasuredKernel::new(m, lobe, strategy) {
                 Some(k) => Ok(Kernel::Measured(k)),
                 None => unsupported(format!("strategy `{strategy}` of a measured table")),
             };
