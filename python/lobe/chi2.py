@@ -257,7 +257,12 @@ class BSDFAdapter:
         u = np.asarray(u, dtype=np.float64)
         uc = u[:, 0] if u.shape[1] == 3 else None
         if uc is None and self.material.chooses_lobe(self.strategy):
-            uc = np.full(u.shape[0], 0.5)
+            # A fixed uc would draw one lobe's share of the mixture, not
+            # the mixture the pdf describes: the test would fail wrongly.
+            raise ValueError(
+                f"strategy {self.strategy!r} of this material chooses between two lobes: "
+                "use ChiSquareTest(..., sample_dim=3), whose first uniform chooses the lobe"
+            )
         s = self.material.sample(self.wo, u[:, -2:], uc, self.strategy, reference=self.reference)
         return s.wi, s.valid
 

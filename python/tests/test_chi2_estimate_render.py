@@ -4,6 +4,7 @@ import json
 import os
 import shutil
 import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -30,6 +31,11 @@ def test_two_lobes_with_uc():
     ad = chi2.BSDFAdapter(m, "vndf", [0.3, 0.0, np.sqrt(1 - 0.09)])
     t = chi2.ChiSquareTest(chi2.SphericalDomain(), ad.sample, ad.pdf, sample_dim=3, sample_count=200_000, res=30)
     assert t.run(), t.messages
+    # Two uniforms cannot choose the lobe: an error that says what to do,
+    # not a wrongly failed test.
+    t2 = chi2.ChiSquareTest(chi2.SphericalDomain(), ad.sample, ad.pdf, sample_count=1000, res=30)
+    with pytest.raises(ValueError, match="sample_dim=3"):
+        t2.run()
 
 
 def test_a_wrong_pdf_fails():
@@ -128,3 +134,22 @@ def test_render_a_tiny_scene():
         lobe.render({"camera": {"width": 0}})
     with pytest.raises(ValueError, match="cannot read"):
         lobe.render("/nonexistent/scene.toml")
+
+
+def test_the_lecture_example_runs():
+    """examples/lecture_comparison.py (without its matplotlib plot): every
+    strategy's estimate prints, and importance sampling has less variance
+    than uniform sampling for each model."""
+    root = os.path.join(os.path.dirname(__file__), "..", "..")
+    script = os.path.join(root, "examples", "lecture_comparison.py")
+    r = subprocess.run([sys.executable, script, "--samples", "20000"], capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0, r.stderr
+    blocks = r.stdout.split("reference")
+    assert len(blocks) == 4, r.stdout
+    for block in blocks[1:]:
+        var = {
+            line.split()[0]: float(line.split("variance")[1])
+            for line in block.splitlines()
+            if "variance" in line
+        }
+        assert var["brdf"] < var["uniform"], r.stdout

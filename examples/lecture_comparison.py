@@ -4,7 +4,7 @@ furnace (L_i = 1), so the estimate of ∫ f cos dω is the mean of the Monte
 Carlo weights f·cos/pdf. The reference is lobe's quadrature (lobe.estimate).
 
     pip install . matplotlib        # from the repository root
-    python python/examples/lecture_comparison.py [--out comparison.png]
+    python examples/lecture_comparison.py [--out comparison.png]
 """
 
 import argparse
