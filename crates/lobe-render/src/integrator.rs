@@ -100,9 +100,9 @@
 //! that hit), its light draws from [`lobe::envmap::EnvMap::sample_lookup_many`]
 //! and its BSDF directions' map lookups from
 //! [`lobe::envmap::EnvMap::lookup_many`] (the reads of a block overlap).
-//! Where the batch loop does not apply (bounces, one-sample MIS, a material
-//! the batch kernels refuse: a measured table with a diffuse term), the
-//! scalar loop renders the whole image and [`batch_refusal`] says why
+//! Where the batch loop does not apply (bounces, one-sample MIS, a
+//! material the batch kernels refuse: none today), the scalar loop renders
+//! the whole image and [`batch_refusal`] says why
 //! (`lobe render` prints it once);
 //! [`RenderLoop::Scalar`] forces the scalar loop. Both give the same bits
 //! for any thread count.
