@@ -167,7 +167,13 @@ fn dvec3(x: [&[f32]; 3], i: usize) -> DVec3 {
     DVec3::new(f64::from(x[0][i]), f64::from(x[1][i]), f64::from(x[2][i])).normalize_or_zero()
 }
 
-fn sample_loop<const S: u8>(d: &MeasuredData, inp: SampleIn<'_>, (out, valid): SampleOut<'_, '_>) {
+/// `sample` over a block, lane by lane: `lane(wo, u, uc)` gives the f64
+/// `(wi, f, pdf)` of one lane, `None` for a failed sample.
+fn sample_lanes(
+    inp: SampleIn<'_>,
+    (out, valid): SampleOut<'_, '_>,
+    lane: impl Fn(DVec3, DVec2, f64) -> Option<(DVec3, Rgb, f64)>,
+) {
     let n = inp[0].len();
     // Equal lengths, stated once.
     for s in &inp {
@@ -181,33 +187,7 @@ fn sample_loop<const S: u8>(d: &MeasuredData, inp: SampleIn<'_>, (out, valid): S
     for i in 0..n {
         let wo = dvec3([inp[0], inp[1], inp[2]], i);
         let u = DVec2::new(f64::from(inp[3][i]), f64::from(inp[4][i]));
-        store_lane(i, sample_one::<S>(d, wo, u), out, valid);
-    }
-}
-
-/// `sample` of a measured material with a diffuse term, lane by lane
-/// through the scalar mixture (`uc`, `inp[5]`, chooses the lobe).
-fn sample_loop_mixture(
-    m: &Material,
-    s: BsdfStrategy,
-    inp: SampleIn<'_>,
-    (out, valid): SampleOut<'_, '_>,
-) {
-    let n = inp[0].len();
-    for x in &inp {
-        assert_eq!(x.len(), n);
-    }
-    for (j, o) in out.iter().enumerate() {
-        assert!(o.len() == n || (o.is_empty() && (3..6).contains(&j)));
-    }
-    assert_eq!(valid.len(), n);
-    for i in 0..n {
-        let wo = dvec3([inp[0], inp[1], inp[2]], i);
-        let u = DVec2::new(f64::from(inp[3][i]), f64::from(inp[4][i]));
-        let x = m
-            .sample(s, wo, f64::from(inp[5][i]), u)
-            .map(|x| (x.wi, x.f, x.pdf));
-        store_lane(i, x, out, valid);
+        store_lane(i, lane(wo, u, f64::from(inp[5][i])), out, valid);
     }
 }
 
@@ -260,10 +240,12 @@ fn store_lane(
     }
 }
 
-fn eval_pdf_loop<const S: u8, const MODE: u8>(
-    d: &MeasuredData,
+/// `eval_pdf` over a block, lane by lane: `lane(wo, wi)` gives the f64
+/// `(f, pdf)`; the outputs `MODE` names are written.
+fn eval_pdf_lanes<const MODE: u8>(
     inp: EvalIn<'_>,
     out: EvalOut<'_, '_>,
+    lane: impl Fn(DVec3, DVec3) -> (Rgb, f64),
 ) {
     let n = inp[0].len();
     for s in &inp {
@@ -281,7 +263,7 @@ fn eval_pdf_loop<const S: u8, const MODE: u8>(
     for i in 0..n {
         let wo = dvec3([inp[0], inp[1], inp[2]], i);
         let wi = dvec3([inp[3], inp[4], inp[5]], i);
-        let (f, pdf) = eval_pdf_one::<S, MODE>(d, wo, wi);
+        let (f, pdf) = lane(wo, wi);
         if MODE != PDF_ONLY {
             // Zero where not finite, as the Cook-Torrance kernels.
             let ok = f.is_finite();
@@ -295,76 +277,57 @@ fn eval_pdf_loop<const S: u8, const MODE: u8>(
     }
 }
 
-/// `eval_pdf` of a measured material with a diffuse term, lane by lane
-/// through the scalar mixture.
-fn eval_pdf_loop_mixture(
-    m: &Material,
-    s: BsdfStrategy,
-    mode: u8,
-    inp: EvalIn<'_>,
-    out: EvalOut<'_, '_>,
-) {
-    let n = inp[0].len();
-    for x in &inp {
-        assert_eq!(x.len(), n);
-    }
-    if mode != PDF_ONLY {
-        for o in &out[..3] {
-            assert_eq!(o.len(), n);
-        }
-    }
-    if mode != F_ONLY {
-        assert_eq!(out[3].len(), n);
-    }
-    #[allow(clippy::needless_range_loop)] // `i` indexes ten slices
-    for i in 0..n {
-        let wo = dvec3([inp[0], inp[1], inp[2]], i);
-        let wi = dvec3([inp[3], inp[4], inp[5]], i);
-        let (f, pdf) = m.eval_pdf(s, wo, wi);
-        if mode != PDF_ONLY {
-            let ok = f.is_finite();
-            out[0][i] = if ok { f.x as f32 } else { 0.0 };
-            out[1][i] = if ok { f.y as f32 } else { 0.0 };
-            out[2][i] = if ok { f.z as f32 } else { 0.0 };
-        }
-        if mode != F_ONLY {
-            out[3][i] = if pdf.is_finite() { pdf as f32 } else { 0.0 };
-        }
-    }
-}
-
-/// `sample` over a block (lengths checked equal by the caller).
+/// `sample` over a block (lengths checked equal by the caller). With a
+/// diffuse term, through the scalar mixture (`uc`, `inp[5]`, chooses the
+/// lobe); without, the table's strategy directly (`uc` unread).
 pub(crate) fn sample_block(k: &MeasuredKernel, inp: SampleIn<'_>, out: SampleOut<'_, '_>) {
     if let Some((m, s)) = &k.mixture {
-        return sample_loop_mixture(m, *s, inp, out);
+        return sample_lanes(inp, out, |wo, u, uc| {
+            m.sample(*s, wo, uc, u).map(|x| (x.wi, x.f, x.pdf))
+        });
     }
+    let d = k.data;
     match k.strat {
-        UNIFORM => sample_loop::<UNIFORM>(k.data, inp, out),
-        COSINE => sample_loop::<COSINE>(k.data, inp, out),
-        BRDF => sample_loop::<BRDF>(k.data, inp, out),
-        _ => sample_loop::<VNDF>(k.data, inp, out),
+        UNIFORM => sample_lanes(inp, out, |wo, u, _| sample_one::<UNIFORM>(d, wo, u)),
+        COSINE => sample_lanes(inp, out, |wo, u, _| sample_one::<COSINE>(d, wo, u)),
+        BRDF => sample_lanes(inp, out, |wo, u, _| sample_one::<BRDF>(d, wo, u)),
+        _ => sample_lanes(inp, out, |wo, u, _| sample_one::<VNDF>(d, wo, u)),
     }
 }
 
 /// `eval_pdf` over a block, writing the outputs `mode` names.
 pub(crate) fn eval_pdf_block(k: &MeasuredKernel, mode: u8, inp: EvalIn<'_>, out: EvalOut<'_, '_>) {
-    if let Some((m, s)) = &k.mixture {
-        return eval_pdf_loop_mixture(m, *s, mode, inp, out);
-    }
     macro_rules! by_mode {
+        ($lane:expr) => {
+            match mode {
+                F_ONLY => eval_pdf_lanes::<F_ONLY>(inp, out, $lane),
+                PDF_ONLY => eval_pdf_lanes::<PDF_ONLY>(inp, out, $lane),
+                _ => eval_pdf_lanes::<BOTH>(inp, out, $lane),
+            }
+        };
+    }
+    if let Some((m, s)) = &k.mixture {
+        return by_mode!(|wo, wi| m.eval_pdf(*s, wo, wi));
+    }
+    let d = k.data;
+    macro_rules! by_strat {
         ($s:ident) => {
             match mode {
-                F_ONLY => eval_pdf_loop::<$s, F_ONLY>(k.data, inp, out),
-                PDF_ONLY => eval_pdf_loop::<$s, PDF_ONLY>(k.data, inp, out),
-                _ => eval_pdf_loop::<$s, BOTH>(k.data, inp, out),
+                F_ONLY => eval_pdf_lanes::<F_ONLY>(inp, out, |wo, wi| {
+                    eval_pdf_one::<$s, F_ONLY>(d, wo, wi)
+                }),
+                PDF_ONLY => eval_pdf_lanes::<PDF_ONLY>(inp, out, |wo, wi| {
+                    eval_pdf_one::<$s, PDF_ONLY>(d, wo, wi)
+                }),
+                _ => eval_pdf_lanes::<BOTH>(inp, out, |wo, wi| eval_pdf_one::<$s, BOTH>(d, wo, wi)),
             }
         };
     }
     match k.strat {
-        UNIFORM => by_mode!(UNIFORM),
-        COSINE => by_mode!(COSINE),
-        BRDF => by_mode!(BRDF),
-        _ => by_mode!(VNDF),
+        UNIFORM => by_strat!(UNIFORM),
+        COSINE => by_strat!(COSINE),
+        BRDF => by_strat!(BRDF),
+        _ => by_strat!(VNDF),
     }
 }
 
