@@ -455,8 +455,13 @@ impl Microfacet {
     /// (`wo`, `wi` in the upper hemisphere).
     #[must_use]
     pub fn pdf_reflect_bounded(&self, wo: DVec3, wi: DVec3) -> f64 {
-        let wm = (wo + wi).normalize_or_zero();
-        let d = self.d(wm);
+        self.pdf_reflect_bounded_d(self.d((wo + wi).normalize_or_zero()), wo)
+    }
+
+    /// [`Microfacet::pdf_reflect_bounded`] given `d`, `D` at the half vector
+    /// of `wo` and `wi` (for callers that have it).
+    #[must_use]
+    pub fn pdf_reflect_bounded_d(&self, d: f64, wo: DVec3) -> f64 {
         let ax = self.alpha_x * wo.x;
         let ay = self.alpha_y * wo.y;
         let len2 = ax * ax + ay * ay;

@@ -292,7 +292,7 @@ impl Bxdf for CookTorrance {
             return 0.0;
         }
         let p = match strategy {
-            BsdfStrategy::BoundedVndf => mf.pdf_reflect_bounded(wo, wi),
+            BsdfStrategy::BoundedVndf => mf.pdf_reflect_bounded_d(mf.d(h), wo),
             BsdfStrategy::Vndf | BsdfStrategy::SphericalCaps => {
                 Microfacet::pdf_visible_reflect(mf.d(h), mf.lambda(wo), wo)
             }
@@ -323,7 +323,7 @@ impl Bxdf for CookTorrance {
             Rgb::ZERO
         };
         let p = match strategy {
-            BsdfStrategy::BoundedVndf => mf.pdf_reflect_bounded(wo, wi),
+            BsdfStrategy::BoundedVndf => mf.pdf_reflect_bounded_d(d, wo),
             BsdfStrategy::Vndf | BsdfStrategy::SphericalCaps => Microfacet::pdf_visible_reflect(d, lo, wo),
             _ => mf.pdf_wm(h) / (4.0 * cos_oh),
         };
