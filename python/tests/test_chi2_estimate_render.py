@@ -2,7 +2,6 @@
 
 import json
 import os
-import shutil
 import subprocess
 import sys
 
@@ -88,7 +87,7 @@ def test_chi2_is_fast_enough_for_ci():
     print(f"chi2 1e6 samples at 100x100: {time.perf_counter() - t0:.2f} s")
 
 
-def test_estimate_returns_the_cli_table():
+def test_estimate_returns_the_cli_table(lobe_exe):
     t = lobe.estimate({"type": "phong", "exponent": 50}, theta=40, light="beam:16:1,1,0",
                       strategies=["uniform", "brdf", "mis"], samples=20000, seed=3)
     assert [r["name"] for r in t["strategies"]] == ["uniform", "brdf", "mis"]
@@ -102,12 +101,7 @@ def test_estimate_returns_the_cli_table():
     with pytest.raises(ValueError, match="unknown light"):
         lobe.estimate({"type": "phong"}, light="lamp", samples=100)
     # The same numbers as `lobe estimate --json` where the binary is built.
-    root = os.path.join(os.path.dirname(__file__), "..", "..")
-    exe = next((p for p in (os.path.join(root, "target", d, "lobe") for d in ("release", "debug")) if os.path.exists(p)),
-               shutil.which("lobe"))
-    if exe is None:
-        pytest.skip("no lobe binary to compare with")
-    out = subprocess.run([exe, "estimate", "--material", '{"type":"phong","exponent":50}', "--theta", "40",
+    out = subprocess.run([lobe_exe, "estimate", "--material", '{"type":"phong","exponent":50}', "--theta", "40",
                           "--light", "beam:16:1,1,0", "--strategy", "uniform,brdf,mis", "--samples", "20000",
                           "--seed", "3", "--json", "--quiet"], check=True, capture_output=True, text=True).stdout
     cli = json.loads(out)

@@ -495,6 +495,14 @@ pub(crate) enum Request {
 }
 
 impl Query {
+    /// `wo` and `wi` as the line gives them, before [`Query::check`]
+    /// normalizes them: the batch path rounds these to f32 as they are, as
+    /// the Python package does with its arrays, so that both give the same
+    /// bits (normalizing in f64 first would move some by an f32 ulp).
+    pub(crate) fn given_dirs(&self) -> (Option<[f64; 3]>, Option<[f64; 3]>) {
+        (self.wo, self.wi)
+    }
+
     /// Check the keys present, the vectors and the strategy.
     pub(crate) fn check(
         self,

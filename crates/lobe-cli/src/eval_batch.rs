@@ -70,10 +70,12 @@ impl Columns {
 }
 
 /// f32 of a direction's components.
-fn push3(cols: &mut [Vec<f32>; 3], v: glam::DVec3) {
-    cols[0].push(v.x as f32);
-    cols[1].push(v.y as f32);
-    cols[2].push(v.z as f32);
+/// A direction as the line gave it (checked to be unit within
+/// [`crate::eval::UNIT_TOLERANCE`]), rounded to f32.
+fn push3(cols: &mut [Vec<f32>; 3], v: [f64; 3]) {
+    cols[0].push(v[0] as f32);
+    cols[1].push(v[1] as f32);
+    cols[2].push(v[2] as f32);
 }
 
 /// Where each line of a block went.
@@ -126,9 +128,13 @@ pub fn process_batch<R: BufRead, W: Write>(
                 if text.is_empty() {
                     continue;
                 }
-                match parse_line(text).and_then(|q| q.check(material, &strategies)) {
+                let checked = parse_line(text).and_then(|q| {
+                    let given = q.given_dirs();
+                    q.check(material, &strategies).map(|r| (r, given))
+                });
+                match checked {
                     Err(m) => Some(Failure::Line(n, m)),
-                    Ok(Request::Eval { wo, wi }) => {
+                    Ok((Request::Eval { .. }, (Some(wo), Some(wi)))) => {
                         places.push(Place::Eval(evals.len()));
                         evals.slot.push(places.len() - 1);
                         evals.line.push(n);
@@ -136,12 +142,12 @@ pub fn process_batch<R: BufRead, W: Write>(
                         push3(&mut evals.b, wi);
                         continue;
                     }
-                    Ok(Request::Sample {
-                        strategy,
-                        wo,
-                        u,
-                        uc,
-                    }) => {
+                    Ok((
+                        Request::Sample {
+                            strategy, u, uc, ..
+                        },
+                        (Some(wo), _),
+                    )) => {
                         let k = strategies
                             .iter()
                             .position(|&s| s == strategy)
@@ -156,6 +162,10 @@ pub fn process_batch<R: BufRead, W: Write>(
                         c.uc.push(unit_interval_f32(uc));
                         continue;
                     }
+                    Ok(_) => Some(Failure::Line(
+                        n,
+                        "internal error: a checked line without its directions".into(),
+                    )),
                 }
             }
             Err(e) if e.kind() == io::ErrorKind::InvalidData => {
@@ -212,16 +222,18 @@ fn run_block<W: Write>(
     if places.is_empty() {
         return Ok(());
     }
-    // Eval lines: f and every strategy's pdf.
+    // Eval lines: f from the first strategy's kernel (as the Python
+    // package's `Material.eval`: GGX's vndf and brdf kernels compute f
+    // another way, equal to rounding), and every strategy's pdf.
     if evals.len() > 0 {
         evals.size_outputs(strategies.len());
         let first = evals.line[0];
         for (k, &s) in strategies.iter().enumerate() {
             let sampler = sampler(samplers, material, s, k, first)?;
             let c = &mut *evals;
-            let [fr, fg, fb] = &mut c.f;
-            sampler
-                .eval_pdf(
+            if k == 0 {
+                let [fr, fg, fb] = &mut c.f;
+                sampler.eval_pdf(
                     dirs(&c.a),
                     dirs(&c.b),
                     EvalPdfOutput {
@@ -233,7 +245,10 @@ fn run_block<W: Write>(
                         pdf: &mut c.pdfs[k],
                     },
                 )
-                .expect("columns of one length");
+            } else {
+                sampler.pdf(dirs(&c.a), dirs(&c.b), &mut c.pdfs[k])
+            }
+            .expect("columns of one length");
         }
     }
     for (k, c) in samples.iter_mut().enumerate() {

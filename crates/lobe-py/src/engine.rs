@@ -363,10 +363,15 @@ fn check_dirs<T: Real>(
     Ok(zeros)
 }
 
-/// `w` normalized where it is further from unit length than the library's
-/// own check (`1e-6` in `|w|²`); within [`UNIT_TOLERANCE`] as checked.
+/// `w` (unit within [`UNIT_TOLERANCE`], as checked) for the f64 reference
+/// path: as given where the core takes it as unit (`1e-6` in `|w|²`,
+/// [`lobe::math::is_unit`]), so that the reference computes on the very
+/// vector the batch kernels get (an f32 direction is not unit to f64
+/// precision; where `wi ≈ −wo` at grazing angles the result depends on
+/// that length); normalized otherwise. (The CLI's f64 path normalizes
+/// anything further than 4 ulp from unit.)
 fn unit(w: DVec3) -> DVec3 {
-    if (w.length_squared() - 1.0).abs() < 1e-6 {
+    if lobe::math::is_unit(w) {
         w
     } else {
         w.normalize()
