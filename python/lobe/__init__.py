@@ -168,12 +168,15 @@ def estimate(
     for name, v in (("samples", samples), ("seed", seed), ("replicas", replicas)):
         if int(v) < 0:
             raise ValueError(f"{name} {v}: must be >= 0")
+    if len(mis_samples) != 2:
+        raise ValueError(f"mis_samples {mis_samples!r}: expected (BSDF samples, light samples)")
+    ms = (int(mis_samples[0]), int(mis_samples[1]))
     names = [strategies] if isinstance(strategies, str) else list(strategies)
     if not all(isinstance(s, str) for s in names):
         raise ValueError("strategies: expected names (strings)")
     text = _lobe._estimate_json(
         m, None if wo is None else [float(x) for x in wo], None if theta is None else float(theta), str(light), list(normal), list(tangent), names, int(samples),
-        str(sequence), int(seed), int(replicas), mis_bsdf, tuple(mis_samples),
+        str(sequence), int(seed), int(replicas), mis_bsdf, ms,
     )
     return json.loads(text)
 
@@ -193,7 +196,10 @@ def render(
     at the top. ``spp``, ``strategy`` (``mis``, ``light``, a BSDF strategy,
     ...), ``seed`` and ``max_depth`` override the scene's ``[render]`` table;
     the image does not depend on ``threads``. Relative paths in a dict are
-    taken from the current directory.
+    taken from the current directory. The scene is in world space (y up);
+    each object's material is evaluated in its local shading frame (+z the
+    surface normal, wo toward the camera, wi toward the light, f without the
+    cosine, pdfs in solid angle), as ``Material`` is.
 
     >>> import lobe
     >>> scene = {"camera": {"origin": [0, 0, 4], "target": [0, 0, 0], "width": 8, "height": 6},

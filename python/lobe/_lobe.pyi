@@ -5,74 +5,108 @@ toward the light, unit, away from the surface; eval WITHOUT the cosine;
 pdfs in solid angle; weight = f·cos θi / pdf.
 """
 
-from typing import Any, Optional, Sequence, Tuple
+from typing import Any, Optional, Sequence, Tuple, final
 
 import numpy as np
 import numpy.typing as npt
 
-ArrayLike = npt.ArrayLike
-F32 = npt.NDArray[np.float32]
-Floats = npt.NDArray[np.floating[Any]]
+_ArrayLike = npt.ArrayLike
+_F32 = npt.NDArray[np.float32]
+_Floats = npt.NDArray[np.floating[Any]]
+
+__all__ = [
+    "BLOCK", "Material", "SampleResult", "_chi2_test", "_chi2_uniforms", "_estimate_json", "_json_to_toml",
+    "_load_json", "_render", "cache_info", "clear_cache", "get_threads", "set_cache_limit", "set_threads", "sidak",
+    "simd_level",
+]
 
 BLOCK: int
+"""Rows per block of the array calls (the unit of the thread split)."""
 
+@final
 class SampleResult:
-    """wi (N, 3), weight (N, 3) = f·cos θi / pdf, pdf (N,) solid angle, valid (N,) bool."""
+    """The result of ``Material.sample``. Conventions: local frame (+z the
+    normal), wo toward the viewer, wi toward the light; weight = f·cos θi /
+    pdf (the cosine included); pdf in solid angle. A failed sample (below
+    the horizon) has valid False and zeros elsewhere, and still counts in an
+    estimator's N."""
 
     @property
-    def wi(self) -> Floats: ...
+    def wi(self) -> _Floats:
+        """(N, 3) unit directions toward the light, local frame; zero where not valid."""
     @property
-    def weight(self) -> Floats: ...
+    def weight(self) -> _Floats:
+        """(N, 3) f·cos θi / pdf (the cosine included); zero where not valid."""
     @property
-    def pdf(self) -> Floats: ...
+    def pdf(self) -> _Floats:
+        """(N,) the density in solid angle with which wi was drawn; zero where not valid."""
     @property
-    def valid(self) -> npt.NDArray[np.bool_]: ...
+    def valid(self) -> npt.NDArray[np.bool_]:
+        """(N,) bool: False for a failed sample (below the horizon)."""
 
+@final
 class Material:
-    """A material (see lobe.load_dict). Local frame, +z the normal, wo toward the viewer."""
+    """A material (see ``lobe.load_dict``). Conventions: local frame (+z
+    the normal), wo toward the viewer, wi toward the light, both unit and
+    away from the surface; eval WITHOUT the cosine; pdfs in solid angle;
+    weight = f·cos θi / pdf. Float32 results come from the batch SIMD
+    kernels, float64 from ``reference=True`` (the scalar f64 path)."""
 
-    def eval(self, wo: ArrayLike, wi: ArrayLike, *, reference: bool = False) -> Floats:
-        """f_r(wo, wi) WITHOUT the cosine, (N, 3)."""
-    def pdf(self, wo: ArrayLike, wi: ArrayLike, strategy: Optional[str] = None, *, reference: bool = False) -> Floats:
-        """Solid-angle pdf of `strategy` at wi, (N,)."""
+    def eval(self, wo: _ArrayLike, wi: _ArrayLike, *, reference: bool = False) -> _Floats:
+        """f_r(wo, wi) WITHOUT the cosine, (N, 3); zero unless both are above the horizon."""
+    def pdf(self, wo: _ArrayLike, wi: _ArrayLike, strategy: Optional[str] = None, *, reference: bool = False) -> _Floats:
+        """The solid-angle density (N,) with which ``sample(wo, ..., strategy)`` draws wi."""
     def eval_pdf(
         self,
-        wo: ArrayLike,
-        wi: ArrayLike,
+        wo: _ArrayLike,
+        wi: _ArrayLike,
         strategy: Optional[str] = None,
         *,
         reference: bool = False,
-        out: Optional[Tuple[F32, F32]] = None,
-    ) -> Tuple[Floats, Floats]:
-        """(f without the cosine (N, 3), pdf (N,))."""
+        out: Optional[Tuple[_F32, _F32]] = None,
+    ) -> Tuple[_Floats, _Floats]:
+        """(f WITHOUT the cosine (N, 3), pdf in solid angle (N,)) in one pass."""
     def sample(
         self,
-        wo: ArrayLike,
-        u: ArrayLike,
-        uc: Optional[ArrayLike] = None,
+        wo: _ArrayLike,
+        u: _ArrayLike,
+        uc: Optional[_ArrayLike] = None,
         strategy: Optional[str] = None,
         *,
         reference: bool = False,
         out: Optional[SampleResult] = None,
     ) -> SampleResult:
-        """Draw wi for each wo from u (N, 2); uc (N,) where the material has two lobes."""
+        """Draw wi toward the light for each wo from u (N, 2); uc (N,) chooses
+        the lobe where the material has two. weight = f·cos θi / pdf."""
     @property
-    def strategies(self) -> list[str]: ...
-    def batched(self, strategy: Optional[str] = None) -> bool: ...
-    def chooses_lobe(self, strategy: Optional[str] = None) -> bool: ...
+    def strategies(self) -> list[str]:
+        """The strategies that apply (names for ``strategy=``)."""
+    def batched(self, strategy: Optional[str] = None) -> bool:
+        """Whether ``strategy`` runs on the batch SIMD kernels (else the scalar f64 path)."""
+    def chooses_lobe(self, strategy: Optional[str] = None) -> bool:
+        """Whether ``strategy`` chooses between two lobes with ``uc``."""
     @property
-    def model(self) -> str: ...
+    def model(self) -> str:
+        """The model's short name (lambert, phong, blinn-phong, cook-torrance, measured)."""
     @property
-    def description(self) -> str: ...
+    def description(self) -> str:
+        """lobe's description of the material: JSON text with the keys of ``--material``."""
 
 def _load_json(text: str) -> Material: ...
-def set_threads(n: Optional[int] = None) -> None: ...
-def get_threads() -> int: ...
-def simd_level() -> str: ...
-def set_cache_limit(nbytes: int) -> None: ...
-def cache_info() -> Tuple[int, int]: ...
-def clear_cache() -> None: ...
-def sidak(alpha: float, tests: int) -> float: ...
+def set_threads(n: Optional[int] = None) -> None:
+    """Threads of the array calls (None: one per core); results do not depend on it."""
+def get_threads() -> int:
+    """Threads of the array calls."""
+def simd_level() -> str:
+    """The dispatch level of the batch kernels: avx512, avx2 or scalar (LOBE_SIMD forces one)."""
+def set_cache_limit(nbytes: int) -> None:
+    """Most bytes of dead result arrays kept for reuse (default 1 GiB, 0 none)."""
+def cache_info() -> Tuple[int, int]:
+    """(limit, kept) bytes of the reuse cache."""
+def clear_cache() -> None:
+    """Free the memory kept for reuse."""
+def sidak(alpha: float, tests: int) -> float:
+    """Šidák's per-test significance level for ``tests`` tests at family level ``alpha``."""
 def _estimate_json(
     material: Material, wo: Optional[Sequence[float]], theta: Optional[float], light: str, normal: Sequence[float], tangent: Sequence[float],
     strategies: list[str], samples: int, sequence: str, seed: int, replicas: int,
@@ -81,7 +115,7 @@ def _estimate_json(
 def _render(
     text: str, path: str, spp: Optional[int], strategy: Optional[str], seed: Optional[int],
     max_depth: Optional[int], threads: Optional[int],
-) -> F32: ...
+) -> _F32: ...
 def _json_to_toml(text: str) -> str: ...
 def _chi2_uniforms(seed: int, samples: int) -> npt.NDArray[np.float64]: ...
 def _chi2_test(

@@ -39,7 +39,10 @@ __all__ = ["ChiSquareTest", "SphericalDomain", "PlanarDomain", "BSDFAdapter"]
 class SphericalDomain:
     """The unit sphere, binned equal-area: ``res`` bins in z = cos θ over
     [-1, 1] times ``2·res`` bins in φ over [0, 2π) (the layout of lobe's
-    Rust harness). Points are unit (N, 3) directions in the local frame."""
+    Rust harness). Points are unit (N, 3) directions in the local frame
+    (+z the normal, the hemisphere of wo above); the pdf is a density in
+    solid angle, as lobe's ``Material.pdf`` gives it (f without the cosine
+    plays no part here)."""
 
     dim = 3
 
@@ -73,7 +76,10 @@ class SphericalDomain:
 class PlanarDomain:
     """A rectangle ``bounds = ((x0, x1), (y0, y1))`` (default [-1, 1]²),
     binned in ``res × res`` cells (or ``res = (nx, ny)``). Points are (N, 2);
-    a point outside the bounds counts as lost; the pdf is a density in area."""
+    a point outside the bounds counts as lost; the pdf is a density in area
+    (for a warp of the unit square or a disk, not a direction: a
+    direction sampler takes ``SphericalDomain``, whose pdf is in solid
+    angle)."""
 
     dim = 2
 
@@ -131,6 +137,11 @@ class ChiSquareTest:
     counts are pooled. After ``run``: ``histogram`` (observed counts) and
     ``pdf`` (expected counts), arrays of the bins' shape; ``p_value``,
     ``statistic``, ``dof``, ``messages``.
+
+    For a BSDF sampler (see ``BSDFAdapter``): directions in the local frame
+    (+z the normal, wo toward the viewer, wi toward the light), the pdf in
+    solid angle; a sample below the horizon is lost, as the sampler's
+    failure, and counts against the total.
     """
 
     def __init__(
@@ -194,7 +205,12 @@ class ChiSquareTest:
     def run(self, significance_level: float = 0.01, test_count: int = 1, quiet: bool = True) -> bool:
         """Run the test; True when the sampler is accepted at
         ``significance_level`` after Šidák's correction for ``test_count``
-        tests (p-value > 1 − (1 − level)^(1/test_count))."""
+        tests (p-value > 1 − (1 − level)^(1/test_count)). ``messages``
+        tells why a test failed (and the pooled cells, the statistic, the
+        degrees of freedom); ``histogram`` and ``pdf`` are then the observed
+        and expected counts per bin, to plot side by side. Directions in the
+        local frame (+z the normal); pdfs in solid angle (area for
+        ``PlanarDomain``)."""
         nz, nphi = self.res
         pts, valid = self._points()
         dirs = np.ascontiguousarray(self.domain.to_sphere(pts, nz, nphi), dtype=np.float64)
@@ -239,7 +255,10 @@ class BSDFAdapter:
     (local frame, +z the normal, toward the viewer), as ``sample_func`` and
     ``pdf_func`` of ``ChiSquareTest`` (with ``sample_dim=3`` the first
     uniform chooses the lobe of a two-lobe material). ``reference=True``
-    tests the scalar f64 path, else the path ``Material.batched`` names."""
+    tests the scalar f64 path, else the path ``Material.batched`` names.
+    The drawn wi are toward the light in the same frame; the pdf is the
+    strategy's, in solid angle (no cosine: that is in the weight,
+    f·cos θi / pdf, which the test does not use)."""
 
     def __init__(self, material: Any, strategy: str | None, wo: Sequence[float] = (0.0, 0.0, 1.0), reference: bool = False):
         from . import Material, load_dict

@@ -267,12 +267,20 @@ pub struct PyMaterial {
 /// toward the light, f without the cosine, weight = f·cos θi / pdf.
 #[pyclass(module = "lobe", name = "SampleResult", frozen)]
 pub struct SampleResult {
+    /// The drawn directions wi (N, 3), unit, in the local frame (+z the
+    /// normal), pointing toward the light; zero where not valid.
     #[pyo3(get)]
     wi: Py<PyAny>,
+    /// The Monte Carlo weights (N, 3) = f·cos θi / pdf (the cosine
+    /// included): the estimate of ∫ f cos L dωi is mean(weight · L(wi)).
     #[pyo3(get)]
     weight: Py<PyAny>,
+    /// The density (N,) in solid angle with which wi was drawn (the
+    /// strategy's pdf, as `Material.pdf` gives it); zero where not valid.
     #[pyo3(get)]
     pdf: Py<PyAny>,
+    /// (N,) bool: False for a failed sample (below the horizon), which an
+    /// estimator still counts in its N with a zero weight.
     #[pyo3(get)]
     valid: Py<PyAny>,
     /// `valid`'s bytes (uint8, 0/1), for `out=`.
@@ -418,9 +426,11 @@ impl PyMaterial {
     /// `(f, pdf)` in one call: f_r WITHOUT the cosine (N, 3) and the
     /// strategy's solid-angle pdf (N,), sharing their terms. Local frame,
     /// +z the normal, wo toward the viewer, wi toward the light; a sample's
-    /// weight is f·cos θi / pdf. `out=(f,
-    /// pdf)` (float32, Fortran-contiguous (N, 3) and (N,), e.g. a previous
-    /// result) writes into them.
+    /// weight is f·cos θi / pdf. `out=(f, pdf)` (float32,
+    /// Fortran-contiguous (N, 3) and (N,), e.g. a previous result) writes
+    /// into them. The pdf has the bits of `pdf(...)`; f those of `eval`,
+    /// except where GGX's vndf and brdf kernels compute it their own way
+    /// (as their samples' f): equal to f32 rounding (2e-6 relative).
     ///
     /// >>> import lobe
     /// >>> m = lobe.load_dict({"type": "cook-torrance", "distribution": "ggx", "alpha": 0.2})
@@ -599,6 +609,8 @@ impl PyMaterial {
 
     /// Whether `strategy` (default: vndf where it applies, else brdf) runs
     /// on the batch SIMD kernels (`True`) or on the scalar f64 path.
+    /// Conventions: local frame (+z the normal), wo toward the viewer, wi
+    /// toward the light, f without the cosine, weight = f·cos θi / pdf.
     #[pyo3(signature = (strategy = None))]
     fn batched(&self, strategy: Option<&str>) -> PyResult<bool> {
         let st = strategy_of(&self.m, strategy)?;
@@ -613,13 +625,19 @@ impl PyMaterial {
         Ok(self.m.chooses_lobe(strategy_of(&self.m, strategy)?))
     }
 
-    /// The model's short name (`lambert`, `phong`, `blinn-phong`, `cook-torrance`).
+    /// The model's short name (`lambert`, `phong`, `blinn-phong`,
+    /// `cook-torrance`, `measured`).
+    /// Conventions: local frame (+z the normal), wo toward the viewer, wi
+    /// toward the light, f without the cosine, weight = f·cos θi / pdf.
     #[getter]
     fn model(&self) -> &'static str {
         self.m.model_name()
     }
 
-    /// lobe's description of the material (JSON text, the keys of `--material`).
+    /// lobe's description of the material (JSON text, the keys of
+    /// `--material`; a Mitsuba dict as translated).
+    /// Conventions: local frame (+z the normal), wo toward the viewer, wi
+    /// toward the light, f without the cosine, weight = f·cos θi / pdf.
     #[getter]
     fn description(&self) -> &str {
         &self.desc
