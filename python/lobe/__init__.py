@@ -98,7 +98,9 @@ def load_dict(desc: Mapping[str, Any]) -> Material:
       ``specular_reflectance`` → ``cook-torrance`` with Smith separable
       shadowing (Mitsuba's) and a conductor Fresnel term;
     * ``roughplastic``: ``distribution``, ``alpha``, ``int_ior`` (1.49),
-      ``ext_ior`` (1.000277), ``specular_reflectance``,
+      ``ext_ior`` (1.000277), each a number or one of Mitsuba's names
+      (``bk7``, ``water``, ``air``, ``diamond``, ... 23 of them),
+      ``specular_reflectance``,
       ``diffuse_reflectance`` (0.5) → ``cook-torrance`` with a dielectric
       Fresnel term plus ``kd/π``. The specular lobe is Mitsuba's; the
       diffuse term is not Fresnel-weighted as in Mitsuba, so it differs.

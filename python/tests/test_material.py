@@ -1,6 +1,7 @@
 """lobe.Material from Python: shapes, dtypes, orders, errors, threads (the
 agreement with lobe's Rust paths: test_rust_paths.py)."""
 
+import json
 import threading
 import time
 
@@ -172,6 +173,11 @@ def test_mitsuba_plugins():
     assert p.chooses_lobe("brdf")
     with pytest.raises(ValueError, match=r"field `sample_visible`"):
         lobe.load_dict({"type": "roughconductor", "sample_visible": False})
+    # Mitsuba's named indices of refraction.
+    named = lobe.load_dict({"type": "roughplastic", "int_ior": "bk7", "ext_ior": "air"})
+    assert '"eta":' + json.dumps(1.5046 / 1.000277) in named.description.replace(" ", "")
+    with pytest.raises(ValueError, match=r"field `ext_ior`: unknown index of refraction `vaccum`"):
+        lobe.load_dict({"type": "roughplastic", "ext_ior": "vaccum"})
 
 
 def test_two_threads_run_at_once():

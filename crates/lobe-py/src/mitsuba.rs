@@ -6,7 +6,7 @@
 //! |---|---|
 //! | `diffuse`: `reflectance` (0.5) | `lambert`, `albedo` |
 //! | `roughconductor`: `distribution` (`beckmann`), `alpha` (0.1) or `alpha_u`/`alpha_v`, `material` (`none`) or `eta`/`k`, `specular_reflectance` (1) | `cook-torrance`, the same NDF and alpha, `shadowing = smith-separable` (Mitsuba's `G1(wi)·G1(wo)`), `ks`, `fresnel = conductor` (or `none` for `material = none`) |
-//! | `roughplastic`: `distribution` (`beckmann`), `alpha` (0.1), `int_ior` (1.49), `ext_ior` (1.000277), `specular_reflectance` (1), `diffuse_reflectance` (0.5) | `cook-torrance` with `fresnel = dielectric`, `eta = int_ior/ext_ior`, `ks`, `kd`, `smith-separable`: the same specular lobe; the diffuse term is lobe's `kd/π`, **without** Mitsuba's Fresnel weighting and internal scattering, so the diffuse part differs |
+//! | `roughplastic`: `distribution` (`beckmann`), `alpha` (0.1), `int_ior` (1.49), `ext_ior` (1.000277), each a number or a name of [`IORS`] (`bk7`, `water`, `air`, ...), `specular_reflectance` (1), `diffuse_reflectance` (0.5) | `cook-torrance` with `fresnel = dielectric`, `eta = int_ior/ext_ior`, `ks`, `kd`, `smith-separable`: the same specular lobe; the diffuse term is lobe's `kd/π`, **without** Mitsuba's Fresnel weighting and internal scattering, so the diffuse part differs |
 //!
 //! A colour is a number, `[r, g, b]`, or Mitsuba's `{"type": "rgb",
 //! "value": ...}`. `material` names one of `none`, `Au`, `Ag`, `Cu`, `Al`
@@ -24,6 +24,56 @@ pub const CONDUCTORS: [(&str, [f64; 3], [f64; 3]); 4] = [
     ("Cu", [0.200, 0.924, 1.102], [3.912, 2.452, 2.142]),
     ("Al", [1.657, 0.880, 0.521], [9.224, 6.270, 4.837]),
 ];
+
+/// Named refractive indices that Mitsuba accepts for `int_ior`/`ext_ior`:
+/// the published values (Hecht, *Optics*, 4th ed.; near 589 nm, 0–20 °C).
+pub const IORS: [(&str, f64); 23] = [
+    ("vacuum", 1.0),
+    ("helium", 1.000_036),
+    ("hydrogen", 1.000_132),
+    ("air", 1.000_277),
+    ("carbon dioxide", 1.000_45),
+    ("water", 1.333),
+    ("acetone", 1.36),
+    ("ethanol", 1.361),
+    ("carbon tetrachloride", 1.461),
+    ("glycerol", 1.4729),
+    ("benzene", 1.501),
+    ("silicone oil", 1.520_45),
+    ("bromine", 1.661),
+    ("water ice", 1.31),
+    ("fused quartz", 1.458),
+    ("pyrex", 1.47),
+    ("acrylic glass", 1.49),
+    ("polypropylene", 1.49),
+    ("bk7", 1.5046),
+    ("sodium chloride", 1.544),
+    ("amber", 1.55),
+    ("pet", 1.575),
+    ("diamond", 2.419),
+];
+
+/// An index of refraction: a number, or a name of [`IORS`] (any case).
+fn ior(plugin: &str, field: &str, v: &Value) -> Result<f64, String> {
+    if let Value::String(name) = v {
+        return IORS
+            .iter()
+            .find(|(n, _)| n.eq_ignore_ascii_case(name))
+            .map(|&(_, x)| x)
+            .ok_or_else(|| {
+                let names: Vec<&str> = IORS.iter().map(|(n, _)| *n).collect();
+                err(
+                    plugin,
+                    field,
+                    format!(
+                        "unknown index of refraction `{name}`: a number, or one of {}",
+                        names.join(", ")
+                    ),
+                )
+            });
+    }
+    number(plugin, field, v)
+}
 
 /// The Mitsuba plugin names that [`translate`] handles.
 pub const PLUGINS: [&str; 3] = ["diffuse", "roughconductor", "roughplastic"];
@@ -221,10 +271,10 @@ pub fn translate(v: Value) -> Result<Value, String> {
             }
             let int_ior = o
                 .get("int_ior")
-                .map_or(Ok(1.49), |v| number(kind, "int_ior", v))?;
+                .map_or(Ok(1.49), |v| ior(kind, "int_ior", v))?;
             let ext_ior = o
                 .get("ext_ior")
-                .map_or(Ok(1.000_277), |v| number(kind, "ext_ior", v))?;
+                .map_or(Ok(1.000_277), |v| ior(kind, "ext_ior", v))?;
             if !(int_ior > 0.0 && ext_ior > 0.0 && int_ior.is_finite() && ext_ior.is_finite()) {
                 return Err(err(
                     kind,
@@ -328,6 +378,26 @@ mod tests {
             lobe::Fresnel::Dielectric {
                 eta: lobe::Rgb::splat(1.5)
             }
+        );
+    }
+
+    #[test]
+    fn named_indices_of_refraction() {
+        let m =
+            load(json!({"type": "roughplastic", "int_ior": "BK7", "ext_ior": "water"})).unwrap();
+        let lobe::Glossy::CookTorrance(c) = m.glossy else {
+            panic!()
+        };
+        assert_eq!(
+            c.fresnel,
+            lobe::Fresnel::Dielectric {
+                eta: lobe::Rgb::splat(1.5046 / 1.333)
+            }
+        );
+        let e = load(json!({"type": "roughplastic", "int_ior": "glass"})).unwrap_err();
+        assert!(
+            e.contains("field `int_ior`: unknown index of refraction `glass`") && e.contains("bk7"),
+            "{e}"
         );
     }
 
