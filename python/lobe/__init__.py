@@ -93,8 +93,10 @@ def load_dict(desc: Mapping[str, Any]) -> Material:
 
     * ``diffuse``: ``reflectance`` → ``lambert``;
     * ``roughconductor``: ``distribution`` (default ``beckmann``), ``alpha``
-      (0.1) or ``alpha_u``/``alpha_v``, ``material`` (``none``, ``Au``,
-      ``Ag``, ``Cu``, ``Al``; RGB fits) or ``eta``/``k``,
+      (0.1) or ``alpha_u``/``alpha_v``, ``material`` (``none`` or one of
+      Mitsuba's conductor names, ``Au``, ``Ag``, ``Cu``, ``Al``, ``Cr``,
+      ``W``, ... with the RGB (eta, k) of Mitsuba's RGB variants) or
+      ``eta``/``k``,
       ``specular_reflectance`` → ``cook-torrance`` with Smith separable
       shadowing (Mitsuba's) and a conductor Fresnel term;
     * ``roughplastic``: ``distribution``, ``alpha``, ``int_ior`` (1.49),

@@ -173,6 +173,11 @@ def test_mitsuba_plugins():
     assert p.chooses_lobe("brdf")
     with pytest.raises(ValueError, match=r"field `sample_visible`"):
         lobe.load_dict({"type": "roughconductor", "sample_visible": False})
+    # Mitsuba's conductor names, with the RGB (eta, k) of its RGB variants.
+    cr = lobe.load_dict({"type": "roughconductor", "material": "Cr", "alpha": 0.2})
+    assert '"eta":[4.36967,2.91651,1.6549]' in cr.description.replace(" ", "")
+    with pytest.raises(ValueError, match=r"field `material`: unknown conductor `Gold`"):
+        lobe.load_dict({"type": "roughconductor", "material": "Gold"})
     # Mitsuba's named indices of refraction.
     named = lobe.load_dict({"type": "roughplastic", "int_ior": "bk7", "ext_ior": "air"})
     assert '"eta":' + json.dumps(1.5046 / 1.000277) in named.description.replace(" ", "")
