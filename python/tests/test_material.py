@@ -125,9 +125,11 @@ def test_failed_samples_are_zero_and_evaluate_to_zero():
 def test_errors_name_the_field():
     with pytest.raises(ValueError, match=r"field `alpha`"):
         lobe.load_dict({"type": "cook-torrance", "alpha": -1})
-    with pytest.raises(ValueError, match=r"unknown field `exponnt`"):
+    with pytest.raises(ValueError, match=r"unknown field `exponnt`") as e:
         lobe.load_dict({"type": "phong", "exponnt": 3})
-    with pytest.raises(ValueError, match=r"field `type`"):
+    # No position in JSON text the user never wrote.
+    assert "line 1" not in str(e.value) and "column" not in str(e.value), str(e.value)
+    with pytest.raises(ValueError, match=r"field `type`: unknown value `glass`.*Mitsuba 3's plugins: diffuse, roughconductor"):
         lobe.load_dict({"type": "glass"})
     with pytest.raises(ValueError, match=r"field `distribution`: unknown value"):
         lobe.load_dict({"type": "roughconductor", "distribution": "phong"})

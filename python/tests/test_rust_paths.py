@@ -78,9 +78,13 @@ def test_the_same_bits_as_the_rust_batch_path(desc, lobe_exe):
     lines = [json.dumps({"wo": wo[i].tolist(), "wi": wi[i].tolist()}) for i in range(n)]
     cli = run_cli(lobe_exe, desc, lines)
     assert same_bits(m.eval(wo, wi), f32([r["f"] for r in cli]))
+    wo64, wi64 = wo.astype(np.float64), np.asfortranarray(wi.astype(np.float64))
+    assert same_bits(m.eval(wo64, wi64), f32([r["f"] for r in cli]))
     for st in m.strategies:
         f, p = m.eval_pdf(wo, wi, strategy=st)
         assert same_bits(p, f32([r["pdf"][st] for r in cli])), st
+        f64, p64 = m.eval_pdf(wo64, wi64, strategy=st)
+        assert same_bits(f64, f) and same_bits(p64, p), st
         assert same_bits(m.pdf(wo, wi, strategy=st), p), st
         # GGX's vndf and brdf kernels compute f another way (as their
         # samples' f): equal to f32 rounding, not always to the bit.

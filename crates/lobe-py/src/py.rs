@@ -659,8 +659,36 @@ fn _load_json(text: &str) -> PyResult<PyMaterial> {
     }
     let v = crate::mitsuba::translate(v).map_err(value_error)?;
     let desc = v.to_string();
-    let m = Material::load(&desc).map_err(value_error)?;
+    let m = Material::load(&desc).map_err(|e| {
+        let m = e.to_string();
+        let m = without_position(&m);
+        if m.starts_with("material: field `type`: unknown value") {
+            value_error(format!(
+                "{m}; or one of Mitsuba 3's plugins: {}",
+                crate::mitsuba::PLUGINS.join(", ")
+            ))
+        } else {
+            value_error(m)
+        }
+    })?;
     Ok(PyMaterial { m, desc })
+}
+
+/// A parser message without serde's trailing " at line L column C": the
+/// position is in the JSON made from the user's dict, which they never see.
+fn without_position(m: &str) -> &str {
+    if let Some(i) = m.rfind(" at line ") {
+        let tail = &m[i + " at line ".len()..];
+        if let Some((line, col)) = tail.split_once(" column ")
+            && !line.is_empty()
+            && line.bytes().all(|b| b.is_ascii_digit())
+            && !col.is_empty()
+            && col.bytes().all(|b| b.is_ascii_digit())
+        {
+            return &m[..i];
+        }
+    }
+    m
 }
 
 /// Set the number of threads of the array calls (`None`: rayon's default,
