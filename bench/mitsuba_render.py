@@ -149,7 +149,35 @@ def latlong(u, v):
     return np.stack([np.sin(theta) * np.sin(phi), np.cos(theta), -np.sin(theta) * np.cos(phi)], -1)
 
 
-def write_maps(out):
+def write_exr_uncompressed(path, img):
+    """`img` (H, W, 3) as a scanline OpenEXR file without compression, float
+    channels B, G, R (the OpenEXR file layout: magic, version, header
+    attributes, the offset table, one scanline per block)."""
+    import struct
+
+    h, w, _ = img.shape
+
+    def attr(name, kind, value):
+        return name.encode() + b"\0" + kind.encode() + b"\0" + struct.pack("<i", len(value)) + value
+
+    chlist = b"".join(c.encode() + b"\0" + struct.pack("<iB3xii", 2, 0, 1, 1) for c in "BGR") + b"\0"
+    box = struct.pack("<iiii", 0, 0, w - 1, h - 1)
+    header = (attr("channels", "chlist", chlist) + attr("compression", "compression", b"\0")
+              + attr("dataWindow", "box2i", box) + attr("displayWindow", "box2i", box)
+              + attr("lineOrder", "lineOrder", b"\0") + attr("pixelAspectRatio", "float", struct.pack("<f", 1.0))
+              + attr("screenWindowCenter", "v2f", struct.pack("<ff", 0.0, 0.0))
+              + attr("screenWindowWidth", "float", struct.pack("<f", 1.0)) + b"\0")
+    start = 8 + len(header) + 8 * h
+    line = 8 + 3 * 4 * w
+    offsets = np.arange(h, dtype="<u8") * line + start
+    planes = np.ascontiguousarray(img[..., ::-1].transpose(0, 2, 1), dtype="<f4")  # (H, B/G/R, W)
+    with open(path, "wb") as f:
+        f.write(b"\x76\x2f\x31\x01" + struct.pack("<i", 2) + header + offsets.tobytes())
+        for y in range(h):
+            f.write(struct.pack("<ii", y, 3 * 4 * w) + planes[y].tobytes())
+
+
+def write_maps(out, lobe_compression="none"):
     os.makedirs(out, exist_ok=True)
     u = (np.arange(MAP_W) + 0.5) / MAP_W
     v_lobe = (np.arange(MAP_H) + 0.5) / MAP_H
@@ -159,7 +187,13 @@ def write_maps(out):
         uu, vv = np.meshgrid(u, v)
         img = sky(latlong(uu, vv)).astype(np.float32)
         p = os.path.join(out, f"sky-sun-{name}.exr")
-        mi.Bitmap(img, mi.Bitmap.PixelFormat.RGB).write(p)
+        if name == "lobe" and lobe_compression == "none":
+            # lobe reads its map inside its timed process, Mitsuba before
+            # its timer starts: lobe's copy without compression (the PIZ
+            # that Mitsuba writes took half of lobe's fixed cost to decode).
+            write_exr_uncompressed(p, img)
+        else:
+            mi.Bitmap(img, mi.Bitmap.PixelFormat.RGB).write(p)
         paths[name] = p
         if name == "lobe":
             save_png(os.path.join(out, "sky-sun-preview.png"), img)
@@ -357,6 +391,9 @@ def main():
     p.add_argument("--skip-mitsuba", action="store_true", help="only the reference and lobe")
     p.add_argument("--out", default=os.path.join(HERE, "out"), help="images and maps (default bench/out)")
     p.add_argument("--json-out", help="write the ladders as JSON here")
+    p.add_argument("--lobe-map-compression", choices=["none", "piz"], default="none",
+                   help="lobe's copy of the map: uncompressed EXR (default; lobe reads it in its timed "
+                        "process, Mitsuba its own before the timer) or PIZ as Mitsuba writes it")
     args = p.parse_args()
     if args.threads < 1 or args.ref_spp < 1 or args.ref_passes < 1 or not 0 < args.target < 1:
         die("--threads, --ref-spp, --ref-passes must be >= 1 and --target in (0, 1)")
@@ -373,7 +410,7 @@ def main():
     dr.set_thread_count(args.threads)
 
     desc, cam, spheres = load_scene_desc()
-    maps = write_maps(args.out)
+    maps = write_maps(args.out, args.lobe_map_compression)
     # lobe renders a copy of the scene file whose environment is the map
     # just written (the committed file names bench/out/sky-sun-lobe.exr).
     with open(SCENE) as f:
