@@ -638,11 +638,16 @@ pub(super) fn eval_pdf_level<L: Lanes>(
 /// Where the chains are short (GGX eval_pdf; GGX brdf at AVX-512, which
 /// has half as many vectors in flight for the same work) two vectors only
 /// add register spills and run slower: measured by `lobe bench` on Zen 4
-/// (BENCHMARKS.md). The numbers are the same bits either way.
+/// (BENCHMARKS.md). GGX vndf's sampler too at AVX-512: two 16-lane vectors
+/// in flight spilled 63 of its ~370 instructions to the stack, and one at
+/// a time ran its s+e+p 7–18% (one thread) and 18–23% (two) faster on Zen 4
+/// (2026-12-03, three alternating runs). Beckmann's, whose chains are
+/// longer still, showed no difference either way and keeps two. The
+/// numbers are the same bits either way.
 pub(super) fn runs_x2(k: &Kernel, eval: bool, wide: bool) -> bool {
     match k {
         Kernel::CookTorrance { ndf, strat, .. } => match *strat {
-            VNDF => *ndf == BECKMANN || (*ndf == GGX && !eval),
+            VNDF => *ndf == BECKMANN || (*ndf == GGX && !eval && !wide),
             BRDF => *ndf == GGX && !eval && !wide,
             _ => false,
         },
