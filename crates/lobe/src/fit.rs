@@ -210,7 +210,9 @@ fn target(m: &Material, turn: bool) -> Target {
                     k += 1;
                 }
                 let f = m.eval(wo, wi);
-                if !(crate::math::luminance(f) > 0.0) || !f.is_finite() {
+                if crate::math::luminance(f).partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater)
+                    || !f.is_finite()
+                {
                     continue;
                 }
                 let c = wi.z;

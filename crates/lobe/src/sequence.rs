@@ -529,6 +529,7 @@ fn sobol_pairs_lanes(seeds: &[u64], index: &[u32], x: &mut [f64], y: &mut [f64])
         for l in 0..n {
             ir[l] = laine_karras(i[l].reverse_bits(), s[l] as u32);
         }
+        #[allow(clippy::needless_range_loop)] // b is also the shift
         for b in 0..32 {
             let (c0, c1) = (cols[0][b], cols[1][b]);
             for l in 0..SOBOL_CHUNK {

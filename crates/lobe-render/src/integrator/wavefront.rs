@@ -390,6 +390,7 @@ impl Batch<'_> {
 
     /// The camera ray of one sample, its hit and shading frame, and its
     /// numbers.
+    #[allow(clippy::too_many_arguments)]
     fn camera_point(
         &self,
         ctx: &Context<'_>,

@@ -101,7 +101,8 @@ fn from_desc(d: &crate::desc::MaterialDesc) -> crate::error::Result<crate::Mater
 #[derive(Debug, Clone)]
 pub enum Table {
     Merl(merl::Merl),
-    Rgl(rgl::Rgl),
+    /// Boxed: an RGL table's fields are large beside MERL's.
+    Rgl(Box<rgl::Rgl>),
 }
 
 impl Table {
@@ -109,7 +110,7 @@ impl Table {
     /// names the file in the error).
     pub fn parse(bytes: &[u8], name: &str) -> crate::error::Result<Table> {
         let r = if rgl::looks_like(bytes) {
-            rgl::Rgl::parse(bytes).map(Table::Rgl)
+            rgl::Rgl::parse(bytes).map(|r| Table::Rgl(Box::new(r)))
         } else if bytes.len() >= 12 && !merl::looks_like(bytes) {
             // Neither: say what the first bytes are, as MERL dimensions.
             merl::Merl::parse(bytes)

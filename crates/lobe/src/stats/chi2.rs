@@ -947,7 +947,8 @@ mod tests {
     #[test]
     fn adaptive_count_matches_the_full_lattice() {
         use std::cell::Cell;
-        let shapes: [(&str, fn(DVec2) -> bool); 4] = [
+        type Shape = (&'static str, fn(DVec2) -> bool);
+        let shapes: [Shape; 4] = [
             ("disc", |u| (u - DVec2::splat(0.5)).length_squared() < 0.2),
             ("annulus", |u| {
                 (0.05..0.15).contains(&(u - DVec2::new(0.3, 0.6)).length_squared())

@@ -171,10 +171,10 @@ fn check(bytes: &[u8], rng: &mut impl Rng, build: bool) -> Result<bool, String> 
                 if !(p.is_finite() && p >= 0.0) {
                     return Err(format!("pdf_warps({wo}, {wi}) = {p}"));
                 }
-                if let Some(s) = r.sample_warps(*wo, *u) {
-                    if !(s.is_finite() && s.z > 0.0 && (s.length() - 1.0).abs() < 1e-9) {
-                        return Err(format!("sample_warps({wo}, {u}) = {s}"));
-                    }
+                if let Some(s) = r.sample_warps(*wo, *u)
+                    && !(s.is_finite() && s.z > 0.0 && (s.length() - 1.0).abs() < 1e-9)
+                {
+                    return Err(format!("sample_warps({wo}, {u}) = {s}"));
                 }
             }
         }

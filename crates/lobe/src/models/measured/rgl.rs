@@ -697,10 +697,13 @@ impl Rgl {
                 phi_i.len()
             ));
         }
-        if theta_i.windows(2).any(|w| !(w[0] < w[1])) {
+        // `!(a < b)`, not `a >= b`: a NaN is not increasing either.
+        #[allow(clippy::neg_cmp_op_on_partial_ord)]
+        let not_increasing = |v: &[f32]| v.windows(2).any(|w| !(w[0] < w[1]));
+        if not_increasing(&theta_i) {
             return Err("field `theta_i` is not increasing".into());
         }
-        if phi_i.windows(2).any(|w| !(w[0] < w[1])) {
+        if not_increasing(&phi_i) {
             return Err("field `phi_i` is not increasing".into());
         }
         let (np, nt) = (phi_i.len(), theta_i.len());
