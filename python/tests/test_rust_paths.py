@@ -61,15 +61,16 @@ def test_the_same_bits_as_the_rust_batch_path(desc, lobe_exe):
         lines = [json.dumps({"wo": wo[i].tolist(), "u": u[i].tolist(), "uc": float(uc[i]), "strategy": st})
                  for i in range(n)]
         cli = run_cli(lobe_exe, desc, lines)
+        valid = np.array([r["wi"] is not None for r in cli])
+        wi = f32([r["wi"] if r["wi"] is not None else [0, 0, 0] for r in cli])
+        pdf, weight = f32([r["pdf"] for r in cli]), f32([r["weight"] for r in cli])
         # f32 arrays, and the same values as f64 arrays: both are the rows the CLI read.
         for w, uu, c in ((wo, u, uc), (wo.astype(np.float64), u.astype(np.float64), uc.astype(np.float64))):
             s = m.sample(w, uu, c, strategy=st)
-            valid = np.array([r["wi"] is not None for r in cli])
             assert np.array_equal(s.valid, valid), st
-            wi = np.array([r["wi"] if r["wi"] is not None else [0, 0, 0] for r in cli])
-            assert same_bits(s.wi, f32(wi)), st
-            assert same_bits(s.pdf, f32([r["pdf"] for r in cli])), st
-            assert same_bits(s.weight, f32([r["weight"] for r in cli])), st
+            assert same_bits(s.wi, wi), st
+            assert same_bits(s.pdf, pdf), st
+            assert same_bits(s.weight, weight), st
     # eval lines: wi drawn by the last strategy (where valid), else from
     # the hemisphere.
     s = m.sample(wo, u, uc, strategy=m.strategies[-1])
@@ -96,10 +97,10 @@ def jitter(rng, a, rel):
     return a * (1 + rel * rng.choice([-1.0, 1.0], a.shape))
 
 
-def undetermined(ref, base, moved):
-    """How far the reference moves when its inputs move by their f32
-    rounding: what the f32 inputs leave open (max over the moves)."""
-    return np.max([np.abs(ref(*m) - base) for m in moved], axis=0)
+def spread(moved, base):
+    """How far the reference moves (`moved`: its values at inputs moved by
+    their f32 rounding) from `base`: what the f32 inputs leave open."""
+    return np.max([np.abs(v - base) for v in moved], axis=0)
 
 
 @pytest.mark.parametrize("desc", MATERIALS, ids=IDS)
@@ -129,25 +130,26 @@ def test_within_1e_4_of_the_scalar_reference(desc):
         differ = s.valid != r.valid
         assert not np.any(differ & ~open_valid & ~horizon), (st, np.flatnonzero(differ & ~open_valid & ~horizon)[:5])
         both = s.valid & r.valid & ~np.any([~x.valid for x in near], axis=0)
-        dwi = np.max([np.abs(x.wi - r.wi).max(axis=1) for x in near], axis=0)
+        dwi = spread([x.wi for x in near], r.wi).max(axis=1)
         err = np.abs(s.wi - r.wi).max(axis=1)
         assert np.all((err <= 1e-5 + 2 * dwi)[both]), (st, err[both].max())
         for a in ("pdf", "weight"):
             got, want = getattr(s, a), getattr(r, a)
-            d = np.max([np.abs(getattr(x, a) - want) for x in near], axis=0)
+            d = spread([getattr(x, a) for x in near], want)
             ok = np.abs(got - want) <= 1e-4 * np.abs(want) + 2 * d + 1e-30
             assert np.all(ok[both]), (st, a, np.flatnonzero(~ok & both)[:5])
-    # eval and pdf at (wo, wi) pairs: wi drawn by each strategy and from the hemisphere.
+    # eval and pdf at (wo, wi) pairs: wi drawn by the last strategy (where
+    # valid) and from the hemisphere.
     wi = np.where(s.valid[:, None], s.wi, inputs(n, 5)[0])
     wi[: n // 2] = inputs(n // 2, 6)[0]
     wi64 = wi.astype(np.float64)
     pairs = [(jitter(rng, wo64, e), jitter(rng, wi64, e)) for _ in range(4)]
     f, fr = m.eval(wo, wi), m.eval(wo64, wi64, reference=True)
-    df = undetermined(lambda a, b: m.eval(a, b, reference=True), fr, pairs)
+    df = spread([m.eval(a, b, reference=True) for a, b in pairs], fr)
     assert np.all(np.abs(f - fr) <= 1e-4 * fr + 2 * df + 1e-30), np.abs(f - fr).max()
     for st in m.strategies:
         p, pr = m.pdf(wo, wi, strategy=st), m.pdf(wo64, wi64, strategy=st, reference=True)
-        dp = undetermined(lambda a, b: m.pdf(a, b, strategy=st, reference=True), pr, pairs)
+        dp = spread([m.pdf(a, b, strategy=st, reference=True) for a, b in pairs], pr)
         bad = np.abs(p - pr) > 1e-4 * pr + 2 * dp + 1e-30
         assert not np.any(bad), (st, np.flatnonzero(bad)[:5], p[bad][:3], pr[bad][:3])
         print(f"{desc['type']} {st}: pdf beyond 1e-4 at {np.sum(np.abs(p - pr) > 1e-4 * pr)} of {n} pairs, "

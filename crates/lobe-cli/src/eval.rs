@@ -164,7 +164,7 @@ pub fn process<R: BufRead, W: Write>(
             .and_then(|q| q.check(material, &strategies))
             .map_err(|m| Failure::Line(n, m))?;
         match request {
-            Request::Eval { wo, wi } => {
+            Request::Eval { wo, wi, .. } => {
                 let f = material.eval(wo, wi);
                 if !f.is_finite() {
                     return Err(Failure::Line(
@@ -200,6 +200,7 @@ pub fn process<R: BufRead, W: Write>(
                 wo,
                 u,
                 uc,
+                ..
             } => match material.sample(strategy, wo, uc, u) {
                 None => out.write_all(b"{\"wi\":null,\"pdf\":0,\"weight\":[0,0,0]}\n")?,
                 Some(s) => {
@@ -479,30 +480,28 @@ fn json_message(e: &serde_json::Error) -> String {
     }
 }
 
-/// A checked line.
+/// A checked line. `wo` and `wi` are normalized for the f64 path;
+/// `given` holds them as the line gave them (unit within
+/// [`UNIT_TOLERANCE`]): the batch path rounds those to f32 as they are, as
+/// the Python package does with its arrays, so that both give the same bits
+/// (normalizing in f64 first would move some by an f32 ulp).
 #[derive(Debug, Clone, Copy)]
 pub(crate) enum Request {
     Eval {
         wo: DVec3,
         wi: DVec3,
+        given: [[f64; 3]; 2],
     },
     Sample {
         strategy: BsdfStrategy,
         wo: DVec3,
+        given_wo: [f64; 3],
         u: DVec2,
         uc: f64,
     },
 }
 
 impl Query {
-    /// `wo` and `wi` as the line gives them, before [`Query::check`]
-    /// normalizes them: the batch path rounds these to f32 as they are, as
-    /// the Python package does with its arrays, so that both give the same
-    /// bits (normalizing in f64 first would move some by an f32 ulp).
-    pub(crate) fn given_dirs(&self) -> (Option<[f64; 3]>, Option<[f64; 3]>) {
-        (self.wo, self.wi)
-    }
-
     /// Check the keys present, the vectors and the strategy.
     pub(crate) fn check(
         self,
@@ -510,10 +509,10 @@ impl Query {
         strategies: &[BsdfStrategy],
     ) -> Result<Request, String> {
         const KINDS: &str = "an eval line has wo and wi; a sample line has wo, u, strategy, and uc where the material has two lobes";
-        let wo = self
+        let given_wo = self
             .wo
             .ok_or_else(|| format!("field \"wo\": missing ({KINDS})"))?;
-        let wo = unit_vector(Key::Wo, wo)?;
+        let wo = unit_vector(Key::Wo, given_wo)?;
         let Some(strategy) = self.strategy else {
             if self.u.is_some() || self.uc.is_some() {
                 let key = if self.u.is_some() { "u" } else { "uc" };
@@ -521,11 +520,15 @@ impl Query {
                     "field \"{key}\": only in a sample line, which also needs \"strategy\" ({KINDS})"
                 ));
             }
-            let wi = self
+            let given_wi = self
                 .wi
                 .ok_or_else(|| format!("field \"wi\": missing ({KINDS})"))?;
-            let wi = unit_vector(Key::Wi, wi)?;
-            return Ok(Request::Eval { wo, wi });
+            let wi = unit_vector(Key::Wi, given_wi)?;
+            return Ok(Request::Eval {
+                wo,
+                wi,
+                given: [given_wo, given_wi],
+            });
         };
         if self.wi.is_some() {
             return Err(format!(
@@ -559,6 +562,7 @@ impl Query {
         Ok(Request::Sample {
             strategy,
             wo,
+            given_wo,
             u: DVec2::from_array(u),
             uc,
         })

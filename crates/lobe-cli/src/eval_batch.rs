@@ -69,7 +69,6 @@ impl Columns {
     }
 }
 
-/// f32 of a direction's components.
 /// A direction as the line gave it (checked to be unit within
 /// [`crate::eval::UNIT_TOLERANCE`]), rounded to f32.
 fn push3(cols: &mut [Vec<f32>; 3], v: [f64; 3]) {
@@ -128,13 +127,11 @@ pub fn process_batch<R: BufRead, W: Write>(
                 if text.is_empty() {
                     continue;
                 }
-                let checked = parse_line(text).and_then(|q| {
-                    let given = q.given_dirs();
-                    q.check(material, &strategies).map(|r| (r, given))
-                });
-                match checked {
+                match parse_line(text).and_then(|q| q.check(material, &strategies)) {
                     Err(m) => Some(Failure::Line(n, m)),
-                    Ok((Request::Eval { .. }, (Some(wo), Some(wi)))) => {
+                    Ok(Request::Eval {
+                        given: [wo, wi], ..
+                    }) => {
                         places.push(Place::Eval(evals.len()));
                         evals.slot.push(places.len() - 1);
                         evals.line.push(n);
@@ -142,12 +139,13 @@ pub fn process_batch<R: BufRead, W: Write>(
                         push3(&mut evals.b, wi);
                         continue;
                     }
-                    Ok((
-                        Request::Sample {
-                            strategy, u, uc, ..
-                        },
-                        (Some(wo), _),
-                    )) => {
+                    Ok(Request::Sample {
+                        strategy,
+                        given_wo: wo,
+                        u,
+                        uc,
+                        ..
+                    }) => {
                         let k = strategies
                             .iter()
                             .position(|&s| s == strategy)
@@ -162,10 +160,6 @@ pub fn process_batch<R: BufRead, W: Write>(
                         c.uc.push(unit_interval_f32(uc));
                         continue;
                     }
-                    Ok(_) => Some(Failure::Line(
-                        n,
-                        "internal error: a checked line without its directions".into(),
-                    )),
                 }
             }
             Err(e) if e.kind() == io::ErrorKind::InvalidData => {
