@@ -26,7 +26,7 @@ pub struct Camera {
     pub fov_y: f64,
     pub width: u32,
     pub height: u32,
-    tan_half: f64,
+    pub(crate) tan_half: f64,
 }
 
 /// A camera parameter that cannot be used: the field and why.

@@ -43,6 +43,7 @@ pub mod compare;
 pub mod envmap_io;
 pub mod geometry;
 pub mod integrator;
+pub mod lanes;
 pub mod light_spec;
 pub mod mesh;
 pub mod options;

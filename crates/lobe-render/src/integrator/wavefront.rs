@@ -6,7 +6,7 @@
 //! ("Batch loop") for what it covers and how it is checked.
 
 use super::{Context, FirstBounce, RenderStats, dims, pixel_seed};
-use crate::geometry::spawn_ray;
+use crate::lanes::{HitLanes, NO_HIT, RayLanes, Vec3Lanes, spawn_many};
 use crate::scene::Scene;
 use glam::{DVec2, DVec3};
 use lobe::batch::{
@@ -164,6 +164,23 @@ struct Point {
     value: Rgb,
 }
 
+impl Point {
+    /// A sample of pixel column `x` that has not hit anything (yet).
+    fn new(x: u32, plan: PixelPlan) -> Self {
+        Point {
+            x,
+            obj: u32::MAX,
+            p: DVec3::ZERO,
+            ng: DVec3::Z,
+            frame: Frame::from_normal(DVec3::Z),
+            wo: DVec3::Z,
+            plan,
+            u: [[0.0; 3]; 2],
+            value: Rgb::ZERO,
+        }
+    }
+}
+
 /// Per draw (two per sample) of a block.
 #[derive(Debug, Clone, Copy, Default)]
 struct Draw {
@@ -206,6 +223,21 @@ struct Lanes {
     /// The escaping BSDF draws' world directions and the map there.
     bsdf_dirs: Vec<DVec3>,
     bsdf_env: Vec<EnvLookup>,
+    /// The block's film positions `(x, y)` in pixels.
+    film: (Vec<f64>, Vec<f64>),
+    /// Independent or stratified numbers: each sample's pair seeds and
+    /// index.
+    each: Vec<(PixelSeeds, u64)>,
+    /// The block's camera rays and their hits; then its shadow rays.
+    rays: RayLanes,
+    hits: HitLanes,
+    /// The shadow rays' origins (the hit points), normals and directions,
+    /// each ray's draw index, and whether it is blocked.
+    shadow_p: Vec3Lanes,
+    shadow_ng: Vec3Lanes,
+    shadow_dir: Vec3Lanes,
+    shadow_draw: Vec<usize>,
+    blocked: Vec<bool>,
 }
 
 /// The pairs a sample of the batch loop draws: camera, BSDF direction,
@@ -231,6 +263,15 @@ impl Lanes {
             draw_index: Vec::with_capacity(2 * BLOCK),
             bsdf_dirs: Vec::with_capacity(2 * BLOCK),
             bsdf_env: Vec::with_capacity(2 * BLOCK),
+            film: (Vec::with_capacity(BLOCK), Vec::with_capacity(BLOCK)),
+            each: Vec::with_capacity(BLOCK),
+            rays: RayLanes::default(),
+            hits: HitLanes::default(),
+            shadow_p: Vec3Lanes::default(),
+            shadow_ng: Vec3Lanes::default(),
+            shadow_dir: Vec3Lanes::default(),
+            shadow_draw: Vec::with_capacity(2 * BLOCK),
+            blocked: Vec::with_capacity(2 * BLOCK),
         }
     }
 }
@@ -248,15 +289,6 @@ impl PixelSeeds {
     fn all(&self) -> [u64; PAIRS] {
         [self.camera, self.bsdf_u, self.bsdf_uc, self.light]
     }
-}
-
-/// Where a sample's pairs come from: computed for the whole block
-/// (Sobol, [`sobol_pairs`]: the camera pair given, the others drawn
-/// afterwards for the samples that hit), or drawn one by one.
-#[derive(Debug, Clone, Copy)]
-enum Pairs {
-    Block(DVec2),
-    Each,
 }
 
 impl Batch<'_> {
@@ -316,6 +348,10 @@ impl Batch<'_> {
                     &mut lanes.pair_y[0][..n],
                 );
             }
+            // The block's camera rays, traced together.
+            lanes.film.0.clear();
+            lanes.film.1.clear();
+            lanes.each.clear();
             let mut cur: Option<(usize, PixelSeeds, PixelPlan)> = None;
             for f in k..end {
                 let (x, i) = ((f / spp) as usize, f % spp);
@@ -327,14 +363,18 @@ impl Batch<'_> {
                     Sequence::Stratified => i,
                     Sequence::Sobol | Sequence::Independent => ctx.pass * spp + i,
                 };
-                let pairs = if sobol {
+                let j = if sobol {
                     let m = (f - k) as usize;
-                    Pairs::Block(DVec2::new(lanes.pair_x[0][m], lanes.pair_y[0][m]))
+                    DVec2::new(lanes.pair_x[0][m], lanes.pair_y[0][m])
                 } else {
-                    Pairs::Each
+                    lanes.each.push((seeds, index));
+                    seeded_pair(ctx, &seeds, index, 0)
                 };
-                pts.push(self.camera_point(ctx, (x, y), index, &seeds, pairs, plan, &mut stats));
+                lanes.film.0.push(x as f64 + j.x);
+                lanes.film.1.push(y as f64 + j.y);
+                pts.push(Point::new(x as u32, plan));
             }
+            self.camera_points(ctx, &mut pts, &mut lanes, &mut stats);
             if sobol {
                 // The shading pairs of the samples that hit, compacted.
                 for v in &mut lanes.hit_seeds {
@@ -388,79 +428,65 @@ impl Batch<'_> {
         stats
     }
 
-    /// The camera ray of one sample, its hit and shading frame, and its
-    /// numbers.
-    #[allow(clippy::too_many_arguments)]
-    fn camera_point(
+    /// The camera rays of a block (film positions `lanes.film`), their
+    /// hits and shading frames: `pts[m]` gets sample `m`'s, its value the
+    /// map's radiance when the ray escapes; with independent or stratified
+    /// numbers (`lanes.each`) also its draws' numbers.
+    fn camera_points(
         &self,
         ctx: &Context<'_>,
-        (x, y): (usize, usize),
-        index: u64,
-        seeds: &PixelSeeds,
-        pairs: Pairs,
-        plan: PixelPlan,
+        pts: &mut [Point],
+        lanes: &mut Lanes,
         stats: &mut RenderStats,
-    ) -> Point {
-        // Pair p of `PixelSeeds::all`.
-        let pair = |p: usize| {
-            DVec2::from_array(pair_point_seeded(
-                ctx.sequence,
-                seeds.all()[p],
-                ctx.spp,
-                index,
-            ))
-        };
-        let j = match pairs {
-            Pairs::Block(c) => c,
-            Pairs::Each => pair(0),
-        };
-        let ray = ctx.scene.camera.ray(x as f64 + j.x, y as f64 + j.y);
-        stats.camera_rays += 1;
-        stats.rays += 1;
-        let mut pt = Point {
-            x: x as u32,
-            obj: u32::MAX,
-            p: DVec3::ZERO,
-            ng: DVec3::Z,
-            frame: Frame::from_normal(DVec3::Z),
-            wo: DVec3::Z,
-            plan,
-            u: [[0.0; 3]; 2],
-            value: Rgb::ZERO,
-        };
-        let Some((hit, obj)) = ctx.scene.intersect(&ray, f64::INFINITY) else {
-            pt.value = self.env.eval(ray.dir);
-            return pt;
-        };
-        // The scalar loop's normals (see `Context::radiance`).
-        let wo_world = -ray.dir;
-        let ng = if hit.ng.dot(wo_world) < 0.0 {
-            -hit.ng
-        } else {
-            hit.ng
-        };
-        let mut ns = if hit.ns.dot(ng) < 0.0 {
-            -hit.ns
-        } else {
-            hit.ns
-        };
-        if ns.dot(wo_world) <= 0.0 {
-            ns = ng;
+    ) {
+        let n = pts.len();
+        ctx.scene
+            .camera
+            .rays_many(self.level, &lanes.film.0, &lanes.film.1, &mut lanes.rays);
+        stats.camera_rays += n as u64;
+        stats.rays += n as u64;
+        ctx.scene
+            .intersect_many(self.level, &lanes.rays, &mut lanes.hits);
+        lanes.bsdf_dirs.clear();
+        lanes.draw_index.clear();
+        let h = &lanes.hits;
+        for (m, pt) in pts.iter_mut().enumerate() {
+            let dir = lanes.rays.dir.get(m);
+            if h.obj[m] == NO_HIT {
+                lanes.bsdf_dirs.push(dir);
+                lanes.draw_index.push(m);
+                continue;
+            }
+            // The scalar loop's normals (see `Context::radiance`).
+            let wo_world = -dir;
+            let (hng, hns) = (h.ng.get(m), h.ns.get(m));
+            let ng = if hng.dot(wo_world) < 0.0 { -hng } else { hng };
+            let mut ns = if hns.dot(ng) < 0.0 { -hns } else { hns };
+            if ns.dot(wo_world) <= 0.0 {
+                ns = ng;
+            }
+            let frame = Frame::from_normal(ns);
+            let wo = frame.to_local(wo_world);
+            if wo.z <= 0.0 {
+                continue;
+            }
+            if let Some(&(seeds, index)) = lanes.each.get(m) {
+                self.assign_u(pt, |p| seeded_pair(ctx, &seeds, index, p));
+            }
+            pt.obj = h.obj[m];
+            pt.p = h.p.get(m);
+            pt.ng = ng;
+            pt.frame = frame;
+            pt.wo = wo;
         }
-        let frame = Frame::from_normal(ns);
-        let wo = frame.to_local(wo_world);
-        if wo.z <= 0.0 {
-            return pt;
+        // The map where the rays escape.
+        let e = lanes.bsdf_dirs.len();
+        lanes.bsdf_env.resize(e, EnvLookup::default());
+        self.env
+            .lookup_many(&lanes.bsdf_dirs, &mut lanes.bsdf_env[..e]);
+        for (&m, l) in lanes.draw_index.iter().zip(&lanes.bsdf_env[..e]) {
+            pts[m].value = l.radiance;
         }
-        if let Pairs::Each = pairs {
-            self.assign_u(&mut pt, pair);
-        }
-        pt.obj = obj as u32;
-        pt.p = hit.p;
-        pt.ng = ng;
-        pt.frame = frame;
-        pt.wo = wo;
-        pt
     }
 
     /// The numbers of `pt`'s draws from its pairs (`pair(p)`, pair `p` of
@@ -560,28 +586,55 @@ impl Batch<'_> {
             self.batch_group(obj, g..e, pts, draws, lanes);
             g = e;
         }
-        // The BSDF draws' shadow rays, then the map at the directions that
-        // escape, for the whole block (`EnvMap::lookup_many`).
-        lanes.bsdf_dirs.clear();
-        lanes.draw_index.clear();
+        // The shadow rays of the block, traced together: the BSDF draws'
+        // (a failed draw when blocked), and the light draws' that carry
+        // light (`f ≠ 0`).
+        lanes.shadow_p.clear();
+        lanes.shadow_ng.clear();
+        lanes.shadow_dir.clear();
+        lanes.shadow_draw.clear();
         for (i, pt) in pts.iter().enumerate() {
             if pt.obj == u32::MAX {
                 continue;
             }
             for s in 0..2 {
-                let d = &mut draws[2 * i + s];
-                if pt.plan.slots[s] != Slot::Bsdf || !d.ok {
-                    continue;
-                }
-                let dir = pt.frame.to_world(d.dir).normalize();
-                stats.rays += 1;
-                if scene.occluded(&spawn_ray(pt.p, pt.ng, dir)) {
-                    // No light: as a failed draw.
-                    d.ok = false;
-                    continue;
-                }
-                lanes.bsdf_dirs.push(dir);
-                lanes.draw_index.push(2 * i + s);
+                let di = 2 * i + s;
+                let d = &mut draws[di];
+                let dir = match pt.plan.slots[s] {
+                    Slot::Bsdf if d.ok => {
+                        // The world direction, kept for the lookup.
+                        d.dir = pt.frame.to_world(d.dir).normalize();
+                        d.dir
+                    }
+                    Slot::Light { .. } if d.ok && d.f != Rgb::ZERO => d.dir,
+                    _ => continue,
+                };
+                lanes.shadow_p.push(pt.p);
+                lanes.shadow_ng.push(pt.ng);
+                lanes.shadow_dir.push(dir);
+                lanes.shadow_draw.push(di);
+            }
+        }
+        stats.rays += lanes.shadow_draw.len() as u64;
+        spawn_many(
+            self.level,
+            &lanes.shadow_p,
+            &lanes.shadow_ng,
+            &lanes.shadow_dir,
+            &mut lanes.rays,
+        );
+        scene.occluded_many(self.level, &lanes.rays, &mut lanes.blocked);
+        // The map at the BSDF directions that escape, for the whole block
+        // (`EnvMap::lookup_many`); a blocked draw has no light.
+        lanes.bsdf_dirs.clear();
+        lanes.draw_index.clear();
+        for (&di, &blocked) in lanes.shadow_draw.iter().zip(&lanes.blocked) {
+            let d = &mut draws[di];
+            if blocked {
+                d.ok = false;
+            } else if pts[di / 2].plan.slots[di % 2] == Slot::Bsdf {
+                lanes.bsdf_dirs.push(d.dir);
+                lanes.draw_index.push(di);
             }
         }
         let n = lanes.bsdf_dirs.len();
@@ -632,10 +685,7 @@ impl Batch<'_> {
                         if d.f == Rgb::ZERO {
                             continue;
                         }
-                        stats.rays += 1;
-                        if scene.occluded(&spawn_ray(pt.p, pt.ng, d.dir)) {
-                            continue;
-                        }
+                        // (Unoccluded: a blocked draw is not `ok`.)
                         let v = d.f * l.radiance * d.wi.z;
                         if let Some(p) = pilot.as_deref_mut() {
                             let q = d.pdf + l.pdf_compensated;
@@ -784,6 +834,17 @@ impl Batch<'_> {
             }
         }
     }
+}
+
+/// Pair `p` of [`PixelSeeds::all`] for sample `index`, drawn alone
+/// (independent or stratified numbers).
+fn seeded_pair(ctx: &Context<'_>, seeds: &PixelSeeds, index: u64, p: usize) -> DVec2 {
+    DVec2::from_array(pair_point_seeded(
+        ctx.sequence,
+        seeds.all()[p],
+        ctx.spp,
+        index,
+    ))
 }
 
 /// The pair seeds of pixel `(x, y)` in `ctx`'s pass.
