@@ -3,7 +3,7 @@
 //!
 //! Each step is a plain loop over `f64` arrays with selects instead of
 //! branches, run inside a `#[target_feature]` function of the SIMD level
-//! (AVX2: 4 lanes, AVX-512: 8), where the compiler vectorizes it. A lane
+//! ([`SimdLevel::run`]; AVX2: 4 lanes, AVX-512: 8), where the compiler vectorizes it. A lane
 //! computes exactly what the scalar functions ([`Camera::ray`],
 //! [`Sphere::intersect`], [`Plane::intersect`], [`spawn_ray`],
 //! [`Scene::intersect`], [`Scene::occluded`]) compute, in the same order of
@@ -17,7 +17,7 @@ use crate::geometry::spawn_ray;
 use crate::geometry::{Plane, RAY_EPSILON, Ray, Sphere};
 use crate::scene::{Scene, Shape};
 use glam::DVec3;
-use lobe::batch::SimdLevel;
+use lobe::batch::{SimdLevel, Step};
 
 /// No object: [`HitLanes::obj`] of a ray that hits nothing.
 pub const NO_HIT: u32 = u32::MAX;
@@ -139,42 +139,6 @@ impl HitLanes {
     }
 }
 
-/// A step over a block of lanes, run by [`at_level`] compiled for a SIMD
-/// level: `run` is inlined into the `#[target_feature]` function of the
-/// level, where the compiler vectorizes its loops (a closure would be
-/// compiled on its own, for the portable target).
-trait Step {
-    fn run(self);
-}
-
-/// Runs `step` compiled for `level` (when the CPU has it; else portable).
-#[inline(always)]
-fn at_level(level: SimdLevel, step: impl Step) {
-    #[cfg(target_arch = "x86_64")]
-    {
-        match level {
-            // SAFETY: the level is available, so the CPU has its features.
-            SimdLevel::Avx512 if level.is_available() => return unsafe { run_avx512(step) },
-            SimdLevel::Avx2 if level.is_available() => return unsafe { run_avx2(step) },
-            _ => {}
-        }
-    }
-    let _ = level;
-    step.run();
-}
-
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2,fma")]
-fn run_avx2(step: impl Step) {
-    step.run();
-}
-
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx512f,avx512dq,avx512bw,avx512vl,avx2,fma")]
-fn run_avx512(step: impl Step) {
-    step.run();
-}
-
 /// `a · b` as glam's `DVec3::dot` computes it.
 #[inline(always)]
 fn dot(ax: f64, ay: f64, az: f64, bx: f64, by: f64, bz: f64) -> f64 {
@@ -190,7 +154,7 @@ impl Camera {
     pub fn rays_many(&self, level: SimdLevel, xs: &[f64], ys: &[f64], out: &mut RayLanes) {
         assert_eq!(xs.len(), ys.len(), "rays_many: lengths differ");
         out.resize(xs.len());
-        at_level(level, CameraRays(self, xs, ys, out));
+        level.run(CameraRays(self, xs, ys, out));
     }
 }
 
@@ -335,8 +299,8 @@ impl Scene {
         out.obj[..n].fill(NO_HIT);
         for (k, o) in self.objects.iter().enumerate() {
             match &o.shape {
-                Shape::Sphere(s) => at_level(level, SphereHits(s, k as u32, rays, out)),
-                Shape::Plane(p) => at_level(level, PlaneHits(p, k as u32, rays, out)),
+                Shape::Sphere(s) => level.run(SphereHits(s, k as u32, rays, out)),
+                Shape::Plane(p) => level.run(PlaneHits(p, k as u32, rays, out)),
                 Shape::Mesh(m) => {
                     for i in 0..n {
                         if let Some(h) = m.intersect(&rays.get(i), out.t[i]) {
@@ -360,8 +324,8 @@ impl Scene {
         out.resize(n, false);
         for o in &self.objects {
             match &o.shape {
-                Shape::Sphere(s) => at_level(level, SphereBlocks(s, rays, out)),
-                Shape::Plane(p) => at_level(level, PlaneBlocks(p, rays, out)),
+                Shape::Sphere(s) => level.run(SphereBlocks(s, rays, out)),
+                Shape::Plane(p) => level.run(PlaneBlocks(p, rays, out)),
                 Shape::Mesh(m) => {
                     for (i, b) in out.iter_mut().enumerate() {
                         if !*b {
@@ -517,7 +481,7 @@ pub fn spawn_many(
         "spawn_many: lengths differ"
     );
     out.resize(n);
-    at_level(level, Spawn(p, ng, dir, out));
+    level.run(Spawn(p, ng, dir, out));
 }
 
 /// [`spawn_many`]'s loop.

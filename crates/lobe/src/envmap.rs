@@ -20,6 +20,7 @@
 //! row, then a uniform direction inside the texel. The density in solid angle
 //! is `lum(texel) / Σ lum·Ω`: proportional to the map's luminance.
 
+use crate::batch::{SimdLevel, Step};
 use crate::math::{Rgb, luminance};
 use glam::{DVec2, DVec3};
 use std::f64::consts::PI;
@@ -168,6 +169,78 @@ fn acos_guess(y: f64) -> f64 {
 /// Draws or directions per step of [`EnvMap::sample_lookup_many`] and
 /// [`EnvMap::lookup_many`].
 const LOOKUP_CHUNK: usize = 64;
+
+/// The texels `j · width + i` of up to [`LOOKUP_CHUNK`] directions, as
+/// [`EnvMap::texel_index`] finds them: the guesses of the whole chunk first,
+/// in a loop without branches that the compiler vectorizes, then each
+/// one's corrections.
+struct TexelIndices<'a> {
+    map: &'a EnvMap,
+    dirs: &'a [DVec3],
+    out: &'a mut [usize; LOOKUP_CHUNK],
+}
+
+impl Step for TexelIndices<'_> {
+    #[inline(always)]
+    fn run(self) {
+        let TexelIndices { map, dirs, out } = self;
+        let (w, h) = (map.width, map.height);
+        let n = dirs.len().min(LOOKUP_CHUNK);
+        let (mut sx, mut cx, mut y) = (
+            [0.0; LOOKUP_CHUNK],
+            [0.0; LOOKUP_CHUNK],
+            [0.0; LOOKUP_CHUNK],
+        );
+        for (k, d) in dirs[..n].iter().enumerate() {
+            let d = map.unrotate(*d);
+            (sx[k], cx[k], y[k]) = (d.x, -d.z, d.y.clamp(-1.0, 1.0));
+        }
+        let (mut gi, mut gj) = ([0u32; LOOKUP_CHUNK], [0u32; LOOKUP_CHUNK]);
+        let (wf, hf) = (w as f64, h as f64 / PI);
+        let (wm, hm) = ((w - 1) as u32, (h - 1) as u32);
+        for k in 0..LOOKUP_CHUNK {
+            let (ax, ay) = (cx[k].abs(), sx[k].abs());
+            let steep = ay > ax;
+            let (lo, hi) = if steep { (ax, ay) } else { (ay, ax) };
+            let a = atan_01(lo / hi);
+            let a = if steep { 0.5 * PI - a } else { a };
+            let a = if cx[k] < 0.0 { PI - a } else { a };
+            let u = a / (2.0 * PI);
+            let u = if sx[k] < 0.0 { 1.0 - u } else { u };
+            let u = if u >= 1.0 { 0.0 } else { u };
+            // (NaN, at a pole, converts to 0; the pole is column 0 below.)
+            gi[k] = if hi > 0.0 {
+                ((u * wf) as u32).min(wm)
+            } else {
+                0
+            };
+            gj[k] = ((acos_guess(y[k]) * hf) as u32).min(hm);
+        }
+        for k in 0..n {
+            let (sx, cx, y) = (sx[k], cx[k], y[k]);
+            let mut i = gi[k] as usize;
+            if w > 1 && (sx != 0.0 || cx != 0.0) {
+                let past = |k: usize| sx * map.col_cs[k].1 - cx * map.col_cs[k].0 >= 0.0;
+                while i > 0 && !past(i) {
+                    i -= 1;
+                }
+                while i + 1 < w && past(i + 1) {
+                    i += 1;
+                }
+            } else {
+                i = 0;
+            }
+            let mut j = gj[k] as usize;
+            while j > 0 && y > map.row_cos[j] {
+                j -= 1;
+            }
+            while j + 1 < h && y <= map.row_cos[j + 1] {
+                j += 1;
+            }
+            out[k] = j * w + i;
+        }
+    }
+}
 
 /// An equirectangular environment map with its sampling distribution.
 #[derive(Debug, Clone, PartialEq)]
@@ -645,13 +718,20 @@ impl EnvMap {
     /// # Panics
     /// If the slices differ in length.
     pub fn lookup_many(&self, dirs: &[DVec3], out: &mut [EnvLookup]) {
+        self.lookup_many_at(SimdLevel::best(), dirs, out);
+    }
+
+    /// [`EnvMap::lookup_many`] with the texel guesses compiled for `level`
+    /// (the same bits at every level).
+    fn lookup_many_at(&self, level: SimdLevel, dirs: &[DVec3], out: &mut [EnvLookup]) {
         assert_eq!(dirs.len(), out.len(), "lookup_many: lengths differ");
         for (dc, oc) in dirs.chunks(LOOKUP_CHUNK).zip(out.chunks_mut(LOOKUP_CHUNK)) {
             let mut idx = [0usize; LOOKUP_CHUNK];
-            for (k, &d) in idx.iter_mut().zip(dc) {
-                let (i, j) = self.texel_index(d);
-                *k = j * self.width + i;
-            }
+            level.run(TexelIndices {
+                map: self,
+                dirs: dc,
+                out: &mut idx,
+            });
             for (o, &k) in oc.iter_mut().zip(&idx) {
                 *o = self.texel_lookup(k);
             }
@@ -929,11 +1009,33 @@ mod tests {
         for (k, &(c, uk)) in draws.iter().enumerate() {
             assert_eq!(got[k], m.sample_lookup(c, uk), "draw {k}");
         }
-        let dirs: Vec<DVec3> = (0..n).map(|k| m.uv_to_direction(u(k + n))).collect();
-        let mut looked = vec![m.lookup(DVec3::Y); n];
-        m.lookup_many(&dirs, &mut looked);
-        for (k, &d) in dirs.iter().enumerate() {
-            assert_eq!(looked[k], m.lookup(d), "direction {k}");
+        // Lookups at every SIMD level, on maps of one texel, one column,
+        // a few and many; the poles, the axes and the seam included.
+        let mut dirs: Vec<DVec3> = (0..2000).map(|k| m.uv_to_direction(u(k + n))).collect();
+        for d in [DVec3::X, DVec3::Y, DVec3::Z] {
+            dirs.extend([d, -d]);
+        }
+        dirs.extend((0..100).map(|k| DVec3::new(-1e-9 * k as f64, 0.3, 1.0).normalize()));
+        let one = EnvMap::new(1, 2, vec![Rgb::ONE, Rgb::splat(2.0)], 1.0, 0.0)
+            .unwrap()
+            .0;
+        let few = EnvMap::new(
+            3,
+            2,
+            (0..6).map(|k| Rgb::splat(k as f64)).collect(),
+            1.0,
+            -10.0,
+        )
+        .unwrap()
+        .0;
+        for map in [&m, &one, &few, &EnvMap::constant(Rgb::ONE)] {
+            for level in SimdLevel::ALL.into_iter().filter(|l| l.is_available()) {
+                let mut looked = vec![EnvLookup::default(); dirs.len()];
+                map.lookup_many_at(level, &dirs, &mut looked);
+                for (k, &d) in dirs.iter().enumerate() {
+                    assert_eq!(looked[k], map.lookup(d), "{level:?} direction {k} {d}");
+                }
+            }
         }
     }
 

@@ -262,6 +262,14 @@ pub enum SimdLevel {
     Avx512,
 }
 
+/// A step over arrays (plain loops that the compiler can vectorize), run by
+/// [`SimdLevel::run`]: `run` is inlined into a `#[target_feature]` function
+/// of the level and compiled for it. (A closure would be compiled on its
+/// own, for the portable target.) Mark `run` `#[inline(always)]`.
+pub trait Step {
+    fn run(self);
+}
+
 impl SimdLevel {
     pub const ALL: [SimdLevel; 3] = [SimdLevel::Scalar, SimdLevel::Avx2, SimdLevel::Avx512];
 
@@ -283,6 +291,31 @@ impl SimdLevel {
             SimdLevel::Avx2 => 8,
             SimdLevel::Avx512 => 16,
         }
+    }
+
+    /// Runs `step` compiled for this level where the CPU has it, else
+    /// compiled for the portable target. Plain IEEE arithmetic gives the
+    /// same bits at every level (Rust does not fuse multiply-adds).
+    #[inline(always)]
+    pub fn run(self, step: impl Step) {
+        #[cfg(target_arch = "x86_64")]
+        {
+            #[target_feature(enable = "avx2,fma")]
+            fn avx2(step: impl Step) {
+                step.run();
+            }
+            #[target_feature(enable = "avx512f,avx512dq,avx512bw,avx512vl,avx2,fma")]
+            fn avx512(step: impl Step) {
+                step.run();
+            }
+            match self {
+                // SAFETY: the level is available, so the CPU has its features.
+                SimdLevel::Avx512 if self.is_available() => return unsafe { avx512(step) },
+                SimdLevel::Avx2 if self.is_available() => return unsafe { avx2(step) },
+                _ => {}
+            }
+        }
+        step.run();
     }
 
     /// Whether this CPU runs the level.
