@@ -454,21 +454,12 @@ pub fn pair_point_seeded(seq: Sequence, s: u64, n: u64, index: u64) -> [f64; 2] 
     }
 }
 
-/// The columns of the reversed-order Sobol matrices of dimensions 0 and 1:
-/// `sobol_reversed(r, d)` is the xor of `SOBOL_REV_COLS[d][b]` over the set
-/// bits `b` of `r` (the tables are linear: entry 0 of each is 0).
-fn sobol_rev_cols() -> [[u32; 32]; 2] {
-    std::array::from_fn(|d| std::array::from_fn(|b| SOBOL_REV[d][b / 8][1 << (b % 8)]))
-}
-
-/// Lanes per chunk of [`sobol_pairs`].
-const SOBOL_CHUNK: usize = 64;
-
 /// Sobol pairs of many samples at once: `(x[k], y[k])` is
 /// `pair_point_seeded(Sequence::Sobol, seeds[k], _, index[k])`, bit for
 /// bit, computed in SIMD lanes at `level` (AVX-512 / AVX2 where the CPU
-/// has it, else portable code): the matrix product as a loop over the 32
-/// index bits across the lanes instead of table lookups per sample.
+/// has it, else portable code): no table lookups, dimension 0's matrix
+/// product is a bit reversal and dimension 1's five shift-and-xor steps
+/// ([`pascal_reversed`]).
 ///
 /// # Panics
 /// If the four slices differ in length.
@@ -513,46 +504,56 @@ fn sobol_pairs_avx512(seeds: &[u64], index: &[u32], x: &mut [f64], y: &mut [f64]
     sobol_pairs_lanes(seeds, index, x, y);
 }
 
+/// `sobol_reversed(r, 1)` of `q = r.reverse_bits()`, without tables: dimension 1's generator matrix
+/// is Pascal's triangle mod 2, so bit `l` of the reversed point is the xor
+/// of the bits `k ⊇ l` (Lucas) of `r.reverse_bits()`: a subset-sum
+/// transform over the five bit levels of the position, five shift-and-xor
+/// steps on all 32 bits at once. (Dimension 0 is `r.reverse_bits()`.)
+#[inline(always)]
+fn pascal_reversed(q: u32) -> u32 {
+    let mut w = q;
+    w ^= (w >> 1) & 0x5555_5555;
+    w ^= (w >> 2) & 0x3333_3333;
+    w ^= (w >> 4) & 0x0f0f_0f0f;
+    w ^= (w >> 8) & 0x00ff_00ff;
+    w ^= (w >> 16) & 0x0000_ffff;
+    w
+}
+
 /// [`sobol_pairs`] in chunks of [`SOBOL_CHUNK`] lanes, each step a plain
 /// loop over the chunk (which the compiler vectorizes).
 #[inline(always)]
 fn sobol_pairs_lanes(seeds: &[u64], index: &[u32], x: &mut [f64], y: &mut [f64]) {
-    let cols = sobol_rev_cols();
     let k = 1.0 / 4_294_967_296.0;
-    let mut start = 0;
-    while start < index.len() {
-        let n = (index.len() - start).min(SOBOL_CHUNK);
-        let (s, i) = (&seeds[start..start + n], &index[start..start + n]);
-        let mut ir = [0u32; SOBOL_CHUNK];
-        let mut a = [0u32; SOBOL_CHUNK];
-        let mut c = [0u32; SOBOL_CHUNK];
-        for l in 0..n {
-            ir[l] = laine_karras(i[l].reverse_bits(), s[l] as u32);
-        }
-        #[allow(clippy::needless_range_loop)] // b is also the shift
-        for b in 0..32 {
-            let (c0, c1) = (cols[0][b], cols[1][b]);
-            for l in 0..SOBOL_CHUNK {
-                // All ones where bit b of ir is set.
-                let m = ((ir[l] << (31 - b)) as i32 >> 31) as u32;
-                a[l] ^= m & c0;
-                c[l] ^= m & c1;
-            }
-        }
-        let (xo, yo) = (&mut x[start..start + n], &mut y[start..start + n]);
-        for l in 0..n {
-            let xv = laine_karras(a[l], (s[l] >> 32) as u32).reverse_bits();
-            let yv = laine_karras(c[l], hash64(s[l]) as u32).reverse_bits();
-            xo[l] = f64::from(xv) * k;
-            yo[l] = f64::from(yv) * k;
-        }
-        start += n;
+    for (((&s, &i), xo), yo) in seeds.iter().zip(index).zip(x).zip(y) {
+        let q = laine_karras(i.reverse_bits(), s as u32).reverse_bits();
+        let xv = laine_karras(q, (s >> 32) as u32).reverse_bits();
+        let yv = laine_karras(pascal_reversed(q), hash64(s) as u32).reverse_bits();
+        *xo = f64::from(xv) * k;
+        *yo = f64::from(yv) * k;
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn pascal_reversed_is_dimension_one() {
+        let mut r = 0x1234_5678u32;
+        for k in 0..4000u32 {
+            r = laine_karras(r, k);
+            // Single bits, runs of ones, and hashed words.
+            for v in [r, 1u32 << (k % 32), u32::MAX >> (k % 32)] {
+                assert_eq!(
+                    pascal_reversed(v.reverse_bits()),
+                    sobol_reversed(v, 1),
+                    "{v:#x}"
+                );
+                assert_eq!(v.reverse_bits(), sobol_reversed(v, 0), "{v:#x}");
+            }
+        }
+    }
 
     #[test]
     fn sobol_pairs_match_pair_point_seeded_at_every_level() {
