@@ -146,13 +146,14 @@ impl<'a> Batch<'a> {
     }
 }
 
-/// Per sample of a block.
+/// Per sample of a block that hits a surface facing the camera.
 #[derive(Debug, Clone, Copy)]
 struct Point {
+    /// The sample's index in the block.
+    m: u32,
     /// The pixel's column.
     x: u32,
-    /// The object hit (`u32::MAX`: none, or no light reflected: `value` is
-    /// the sample's value).
+    /// The object hit.
     obj: u32,
     p: DVec3,
     ng: DVec3,
@@ -162,23 +163,6 @@ struct Point {
     /// The numbers of the two draws, `[uc, u₁, u₂]`.
     u: [[f64; 3]; 2],
     value: Rgb,
-}
-
-impl Point {
-    /// A sample of pixel column `x` that has not hit anything (yet).
-    fn new(x: u32, plan: PixelPlan) -> Self {
-        Point {
-            x,
-            obj: u32::MAX,
-            p: DVec3::ZERO,
-            ng: DVec3::Z,
-            frame: Frame::from_normal(DVec3::Z),
-            wo: DVec3::Z,
-            plan,
-            u: [[0.0; 3]; 2],
-            value: Rgb::ZERO,
-        }
-    }
 }
 
 /// Per draw (two per sample) of a block.
@@ -228,6 +212,11 @@ struct Lanes {
     /// Independent or stratified numbers: each sample's pair seeds and
     /// index.
     each: Vec<(PixelSeeds, u64)>,
+    /// Each sample's pixel column, plan, and value (the map's radiance
+    /// where its camera ray escapes, else its estimate).
+    px: Vec<f64>,
+    plans: Vec<PixelPlan>,
+    value: Vec<Rgb>,
     /// The block's camera rays and their hits; then its shadow rays.
     rays: RayLanes,
     hits: HitLanes,
@@ -265,6 +254,9 @@ impl Lanes {
             bsdf_env: Vec::with_capacity(2 * BLOCK),
             film: (Vec::with_capacity(BLOCK), Vec::with_capacity(BLOCK)),
             each: Vec::with_capacity(BLOCK),
+            px: Vec::with_capacity(BLOCK),
+            plans: Vec::with_capacity(BLOCK),
+            value: Vec::with_capacity(BLOCK),
             rays: RayLanes::default(),
             hits: HitLanes::default(),
             shadow_p: Vec3Lanes::default(),
@@ -317,63 +309,64 @@ impl Batch<'_> {
             let end = (k + BLOCK as u64).min(total);
             pts.clear();
             let sobol = ctx.sequence == Sequence::Sobol;
+            // The block's samples, pixel by pixel: each one's column, plan
+            // and index in its pixel's sequence, and (Sobol) its pairs'
+            // seeds; independent or stratified numbers: its seeds.
+            for v in &mut lanes.pair_seeds {
+                v.clear();
+            }
+            lanes.pair_index.clear();
+            lanes.px.clear();
+            lanes.plans.clear();
+            lanes.each.clear();
+            let mut f = k;
+            while f < end {
+                let (x, i0) = ((f / spp) as usize, f % spp);
+                let run = (spp - i0).min(end - f) as usize;
+                let seeds = pixel_seeds(ctx, x, y);
+                let plan = self.plan(mode(x));
+                lanes.px.extend(std::iter::repeat_n(x as f64, run));
+                lanes.plans.extend(std::iter::repeat_n(plan, run));
+                for i in i0..i0 + run as u64 {
+                    let index = match ctx.sequence {
+                        Sequence::Stratified => i,
+                        Sequence::Sobol | Sequence::Independent => ctx.pass * spp + i,
+                    };
+                    if sobol {
+                        debug_assert!(index <= u64::from(u32::MAX));
+                        lanes.pair_index.push(index as u32);
+                    } else {
+                        lanes.each.push((seeds, index));
+                    }
+                }
+                if sobol {
+                    for (v, s) in lanes.pair_seeds.iter_mut().zip(seeds.all()) {
+                        v.extend(std::iter::repeat_n(s, run));
+                    }
+                }
+                f += run as u64;
+            }
+            // The camera pairs of every sample; the other pairs (below)
+            // only for the samples that hit.
+            let n = lanes.px.len();
+            let (jx, jy) = (&mut lanes.pair_x[0][..n], &mut lanes.pair_y[0][..n]);
             if sobol {
-                // The block's Sobol pairs in SIMD lanes, first.
-                for v in &mut lanes.pair_seeds {
-                    v.clear();
+                sobol_pairs(self.level, &lanes.pair_seeds[0], &lanes.pair_index, jx, jy);
+            } else {
+                for ((&(seeds, index), x), y) in lanes.each.iter().zip(jx).zip(jy) {
+                    [*x, *y] = seeded_pair(ctx, &seeds, index, 0).to_array();
                 }
-                lanes.pair_index.clear();
-                let mut cur: Option<(usize, [u64; PAIRS])> = None;
-                for f in k..end {
-                    let (x, i) = ((f / spp) as usize, f % spp);
-                    if cur.is_none_or(|c| c.0 != x) {
-                        cur = Some((x, pixel_seeds(ctx, x, y).all()));
-                    }
-                    let seeds = cur.expect("set above").1;
-                    for (v, s) in lanes.pair_seeds.iter_mut().zip(seeds) {
-                        v.push(s);
-                    }
-                    let index = ctx.pass * spp + i;
-                    debug_assert!(index <= u64::from(u32::MAX));
-                    lanes.pair_index.push(index as u32);
-                }
-                // The camera pair of every sample; the others (below) only
-                // for the samples that hit.
-                let n = lanes.pair_index.len();
-                sobol_pairs(
-                    self.level,
-                    &lanes.pair_seeds[0],
-                    &lanes.pair_index,
-                    &mut lanes.pair_x[0][..n],
-                    &mut lanes.pair_y[0][..n],
-                );
             }
             // The block's camera rays, traced together.
             lanes.film.0.clear();
             lanes.film.1.clear();
-            lanes.each.clear();
-            let mut cur: Option<(usize, PixelSeeds, PixelPlan)> = None;
-            for f in k..end {
-                let (x, i) = ((f / spp) as usize, f % spp);
-                if cur.is_none_or(|c| c.0 != x) {
-                    cur = Some((x, pixel_seeds(ctx, x, y), self.plan(mode(x))));
-                }
-                let (_, seeds, plan) = cur.expect("set above");
-                let index = match ctx.sequence {
-                    Sequence::Stratified => i,
-                    Sequence::Sobol | Sequence::Independent => ctx.pass * spp + i,
-                };
-                let j = if sobol {
-                    let m = (f - k) as usize;
-                    DVec2::new(lanes.pair_x[0][m], lanes.pair_y[0][m])
-                } else {
-                    lanes.each.push((seeds, index));
-                    seeded_pair(ctx, &seeds, index, 0)
-                };
-                lanes.film.0.push(x as f64 + j.x);
-                lanes.film.1.push(y as f64 + j.y);
-                pts.push(Point::new(x as u32, plan));
-            }
+            let yf = y as f64;
+            let (jx, jy) = (&lanes.pair_x[0][..n], &lanes.pair_y[0][..n]);
+            lanes
+                .film
+                .0
+                .extend(lanes.px.iter().zip(jx).map(|(&x, &j)| x + j));
+            lanes.film.1.extend(jy.iter().map(|&j| yf + j));
             self.camera_points(ctx, &mut pts, &mut lanes, &mut stats);
             if sobol {
                 // The shading pairs of the samples that hit, compacted.
@@ -381,12 +374,8 @@ impl Batch<'_> {
                     v.clear();
                 }
                 lanes.hit_index.clear();
-                lanes.draw_index.clear();
-                for (m, pt) in pts.iter().enumerate() {
-                    if pt.obj == u32::MAX {
-                        continue;
-                    }
-                    lanes.draw_index.push(m);
+                for pt in &pts {
+                    let m = pt.m as usize;
                     lanes.hit_index.push(lanes.pair_index[m]);
                     for p in 1..PAIRS {
                         lanes.hit_seeds[p].push(lanes.pair_seeds[p][m]);
@@ -402,9 +391,9 @@ impl Batch<'_> {
                         &mut lanes.pair_y[p][..n],
                     );
                 }
-                for (h, &m) in lanes.draw_index.iter().enumerate() {
+                for (h, pt) in pts.iter_mut().enumerate() {
                     let (px, py) = (&lanes.pair_x, &lanes.pair_y);
-                    self.assign_u(&mut pts[m], |p| DVec2::new(px[p][h], py[p][h]));
+                    self.assign_u(pt, |p| DVec2::new(px[p][h], py[p][h]));
                 }
             }
             self.shade(
@@ -416,8 +405,11 @@ impl Batch<'_> {
                 pilots.as_deref_mut(),
             );
             for pt in &pts {
-                if pt.value.is_finite() {
-                    row[pt.x as usize] += pt.value;
+                lanes.value[pt.m as usize] = pt.value;
+            }
+            for (&x, v) in lanes.px.iter().zip(&lanes.value) {
+                if v.is_finite() {
+                    row[x as usize] += *v;
                 } else {
                     stats.nonfinite += 1;
                 }
@@ -429,17 +421,19 @@ impl Batch<'_> {
     }
 
     /// The camera rays of a block (film positions `lanes.film`), their
-    /// hits and shading frames: `pts[m]` gets sample `m`'s, its value the
-    /// map's radiance when the ray escapes; with independent or stratified
-    /// numbers (`lanes.each`) also its draws' numbers.
+    /// hits and shading frames: a [`Point`] in `pts` per sample that hits
+    /// and faces the camera, in sample order; `lanes.value` the map's
+    /// radiance for a sample whose ray escapes, else zero. With
+    /// independent or stratified numbers (`lanes.each`) the points also get
+    /// their draws' numbers.
     fn camera_points(
         &self,
         ctx: &Context<'_>,
-        pts: &mut [Point],
+        pts: &mut Vec<Point>,
         lanes: &mut Lanes,
         stats: &mut RenderStats,
     ) {
-        let n = pts.len();
+        let n = lanes.film.0.len();
         ctx.scene
             .camera
             .rays_many(self.level, &lanes.film.0, &lanes.film.1, &mut lanes.rays);
@@ -449,8 +443,10 @@ impl Batch<'_> {
             .intersect_many(self.level, &lanes.rays, &mut lanes.hits);
         lanes.bsdf_dirs.clear();
         lanes.draw_index.clear();
+        lanes.value.clear();
+        lanes.value.resize(n, Rgb::ZERO);
         let h = &lanes.hits;
-        for (m, pt) in pts.iter_mut().enumerate() {
+        for m in 0..n {
             let dir = lanes.rays.dir.get(m);
             if h.obj[m] == NO_HIT {
                 lanes.bsdf_dirs.push(dir);
@@ -470,14 +466,22 @@ impl Batch<'_> {
             if wo.z <= 0.0 {
                 continue;
             }
+            let mut pt = Point {
+                m: m as u32,
+                x: lanes.px[m] as u32,
+                obj: h.obj[m],
+                p: h.p.get(m),
+                ng,
+                frame,
+                wo,
+                plan: lanes.plans[m],
+                u: [[0.0; 3]; 2],
+                value: Rgb::ZERO,
+            };
             if let Some(&(seeds, index)) = lanes.each.get(m) {
-                self.assign_u(pt, |p| seeded_pair(ctx, &seeds, index, p));
+                self.assign_u(&mut pt, |p| seeded_pair(ctx, &seeds, index, p));
             }
-            pt.obj = h.obj[m];
-            pt.p = h.p.get(m);
-            pt.ng = ng;
-            pt.frame = frame;
-            pt.wo = wo;
+            pts.push(pt);
         }
         // The map where the rays escape.
         let e = lanes.bsdf_dirs.len();
@@ -485,7 +489,7 @@ impl Batch<'_> {
         self.env
             .lookup_many(&lanes.bsdf_dirs, &mut lanes.bsdf_env[..e]);
         for (&m, l) in lanes.draw_index.iter().zip(&lanes.bsdf_env[..e]) {
-            pts[m].value = l.radiance;
+            lanes.value[m] = l.radiance;
         }
     }
 
@@ -538,9 +542,6 @@ impl Batch<'_> {
         lanes.draw_index.clear();
         let key = |obj: u32, di: usize| (u64::from(obj) << 32) | di as u64;
         for (i, pt) in pts.iter().enumerate() {
-            if pt.obj == u32::MAX {
-                continue;
-            }
             for s in 0..2 {
                 draws[2 * i + s] = Draw::default();
                 match pt.plan.slots[s] {
@@ -594,9 +595,6 @@ impl Batch<'_> {
         lanes.shadow_dir.clear();
         lanes.shadow_draw.clear();
         for (i, pt) in pts.iter().enumerate() {
-            if pt.obj == u32::MAX {
-                continue;
-            }
             for s in 0..2 {
                 let di = 2 * i + s;
                 let d = &mut draws[di];
@@ -646,9 +644,6 @@ impl Batch<'_> {
         }
         // Shadow rays and the estimates, in sample order.
         for (i, pt) in pts.iter_mut().enumerate() {
-            if pt.obj == u32::MAX {
-                continue;
-            }
             let mut sum = Rgb::ZERO;
             let mut n = 0.0;
             let mut pilot = pilots.as_deref_mut().map(|p| &mut p[pt.x as usize]);
