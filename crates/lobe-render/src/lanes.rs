@@ -189,88 +189,89 @@ impl Step for CameraRays<'_> {
     }
 }
 
-/// Lanes of a chunk of [`sphere_chunks`].
+/// Lanes of a chunk of [`sphere_chunk`].
 const CHUNK: usize = 8;
 
-/// A sphere's hits of every ray, [`CHUNK`] rays at a time:
-/// `each(start, m, t, n)` with the chunk's first ray, its ray count, and
-/// per lane `t` (infinite when none) and the unit normal (unspecified
-/// when none), as [`Sphere::intersect`] with `t_max = ∞` finds them. The
-/// steps that only a hit needs (the root, then the normal) are skipped for
-/// a chunk where no lane gets that far, as the scalar test returns early.
+/// A sphere's hits of the rays `start..start + m` (`m ≤ CHUNK`, its rays
+/// count): per lane `t` (infinite when none) and the unit normal
+/// (unspecified when none), as [`Sphere::intersect`] with `t_max = ∞`
+/// finds them. The steps that only a hit needs (the root, then the
+/// normal) are skipped for a chunk where no lane gets that far, as the
+/// scalar test returns early. Inlined into each caller's loop over the
+/// chunks, so that it is compiled for the caller's SIMD level.
 #[inline(always)]
-fn sphere_chunks(
+fn sphere_chunk(
     s: &Sphere,
     rays: &RayLanes,
-    mut each: impl FnMut(usize, usize, &[f64; CHUNK], &[[f64; CHUNK]; 3]),
-) {
+    start: usize,
+    m: usize,
+) -> ([f64; CHUNK], [[f64; CHUNK]; 3]) {
     let (c, r) = (s.center, s.radius);
     let r2 = r * r;
-    let n = rays.len();
     let (og, dg) = (&rays.origin, &rays.dir);
-    let mut start = 0;
-    while start < n {
-        let m = (n - start).min(CHUNK);
-        // The chunk's rays; a short chunk's other lanes are zeros.
-        let mut o = [[0.0; CHUNK]; 3];
-        let mut d = [[0.0; CHUNK]; 3];
-        for (src, dst) in [&og.x, &og.y, &og.z, &dg.x, &dg.y, &dg.z]
-            .into_iter()
-            .zip(o.iter_mut().chain(d.iter_mut()))
-        {
+    // The chunk's rays; a short chunk's other lanes are zeros.
+    let mut o = [[0.0; CHUNK]; 3];
+    let mut d = [[0.0; CHUNK]; 3];
+    for (src, dst) in [&og.x, &og.y, &og.z, &dg.x, &dg.y, &dg.z]
+        .into_iter()
+        .zip(o.iter_mut().chain(d.iter_mut()))
+    {
+        if m == CHUNK {
+            // A fixed-size copy (vector moves, not a call to memcpy).
+            dst.copy_from_slice(&src[start..start + CHUNK]);
+        } else {
             dst[..m].copy_from_slice(&src[start..start + m]);
         }
-        let mut t = [f64::INFINITY; CHUNK];
-        let mut nrm = [[0.0; CHUNK]; 3];
-        let (mut b, mut disc, mut cc) = ([0.0; CHUNK], [0.0; CHUNK], [0.0; CHUNK]);
-        let mut any = false;
-        for l in 0..CHUNK {
-            let (ocx, ocy, ocz) = (o[0][l] - c.x, o[1][l] - c.y, o[2][l] - c.z);
-            b[l] = dot(ocx, ocy, ocz, d[0][l], d[1][l], d[2][l]);
-            let (px, py, pz) = (
-                ocx - d[0][l] * b[l],
-                ocy - d[1][l] * b[l],
-                ocz - d[2][l] * b[l],
-            );
-            disc[l] = r2 - dot(px, py, pz, px, py, pz);
-            cc[l] = dot(ocx, ocy, ocz, ocx, ocy, ocz) - r2;
-            any |= (l < m) & (disc[l] >= 0.0);
-        }
-        if any {
-            // Roots of t² + 2bt + c: q = −(b + sign(b) √disc), t = q and c / q.
-            any = false;
-            for l in 0..CHUNK {
-                let q = -(b[l] + disc[l].sqrt().copysign(b[l]));
-                let nz = q != 0.0;
-                let t0 = if nz { cc[l] / q } else { 0.0 };
-                let t1 = if nz { q } else { 0.0 };
-                let (lo, hi) = if t0 > t1 { (t1, t0) } else { (t0, t1) };
-                let tl = if lo > 0.0 { lo } else { hi };
-                // `disc < 0` gave NaN above.
-                let ok = disc[l] >= 0.0 && tl > 0.0 && tl.is_finite();
-                t[l] = if ok { tl } else { f64::INFINITY };
-                any |= (l < m) & ok;
-            }
-        }
-        if any {
-            // The normal at `o + t d`, normalized as `try_normalize`: a
-            // hit only where that succeeds.
-            for l in 0..CHUNK {
-                let tl = t[l];
-                let nx = (o[0][l] + d[0][l] * tl - c.x) / r;
-                let ny = (o[1][l] + d[1][l] * tl - c.y) / r;
-                let nz = (o[2][l] + d[2][l] * tl - c.z) / r;
-                let rcp = 1.0 / dot(nx, ny, nz, nx, ny, nz).sqrt();
-                let ok = rcp.is_finite() && rcp > 0.0;
-                t[l] = if ok { tl } else { f64::INFINITY };
-                nrm[0][l] = nx * rcp;
-                nrm[1][l] = ny * rcp;
-                nrm[2][l] = nz * rcp;
-            }
-        }
-        each(start, m, &t, &nrm);
-        start += m;
     }
+    let mut t = [f64::INFINITY; CHUNK];
+    let mut nrm = [[0.0; CHUNK]; 3];
+    let (mut b, mut disc, mut cc) = ([0.0; CHUNK], [0.0; CHUNK], [0.0; CHUNK]);
+    let mut any = false;
+    for l in 0..CHUNK {
+        let (ocx, ocy, ocz) = (o[0][l] - c.x, o[1][l] - c.y, o[2][l] - c.z);
+        b[l] = dot(ocx, ocy, ocz, d[0][l], d[1][l], d[2][l]);
+        let (px, py, pz) = (
+            ocx - d[0][l] * b[l],
+            ocy - d[1][l] * b[l],
+            ocz - d[2][l] * b[l],
+        );
+        disc[l] = r2 - dot(px, py, pz, px, py, pz);
+        cc[l] = dot(ocx, ocy, ocz, ocx, ocy, ocz) - r2;
+        any |= (l < m) & (disc[l] >= 0.0);
+    }
+    if any {
+        // Roots of t² + 2bt + c: q = −(b + sign(b) √disc), t = q and c / q.
+        any = false;
+        for l in 0..CHUNK {
+            let q = -(b[l] + disc[l].sqrt().copysign(b[l]));
+            let nz = q != 0.0;
+            let t0 = if nz { cc[l] / q } else { 0.0 };
+            let t1 = if nz { q } else { 0.0 };
+            let (lo, hi) = if t0 > t1 { (t1, t0) } else { (t0, t1) };
+            let tl = if lo > 0.0 { lo } else { hi };
+            // `disc < 0` gave NaN above.
+            let ok = disc[l] >= 0.0 && tl > 0.0 && tl.is_finite();
+            t[l] = if ok { tl } else { f64::INFINITY };
+            any |= (l < m) & ok;
+        }
+    }
+    if any {
+        // The normal at `o + t d`, normalized as `try_normalize`: a
+        // hit only where that succeeds.
+        for l in 0..CHUNK {
+            let tl = t[l];
+            let nx = (o[0][l] + d[0][l] * tl - c.x) / r;
+            let ny = (o[1][l] + d[1][l] * tl - c.y) / r;
+            let nz = (o[2][l] + d[2][l] * tl - c.z) / r;
+            let rcp = 1.0 / dot(nx, ny, nz, nx, ny, nz).sqrt();
+            let ok = rcp.is_finite() && rcp > 0.0;
+            t[l] = if ok { tl } else { f64::INFINITY };
+            nrm[0][l] = nx * rcp;
+            nrm[1][l] = ny * rcp;
+            nrm[2][l] = nz * rcp;
+        }
+    }
+    (t, nrm)
 }
 
 /// A plane's candidate hit in one lane: `t` (infinite when none) and the
@@ -358,11 +359,14 @@ impl Step for SphereBlocks<'_> {
     #[inline(always)]
     fn run(self) {
         let SphereBlocks(s, rays, out) = self;
-        sphere_chunks(s, rays, |start, m, t, _| {
-            for (b, &t) in out[start..start + m].iter_mut().zip(t) {
+        let n = rays.len();
+        for start in (0..n).step_by(CHUNK) {
+            let m = (n - start).min(CHUNK);
+            let (t, _) = sphere_chunk(s, rays, start, m);
+            for (b, &t) in out[start..start + m].iter_mut().zip(&t) {
                 *b |= t < f64::INFINITY;
             }
-        });
+        }
     }
 }
 
@@ -386,7 +390,10 @@ impl Step for SphereHits<'_> {
     fn run(self) {
         let SphereHits(s, k, rays, out) = self;
         let (c, r) = (s.center, s.radius);
-        sphere_chunks(s, rays, |start, m, tc, nv| {
+        let n = rays.len();
+        for start in (0..n).step_by(CHUNK) {
+            let m = (n - start).min(CHUNK);
+            let (tc, nv) = sphere_chunk(s, rays, start, m);
             let e = start + m;
             let (t, obj) = (&mut out.t[start..e], &mut out.obj[start..e]);
             let (px, py, pz) = (
@@ -423,7 +430,7 @@ impl Step for SphereHits<'_> {
                 sy[i] = ny;
                 sz[i] = nz;
             }
-        });
+        }
     }
 }
 
