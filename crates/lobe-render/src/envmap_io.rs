@@ -28,7 +28,8 @@ pub const SKY: (usize, usize, f64, f64) = (512, 256, 35.0, 40.0);
 
 /// Load `path` (`.hdr`, `.exr`, or the word `sky`) as an environment map
 /// with `scale` and a rotation about +Y in degrees. Returns the map and the
-/// number of texels whose negative or NaN channels were clamped to 0.
+/// number of texels whose negative, infinite or NaN channels were clamped
+/// to 0 ([`EnvMap::new`]).
 pub fn load_envmap(path: &Path, scale: f64, rotation_y: f64) -> Result<(EnvMap, usize), LoadError> {
     let map_err = |source| LoadError::Map {
         path: path.to_path_buf(),
@@ -86,7 +87,7 @@ pub fn load_envmap(path: &Path, scale: f64, rotation_y: f64) -> Result<(EnvMap, 
 #[derive(Debug, Clone)]
 pub struct LoadedEnvMap {
     pub map: EnvMap,
-    /// Texels whose negative or NaN channels were clamped to 0.
+    /// Texels whose negative, infinite or NaN channels were clamped to 0.
     pub clamped: usize,
     /// What the caller should print, one sentence each, naming the file:
     /// clamped texels, and a map that is not 2:1 (an equirectangular map
@@ -117,7 +118,7 @@ pub fn load_envmap_checked(
     let mut warnings = Vec::new();
     if clamped > 0 {
         warnings.push(format!(
-            "{}: {clamped} texels with negative or NaN channels were clamped to 0",
+            "{}: {clamped} texels with negative, infinite or NaN channels were clamped to 0",
             path.display()
         ));
     }

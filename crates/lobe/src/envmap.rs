@@ -251,9 +251,9 @@ pub struct EnvMap {
     row_cos: Vec<f64>,
     /// `(sin, cos)(2π i / width)` for `i = 0..=width`: the columns' edges.
     col_cs: Vec<(f64, f64)>,
-    /// Radiance and luminance per texel, together: a lookup reads one
-    /// 32-byte block (the densities are the luminance's functions,
-    /// [`TexelSampler::weight`]).
+    /// Radiance per texel in `f32`, 16 bytes each: a lookup reads one
+    /// aligned block, and computes the luminance the densities are
+    /// functions of ([`TexelSampler::weight`]) from it.
     texels: Vec<Texel>,
     scale: f64,
     /// cos and sin of the rotation about +Y.
@@ -264,12 +264,31 @@ pub struct EnvMap {
     compensated: TexelSampler,
 }
 
-/// One texel: its radiance (before `scale`) and luminance.
+/// One texel's radiance (before `scale`), in `f32` as map files hold it
+/// (an `.exr`'s half or float, an `.hdr`'s RGBE: no rounding), padded to
+/// 16 bytes so that none straddles a cache line.
 #[derive(Debug, Clone, Copy, PartialEq)]
-#[repr(C, align(32))]
+#[repr(C, align(16))]
 struct Texel {
-    rgb: [f64; 3],
-    lum: f64,
+    rgb: [f32; 3],
+}
+
+impl Texel {
+    #[inline]
+    fn rgb(self) -> Rgb {
+        Rgb::new(
+            f64::from(self.rgb[0]),
+            f64::from(self.rgb[1]),
+            f64::from(self.rgb[2]),
+        )
+    }
+
+    /// The luminance, in `f64` from the `f64` radiance: the same bits
+    /// wherever it is computed (the densities' build and every lookup).
+    #[inline]
+    fn lum(self) -> f64 {
+        luminance(self.rgb())
+    }
 }
 
 /// A piecewise-constant density over the texels: texel weights times their
@@ -370,13 +389,15 @@ impl std::fmt::Display for EnvMapError {
 impl std::error::Error for EnvMapError {}
 
 impl EnvMap {
-    /// A map from row-major texels, row 0 at the top. Negative or NaN
-    /// channels are clamped to 0; the count of clamped texels is returned
+    /// A map from row-major texels, row 0 at the top, stored in `f32`
+    /// (rounded to nearest; a map file's values are `f32` already). Negative,
+    /// infinite or NaN channels are clamped to 0, finite ones above
+    /// `f32::MAX` to `f32::MAX`; the count of clamped texels is returned
     /// beside the map so that the caller can warn once.
     pub fn new(
         width: usize,
         height: usize,
-        mut texels: Vec<Rgb>,
+        texels: Vec<Rgb>,
         scale: f64,
         rotation_y_deg: f64,
     ) -> Result<(Self, usize), EnvMapError> {
@@ -397,17 +418,27 @@ impl EnvMap {
             return Err(EnvMapError::Rotation(rotation_y_deg));
         }
         let mut clamped = 0;
-        for t in &mut texels {
-            let ok = t.to_array().map(|c| c >= 0.0 && c.is_finite());
-            if ok.contains(&false) {
-                clamped += 1;
-                *t = Rgb::from_array(
-                    t.to_array()
-                        .map(|c| if c >= 0.0 && c.is_finite() { c } else { 0.0 }),
-                );
-            }
-        }
-        let lum: Vec<f64> = texels.iter().map(|&t| luminance(t)).collect();
+        let top = f64::from(f32::MAX);
+        let texels: Vec<Texel> = texels
+            .iter()
+            .map(|t| {
+                let ok = t.to_array().map(|c| (0.0..=top).contains(&c));
+                if ok.contains(&false) {
+                    clamped += 1;
+                }
+                let c = t.to_array().map(|c| {
+                    if c >= 0.0 && c.is_finite() {
+                        c.min(top)
+                    } else {
+                        0.0
+                    }
+                });
+                Texel {
+                    rgb: c.map(|c| c as f32),
+                }
+            })
+            .collect();
+        let lum: Vec<f64> = texels.iter().map(|t| t.lum()).collect();
         let plain = TexelSampler::new(width, height, None, &lum);
         // Mean luminance over the sphere, then the part above it.
         let mean = plain.norm / (4.0 * PI);
@@ -416,14 +447,6 @@ impl EnvMap {
         } else {
             plain.clone()
         };
-        let texels = texels
-            .iter()
-            .zip(&lum)
-            .map(|(t, &lum)| Texel {
-                rgb: t.to_array(),
-                lum,
-            })
-            .collect();
         let r = rotation_y_deg.to_radians();
         Ok((
             EnvMap {
@@ -467,7 +490,7 @@ impl EnvMap {
 
     #[must_use]
     pub fn texel(&self, i: usize, j: usize) -> Rgb {
-        Rgb::from_array(self.texels[j * self.width + i].rgb) * self.scale
+        self.texels[j * self.width + i].rgb() * self.scale
     }
 
     /// Map coordinates `(u, v)` of a world direction.
@@ -625,7 +648,7 @@ impl EnvMap {
             return 0.0;
         }
         let (i, j) = self.texel_index(d);
-        t.weight(self.texels[j * self.width + i].lum) / t.norm
+        t.weight(self.texels[j * self.width + i].lum()) / t.norm
     }
 
     /// Radiance and both densities ([`EnvMap::pdf`],
@@ -641,15 +664,16 @@ impl EnvMap {
     #[inline]
     fn texel_lookup(&self, k: usize) -> EnvLookup {
         let texel = self.texels[k];
+        let lum = texel.lum();
         let pdf = |t: &TexelSampler| {
             if t.norm > 0.0 {
-                t.weight(texel.lum) / t.norm
+                t.weight(lum) / t.norm
             } else {
                 0.0
             }
         };
         EnvLookup {
-            radiance: Rgb::from_array(texel.rgb) * self.scale,
+            radiance: texel.rgb() * self.scale,
             pdf: pdf(&self.plain),
             pdf_compensated: pdf(&self.compensated),
         }
@@ -896,17 +920,39 @@ mod tests {
     }
 
     #[test]
-    fn negative_and_nan_texels_are_clamped_and_counted() {
+    fn negative_nan_and_huge_texels_are_clamped_and_counted() {
         let (m, n) = EnvMap::new(
             2,
             1,
-            vec![Rgb::new(-1.0, 0.5, f64::NAN), Rgb::ONE],
+            vec![
+                Rgb::new(-1.0, 0.5, f64::NAN),
+                Rgb::new(f64::INFINITY, 1.0, 1.0),
+            ],
+            1.0,
+            0.0,
+        )
+        .unwrap();
+        assert_eq!(n, 2);
+        assert_eq!(m.texel(0, 0), Rgb::new(0.0, 0.5, 0.0));
+        assert_eq!(m.texel(1, 0), Rgb::new(0.0, 1.0, 1.0));
+        // Beyond f32: the largest f32, and counted; an f64 value is
+        // rounded to the nearest f32. (+∞ is clamped to 0 like NaN.)
+        let big = f64::from(f32::MAX);
+        let (m, n) = EnvMap::new(
+            3,
+            1,
+            vec![Rgb::new(1e300, 0.1, 2e38), Rgb::splat(big), Rgb::ONE],
             1.0,
             0.0,
         )
         .unwrap();
         assert_eq!(n, 1);
-        assert_eq!(m.texel(0, 0), Rgb::new(0.0, 0.5, 0.0));
+        assert_eq!(
+            m.texel(0, 0),
+            Rgb::new(big, f64::from(0.1f32), f64::from(2e38f32))
+        );
+        assert_eq!(m.texel(1, 0), Rgb::splat(big));
+        assert!(m.lookup(DVec3::X).pdf.is_finite());
     }
 
     #[test]
@@ -985,7 +1031,7 @@ mod tests {
         let texels = EnvMap::sky(64, 32, 30.0, 40.0)
             .texels
             .iter()
-            .map(|t| Rgb::from_array(t.rgb))
+            .map(|t| t.rgb())
             .collect();
         EnvMap::new(64, 32, texels, 1.5, 33.0).unwrap().0
     }
