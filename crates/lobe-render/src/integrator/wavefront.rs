@@ -187,8 +187,13 @@ struct Lanes {
     a: [Vec<f32>; 6],
     out: [Vec<f32>; 10],
     valid: Vec<u8>,
-    /// (object, draw index) of every BSDF or light draw, sorted by object.
+    /// (object, draw index) of every BSDF or light draw, grouped by
+    /// object (a stable counting sort, through `sorted` and the per-object
+    /// `starts`): in each group the BSDF draws and the light draws each
+    /// in draw order.
     keys: Vec<u64>,
+    sorted: Vec<u64>,
+    starts: Vec<usize>,
     /// The block's Sobol pairs: per sample, the seeds of its [`PAIRS`]
     /// pairs, its index, and the points.
     pair_seeds: [Vec<u64>; PAIRS],
@@ -241,6 +246,8 @@ impl Lanes {
             out: std::array::from_fn(|_| v()),
             valid: vec![0; 2 * BLOCK],
             keys: Vec::with_capacity(2 * BLOCK),
+            sorted: Vec::with_capacity(2 * BLOCK),
+            starts: Vec::new(),
             pair_seeds: std::array::from_fn(|_| Vec::with_capacity(BLOCK)),
             pair_index: Vec::with_capacity(BLOCK),
             pair_x: std::array::from_fn(|_| vec![0.0; BLOCK]),
@@ -575,17 +582,36 @@ impl Batch<'_> {
             d.light = Some(l);
             lanes.keys.push(key(pt.obj, di));
         }
-        lanes.keys.sort_unstable();
+        // Grouped by object, each group's BSDF draws and light draws in
+        // draw order (as they were pushed), so each batch call's lanes are
+        // in draw order.
+        let objects = self.samplers.len();
+        lanes.starts.clear();
+        lanes.starts.resize(objects + 1, 0);
+        for &key in &lanes.keys {
+            lanes.starts[(key >> 32) as usize + 1] += 1;
+        }
+        for o in 0..objects {
+            lanes.starts[o + 1] += lanes.starts[o];
+        }
+        lanes.sorted.clear();
+        lanes.sorted.resize(lanes.keys.len(), 0);
+        // Each group's start as its cursor, which ends at the next
+        // group's start; then shifted back.
+        for &key in &lanes.keys {
+            let o = (key >> 32) as usize;
+            lanes.sorted[lanes.starts[o]] = key;
+            lanes.starts[o] += 1;
+        }
+        lanes.starts.copy_within(0..objects, 1);
+        lanes.starts[0] = 0;
+        std::mem::swap(&mut lanes.keys, &mut lanes.sorted);
         // One batch call per object and kind of draw.
-        let mut g = 0;
-        while g < lanes.keys.len() {
-            let obj = (lanes.keys[g] >> 32) as usize;
-            let mut e = g;
-            while e < lanes.keys.len() && (lanes.keys[e] >> 32) as usize == obj {
-                e += 1;
+        for obj in 0..objects {
+            let (g, e) = (lanes.starts[obj], lanes.starts[obj + 1]);
+            if g < e {
+                self.batch_group(obj, g..e, pts, draws, lanes);
             }
-            self.batch_group(obj, g..e, pts, draws, lanes);
-            g = e;
         }
         // The shadow rays of the block, traced together: the BSDF draws'
         // (a failed draw when blocked), and the light draws' that carry
