@@ -3,7 +3,6 @@
 //! crate). A compression the reader cannot decode (DWAA, DWAB) is named in
 //! the error. `sky` is the built-in procedural sky.
 
-use glam::DVec3;
 use lobe::envmap::EnvMap;
 use std::path::{Path, PathBuf};
 
@@ -76,11 +75,8 @@ pub fn load_envmap(path: &Path, scale: f64, rotation_y: f64) -> Result<(EnvMap, 
         .map_err(|e| format_err(format!("cannot decode: {e}")))?;
     let rgb = img.into_rgb32f();
     let (w, h) = (rgb.width() as usize, rgb.height() as usize);
-    let texels = rgb
-        .pixels()
-        .map(|p| DVec3::new(f64::from(p[0]), f64::from(p[1]), f64::from(p[2])))
-        .collect();
-    EnvMap::new(w, h, texels, scale, rotation_y).map_err(map_err)
+    let (texels, _) = rgb.as_raw().as_chunks::<3>();
+    EnvMap::from_rgb32f(w, h, texels, scale, rotation_y).map_err(map_err)
 }
 
 /// An environment map with the warnings of its loading ([`load_envmap_checked`]).

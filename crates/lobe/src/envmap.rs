@@ -311,14 +311,13 @@ struct TexelSampler {
 }
 
 impl TexelSampler {
-    fn new(width: usize, height: usize, shift: Option<f64>, lum: &[f64]) -> Self {
-        let weights: Vec<f64> = lum.iter().map(|&l| Self::weight_of(shift, l)).collect();
+    fn new(width: usize, height: usize, shift: Option<f64>, texels: &[Texel]) -> Self {
         let dphi = 2.0 * PI / width as f64;
         let row = |j: usize| {
             let omega = dphi * EnvMap::band(height, j);
-            let w: Vec<f64> = weights[j * width..(j + 1) * width]
+            let w: Vec<f64> = texels[j * width..(j + 1) * width]
                 .iter()
-                .map(|&t| t * omega)
+                .map(|t| Self::weight_of(shift, t.lum()) * omega)
                 .collect();
             Distribution1D::new(&w)
         };
@@ -407,14 +406,51 @@ impl EnvMap {
         scale: f64,
         rotation_y_deg: f64,
     ) -> Result<(Self, usize), EnvMapError> {
+        Self::from_channels(
+            width,
+            height,
+            texels.len(),
+            texels.iter().map(|t| t.to_array()),
+            scale,
+            rotation_y_deg,
+        )
+    }
+
+    /// [`EnvMap::new`] from `f32` RGB texels, as an image decoder gives
+    /// them (stored as they are: no rounding, no `f64` copy of the map).
+    pub fn from_rgb32f(
+        width: usize,
+        height: usize,
+        texels: &[[f32; 3]],
+        scale: f64,
+        rotation_y_deg: f64,
+    ) -> Result<(Self, usize), EnvMapError> {
+        Self::from_channels(
+            width,
+            height,
+            texels.len(),
+            texels.iter().map(|t| t.map(f64::from)),
+            scale,
+            rotation_y_deg,
+        )
+    }
+
+    fn from_channels(
+        width: usize,
+        height: usize,
+        len: usize,
+        texels: impl Iterator<Item = [f64; 3]>,
+        scale: f64,
+        rotation_y_deg: f64,
+    ) -> Result<(Self, usize), EnvMapError> {
         if width == 0 || height == 0 {
             return Err(EnvMapError::Empty { width, height });
         }
-        if texels.len() != width * height {
+        if len != width * height {
             return Err(EnvMapError::Size {
                 width,
                 height,
-                got: texels.len(),
+                got: len,
             });
         }
         if !scale.is_finite() || scale < 0.0 {
@@ -426,13 +462,12 @@ impl EnvMap {
         let mut clamped = 0;
         let top = f64::from(f32::MAX);
         let texels: Vec<Texel> = texels
-            .iter()
             .map(|t| {
-                let ok = t.to_array().map(|c| (0.0..=top).contains(&c));
+                let ok = t.map(|c| (0.0..=top).contains(&c));
                 if ok.contains(&false) {
                     clamped += 1;
                 }
-                let c = t.to_array().map(|c| {
+                let c = t.map(|c| {
                     if c >= 0.0 && c.is_finite() {
                         c.min(top)
                     } else {
@@ -444,12 +479,11 @@ impl EnvMap {
                 }
             })
             .collect();
-        let lum: Vec<f64> = texels.iter().map(|t| t.lum()).collect();
-        let plain = TexelSampler::new(width, height, None, &lum);
+        let plain = TexelSampler::new(width, height, None, &texels);
         // Mean luminance over the sphere, then the part above it.
         let mean = plain.norm / (4.0 * PI);
-        let compensated = if lum.iter().any(|&l| (l - mean).max(0.0) > 0.0) {
-            TexelSampler::new(width, height, Some(mean), &lum)
+        let compensated = if texels.iter().any(|t| (t.lum() - mean).max(0.0) > 0.0) {
+            TexelSampler::new(width, height, Some(mean), &texels)
         } else {
             plain.clone()
         };
@@ -1020,6 +1054,28 @@ mod tests {
         );
         assert_eq!(m.texel(1, 0), Rgb::splat(big));
         assert!(m.lookup(DVec3::X).pdf.is_finite());
+    }
+
+    /// `from_rgb32f` builds the map `new` builds from the same values
+    /// (clamps and counts included), and refuses a wrong texel count.
+    #[test]
+    fn f32_texels_make_the_same_map() {
+        let rgb: Vec<[f32; 3]> = (0..32 * 16)
+            .map(|k| match k % 97 {
+                0 => [-1.0, f32::NAN, 2.0],
+                1 => [f32::INFINITY, 1.0, 0.5],
+                _ => [k as f32 * 0.37, (k % 13) as f32, 1e-3 * k as f32],
+            })
+            .collect();
+        let wide: Vec<Rgb> = rgb
+            .iter()
+            .map(|c| Rgb::from_array(c.map(f64::from)))
+            .collect();
+        let a = EnvMap::from_rgb32f(32, 16, &rgb, 1.5, 20.0).unwrap();
+        let b = EnvMap::new(32, 16, wide, 1.5, 20.0).unwrap();
+        assert_eq!(a.1, 12);
+        assert_eq!(a, b);
+        assert!(EnvMap::from_rgb32f(32, 15, &rgb, 1.0, 0.0).is_err());
     }
 
     #[test]
