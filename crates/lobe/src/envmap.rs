@@ -789,6 +789,34 @@ impl EnvMap {
     /// (the same bits at every level).
     fn lookup_many_at(&self, level: SimdLevel, dirs: &[DVec3], out: &mut [EnvLookup]) {
         assert_eq!(dirs.len(), out.len(), "lookup_many: lengths differ");
+        self.texels_many(level, dirs, out, |k| self.texel_lookup(k));
+    }
+
+    /// [`EnvMap::eval`] of many directions, the radiance alone (no
+    /// densities): `out[k] = self.eval(dirs[k])`, bit for bit, as
+    /// [`EnvMap::lookup_many`] finds the texels.
+    ///
+    /// # Panics
+    /// If the slices differ in length.
+    pub fn eval_many(&self, dirs: &[DVec3], out: &mut [Rgb]) {
+        self.eval_many_at(SimdLevel::best(), dirs, out);
+    }
+
+    fn eval_many_at(&self, level: SimdLevel, dirs: &[DVec3], out: &mut [Rgb]) {
+        assert_eq!(dirs.len(), out.len(), "eval_many: lengths differ");
+        self.texels_many(level, dirs, out, |k| self.texels[k].rgb() * self.scale);
+    }
+
+    /// `out[k] = at(texel index of dirs[k])`, the indices of a chunk found
+    /// together at `level` first.
+    #[inline]
+    fn texels_many<T>(
+        &self,
+        level: SimdLevel,
+        dirs: &[DVec3],
+        out: &mut [T],
+        at: impl Fn(usize) -> T,
+    ) {
         for (dc, oc) in dirs.chunks(LOOKUP_CHUNK).zip(out.chunks_mut(LOOKUP_CHUNK)) {
             let mut idx = [0usize; LOOKUP_CHUNK];
             level.run(TexelIndices {
@@ -797,7 +825,7 @@ impl EnvMap {
                 out: &mut idx,
             });
             for (o, &k) in oc.iter_mut().zip(&idx) {
-                *o = self.texel_lookup(k);
+                *o = at(k);
             }
         }
     }
@@ -1201,8 +1229,11 @@ mod tests {
             for level in SimdLevel::ALL.into_iter().filter(|l| l.is_available()) {
                 let mut looked = vec![EnvLookup::default(); dirs.len()];
                 map.lookup_many_at(level, &dirs, &mut looked);
+                let mut radiance = vec![Rgb::ZERO; dirs.len()];
+                map.eval_many_at(level, &dirs, &mut radiance);
                 for (k, &d) in dirs.iter().enumerate() {
                     assert_eq!(looked[k], map.lookup(d), "{level:?} direction {k} {d}");
+                    assert_eq!(radiance[k], map.eval(d), "{level:?} direction {k} {d}");
                 }
             }
         }

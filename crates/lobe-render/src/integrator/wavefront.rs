@@ -212,6 +212,8 @@ struct Lanes {
     /// The escaping BSDF draws' world directions and the map there.
     bsdf_dirs: Vec<DVec3>,
     bsdf_env: Vec<EnvLookup>,
+    /// The map's radiance where camera rays escape.
+    miss_radiance: Vec<Rgb>,
     /// The block's film positions `(x, y)` in pixels.
     film: (Vec<f64>, Vec<f64>),
     /// Independent or stratified numbers: each sample's pair seeds and
@@ -259,6 +261,7 @@ impl Lanes {
             draw_index: Vec::with_capacity(2 * BLOCK),
             bsdf_dirs: Vec::with_capacity(2 * BLOCK),
             bsdf_env: Vec::with_capacity(2 * BLOCK),
+            miss_radiance: Vec::with_capacity(BLOCK),
             film: (Vec::with_capacity(BLOCK), Vec::with_capacity(BLOCK)),
             each: Vec::with_capacity(BLOCK),
             px: Vec::with_capacity(BLOCK),
@@ -490,13 +493,13 @@ impl Batch<'_> {
             }
             pts.push(pt);
         }
-        // The map where the rays escape.
+        // The map's radiance where the rays escape.
         let e = lanes.bsdf_dirs.len();
-        lanes.bsdf_env.resize(e, EnvLookup::default());
+        lanes.miss_radiance.resize(e, Rgb::ZERO);
         self.env
-            .lookup_many(&lanes.bsdf_dirs, &mut lanes.bsdf_env[..e]);
-        for (&m, l) in lanes.draw_index.iter().zip(&lanes.bsdf_env[..e]) {
-            lanes.value[m] = l.radiance;
+            .eval_many(&lanes.bsdf_dirs, &mut lanes.miss_radiance[..e]);
+        for (&m, &l) in lanes.draw_index.iter().zip(&lanes.miss_radiance[..e]) {
+            lanes.value[m] = l;
         }
     }
 
