@@ -80,16 +80,18 @@
 //! direct lighting (`max_depth = 1`) with a BSDF strategy, `light`, or MIS
 //! with one BSDF and one light draw (`mis`, `mis-balance`, `mis-power`),
 //! each row is rendered in blocks of [`BLOCK`] samples (consecutive samples
-//! of consecutive pixels): the camera rays and their hits (f64, scalar),
-//! then every BSDF draw of the block in one
+//! of consecutive pixels): the camera rays and their hits (f64 lanes,
+//! [`crate::lanes`]; the escaping rays' radiance from
+//! [`lobe::envmap::EnvMap::eval_many`]), then every BSDF draw of the block in one
 //! [`lobe::batch::BatchSampler::sample`] call per object and every light
 //! draw's `f` and BSDF pdf in one [`lobe::batch::BatchSampler::eval_pdf`]
 //! call per object (f32 lanes, structure of arrays, AVX-512 / AVX2 /
 //! portable as [`lobe::batch::SimdLevel::from_env`] says), the light draws
 //! from [`lobe::envmap::EnvMap::sample_lookup`] (guide-table CDF inversion,
-//! O(1) per sample, with the drawn texel's radiance and pdfs), each BSDF
+//! a binary search only inside one interval of the guide, with the drawn
+//! texel's radiance and pdfs), each BSDF
 //! direction's radiance and pdfs from one [`lobe::envmap::EnvMap::lookup`],
-//! then the block's shadow rays. It draws the same numbers from the same
+//! then the block's shadow rays (f64 lanes). It draws the same numbers from the same
 //! dimensions as the scalar loop and weights them the same way, so the two
 //! loops estimate the same image and, for one seed, agree to f32 rounding
 //! (the test `batch_loop_matches_the_scalar_loop`). Adaptive MIS's pilot

@@ -80,7 +80,7 @@ pub struct FresnelDesc {
 }
 
 /// A material as written by a user; [`MaterialDesc::build`] checks it and
-/// turns it into a [`Material`].
+/// turns it into a [`Material`](crate::Material).
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct MaterialDesc {

@@ -27,9 +27,9 @@ use std::f64::consts::PI;
 
 /// A piecewise-constant 1D distribution over `n` bins, sampled by inversion
 /// of its CDF in O(1) expected time: a guide table (Chen and Asau 1974)
-/// gives, for each of `n` equal intervals of `u`, the bin where `u`'s search
-/// starts, so a sample looks at about one bin instead of a binary search's
-/// `log₂ n`. Inversion keeps the map from `u` to the bin monotone, so
+/// gives, for each of `n` equal intervals of `u`, the first and the last bin
+/// `u` can fall in, so a sample searches those (about one bin on average,
+/// the bins of one interval at most) instead of all `n`. Inversion keeps the map from `u` to the bin monotone, so
 /// stratified and Sobol numbers stay stratified over the texels (an alias
 /// table would not).
 #[derive(Debug, Clone, PartialEq)]

@@ -459,7 +459,7 @@ pub fn pair_point_seeded(seq: Sequence, s: u64, n: u64, index: u64) -> [f64; 2] 
 /// bit, computed in SIMD lanes at `level` (AVX-512 / AVX2 where the CPU
 /// has it, else portable code): no table lookups, dimension 0's matrix
 /// product is a bit reversal and dimension 1's five shift-and-xor steps
-/// ([`pascal_reversed`]).
+/// (`pascal_reversed`).
 ///
 /// # Panics
 /// If the four slices differ in length.
