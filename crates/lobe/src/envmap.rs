@@ -29,9 +29,9 @@ use std::f64::consts::PI;
 /// of its CDF in O(1) expected time: a guide table (Chen and Asau 1974)
 /// gives, for each of `n` equal intervals of `u`, the first and the last bin
 /// `u` can fall in, so a sample searches those (about one bin on average,
-/// the bins of one interval at most) instead of all `n`. Inversion keeps the map from `u` to the bin monotone, so
-/// stratified and Sobol numbers stay stratified over the texels (an alias
-/// table would not).
+/// the bins of one interval at most) instead of all `n`. Inversion keeps
+/// the map from `u` to the bin monotone, so stratified and Sobol numbers
+/// stay stratified over the texels (an alias table would not).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Distribution1D {
     /// `cdf[i]` = probability of bins `0..i`; `cdf[n] = 1`.
@@ -409,7 +409,6 @@ impl EnvMap {
         Self::from_channels(
             width,
             height,
-            texels.len(),
             texels.iter().map(|t| t.to_array()),
             scale,
             rotation_y_deg,
@@ -428,7 +427,6 @@ impl EnvMap {
         Self::from_channels(
             width,
             height,
-            texels.len(),
             texels.iter().map(|t| t.map(f64::from)),
             scale,
             rotation_y_deg,
@@ -438,19 +436,18 @@ impl EnvMap {
     fn from_channels(
         width: usize,
         height: usize,
-        len: usize,
-        texels: impl Iterator<Item = [f64; 3]>,
+        texels: impl ExactSizeIterator<Item = [f64; 3]>,
         scale: f64,
         rotation_y_deg: f64,
     ) -> Result<(Self, usize), EnvMapError> {
         if width == 0 || height == 0 {
             return Err(EnvMapError::Empty { width, height });
         }
-        if len != width * height {
+        if texels.len() != width * height {
             return Err(EnvMapError::Size {
                 width,
                 height,
-                got: len,
+                got: texels.len(),
             });
         }
         if !scale.is_finite() || scale < 0.0 {
@@ -463,10 +460,6 @@ impl EnvMap {
         let top = f64::from(f32::MAX);
         let texels: Vec<Texel> = texels
             .map(|t| {
-                let ok = t.map(|c| (0.0..=top).contains(&c));
-                if ok.contains(&false) {
-                    clamped += 1;
-                }
                 let c = t.map(|c| {
                     if c >= 0.0 && c.is_finite() {
                         c.min(top)
@@ -474,6 +467,10 @@ impl EnvMap {
                         0.0
                     }
                 });
+                // (A NaN channel compares unequal too.)
+                if c != t {
+                    clamped += 1;
+                }
                 Texel {
                     rgb: c.map(|c| c as f32),
                 }
@@ -530,7 +527,13 @@ impl EnvMap {
 
     #[must_use]
     pub fn texel(&self, i: usize, j: usize) -> Rgb {
-        self.texels[j * self.width + i].rgb() * self.scale
+        self.radiance_at(j * self.width + i)
+    }
+
+    /// The scaled radiance of texel `k` (row-major).
+    #[inline]
+    fn radiance_at(&self, k: usize) -> Rgb {
+        self.texels[k].rgb() * self.scale
     }
 
     /// Map coordinates `(u, v)` of a world direction.
@@ -713,7 +716,7 @@ impl EnvMap {
             }
         };
         EnvLookup {
-            radiance: texel.rgb() * self.scale,
+            radiance: self.radiance_at(k),
             pdf: pdf(&self.plain),
             pdf_compensated: pdf(&self.compensated),
         }
@@ -804,7 +807,7 @@ impl EnvMap {
 
     fn eval_many_at(&self, level: SimdLevel, dirs: &[DVec3], out: &mut [Rgb]) {
         assert_eq!(dirs.len(), out.len(), "eval_many: lengths differ");
-        self.texels_many(level, dirs, out, |k| self.texels[k].rgb() * self.scale);
+        self.texels_many(level, dirs, out, |k| self.radiance_at(k));
     }
 
     /// `out[k] = at(texel index of dirs[k])`, the indices of a chunk found

@@ -504,11 +504,11 @@ fn sobol_pairs_avx512(seeds: &[u64], index: &[u32], x: &mut [f64], y: &mut [f64]
     sobol_pairs_lanes(seeds, index, x, y);
 }
 
-/// `sobol_reversed(r, 1)` of `q = r.reverse_bits()`, without tables: dimension 1's generator matrix
-/// is Pascal's triangle mod 2, so bit `l` of the reversed point is the xor
-/// of the bits `k ⊇ l` (Lucas) of `r.reverse_bits()`: a subset-sum
-/// transform over the five bit levels of the position, five shift-and-xor
-/// steps on all 32 bits at once. (Dimension 0 is `r.reverse_bits()`.)
+/// `sobol_reversed(r, 1)` of `q = r.reverse_bits()`, without tables:
+/// dimension 1's generator matrix is Pascal's triangle mod 2, so bit `l` of
+/// the reversed point is the xor of the bits `k ⊇ l` (Lucas) of `q`: a
+/// subset-sum transform over the five bit levels of the position, five
+/// shift-and-xor steps on all 32 bits at once. (Dimension 0 is `q`.)
 #[inline(always)]
 fn pascal_reversed(q: u32) -> u32 {
     let mut w = q;
@@ -520,8 +520,8 @@ fn pascal_reversed(q: u32) -> u32 {
     w
 }
 
-/// [`sobol_pairs`] in chunks of [`SOBOL_CHUNK`] lanes, each step a plain
-/// loop over the chunk (which the compiler vectorizes).
+/// [`sobol_pairs`] as one plain loop over the lanes (which the compiler
+/// vectorizes at the caller's SIMD level).
 #[inline(always)]
 fn sobol_pairs_lanes(seeds: &[u64], index: &[u32], x: &mut [f64], y: &mut [f64]) {
     let k = 1.0 / 4_294_967_296.0;

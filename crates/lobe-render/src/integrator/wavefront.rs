@@ -149,10 +149,9 @@ impl<'a> Batch<'a> {
 /// Per sample of a block that hits a surface facing the camera.
 #[derive(Debug, Clone, Copy)]
 struct Point {
-    /// The sample's index in the block.
+    /// The sample's index in the block (its column is `Lanes::px[m]`, its
+    /// estimate goes to `Lanes::value[m]`).
     m: u32,
-    /// The pixel's column.
-    x: u32,
     /// The object hit.
     obj: u32,
     p: DVec3,
@@ -162,7 +161,6 @@ struct Point {
     plan: PixelPlan,
     /// The numbers of the two draws, `[uc, u₁, u₂]`.
     u: [[f64; 3]; 2],
-    value: Rgb,
 }
 
 /// Per draw (two per sample) of a block.
@@ -408,15 +406,12 @@ impl Batch<'_> {
             }
             self.shade(
                 ctx.scene,
-                &mut pts,
+                &pts,
                 &mut draws,
                 &mut lanes,
                 &mut stats,
                 pilots.as_deref_mut(),
             );
-            for pt in &pts {
-                lanes.value[pt.m as usize] = pt.value;
-            }
             for (&x, v) in lanes.px.iter().zip(&lanes.value) {
                 if v.is_finite() {
                     row[x as usize] += *v;
@@ -478,7 +473,6 @@ impl Batch<'_> {
             }
             let mut pt = Point {
                 m: m as u32,
-                x: lanes.px[m] as u32,
                 obj: h.obj[m],
                 p: h.p.get(m),
                 ng,
@@ -486,7 +480,6 @@ impl Batch<'_> {
                 wo,
                 plan: lanes.plans[m],
                 u: [[0.0; 3]; 2],
-                value: Rgb::ZERO,
             };
             if let Some(&(seeds, index)) = lanes.each.get(m) {
                 self.assign_u(&mut pt, |p| seeded_pair(ctx, &seeds, index, p));
@@ -535,11 +528,12 @@ impl Batch<'_> {
     }
 
     /// The draws of a block: BSDF samples and light samples' `f` and pdf
-    /// in batches per object, then the shadow rays and the estimates.
+    /// in batches per object, then the shadow rays and the estimates (into
+    /// `lanes.value`, at each point's sample).
     fn shade(
         &self,
         scene: &Scene,
-        pts: &mut [Point],
+        pts: &[Point],
         draws: &mut [Draw],
         lanes: &mut Lanes,
         stats: &mut RenderStats,
@@ -672,10 +666,11 @@ impl Batch<'_> {
             draws[di].light = Some(l);
         }
         // Shadow rays and the estimates, in sample order.
-        for (i, pt) in pts.iter_mut().enumerate() {
+        for (i, pt) in pts.iter().enumerate() {
             let mut sum = Rgb::ZERO;
             let mut n = 0.0;
-            let mut pilot = pilots.as_deref_mut().map(|p| &mut p[pt.x as usize]);
+            let x = lanes.px[pt.m as usize] as usize;
+            let mut pilot = pilots.as_deref_mut().map(|p| &mut p[x]);
             if let Some(p) = pilot.as_deref_mut() {
                 p.samples += 1;
             }
@@ -727,7 +722,7 @@ impl Batch<'_> {
                     }
                 }
             }
-            pt.value = match pt.plan.mis {
+            lanes.value[pt.m as usize] = match pt.plan.mis {
                 None if n > 1.0 => sum / n,
                 _ => sum,
             };
