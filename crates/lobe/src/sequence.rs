@@ -248,8 +248,10 @@ static SOBOL_BYTES: [[[u32; 256]; 4]; 4] = byte_tables();
 /// The byte tables of the bit-reversed point of a bit-reversed index:
 /// `SOBOL_REV[d]` applied to `i.reverse_bits()` gives
 /// `sobol(i, d).reverse_bits()`. Burley's scramble works on reversed bits,
-/// so [`pair_point_seeded`] stays in reversed order between its scrambles
-/// and reverses three times per pair instead of six.
+/// so a pair stays in reversed order between its scrambles. The pairs use
+/// the table-free forms ([`pascal_reversed`]); the tests check them
+/// against these tables.
+#[cfg(test)]
 const fn reversed_tables() -> [[[u32; 256]; 4]; 4] {
     let m = matrices();
     let mut t = [[[0u32; 256]; 4]; 4];
@@ -277,10 +279,11 @@ const fn reversed_tables() -> [[[u32; 256]; 4]; 4] {
     t
 }
 
+#[cfg(test)]
 static SOBOL_REV: [[[u32; 256]; 4]; 4] = reversed_tables();
 
 /// `sobol(r.reverse_bits(), d).reverse_bits()`.
-#[inline]
+#[cfg(test)]
 fn sobol_reversed(r: u32, d: usize) -> u32 {
     let t = &SOBOL_REV[d];
     t[0][(r & 0xff) as usize]
@@ -443,29 +446,62 @@ pub fn pair_point_seeded(seq: Sequence, s: u64, n: u64, index: u64) -> [f64; 2] 
         }
         Sequence::Sobol => {
             debug_assert!(index <= u64::from(u32::MAX));
-            // nested_uniform_scramble(sobol(nested_uniform_scramble(index)))
-            // per coordinate, kept in reversed bit order in between.
-            let ir = laine_karras((index as u32).reverse_bits(), s as u32);
-            let x = laine_karras(sobol_reversed(ir, 0), (s >> 32) as u32).reverse_bits();
-            let y = laine_karras(sobol_reversed(ir, 1), hash64(s) as u32).reverse_bits();
+            let (x, y) = SobolKeys::new(s).point(index as u32);
             let k = 1.0 / 4_294_967_296.0;
             [f64::from(x) * k, f64::from(y) * k]
         }
     }
 }
 
+/// The three 32-bit keys of a Sobol pair's randomization
+/// `s = pair_seed(seed, dim)`: the index shuffle's and each coordinate's
+/// Owen scramble. [`sobol_pairs`] takes them computed once per pixel and
+/// pair, so that its lanes need no 64-bit hash.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct SobolKeys {
+    index: u32,
+    x: u32,
+    y: u32,
+}
+
+impl SobolKeys {
+    /// The keys of randomization `s` ([`pair_seed`]).
+    #[inline]
+    #[must_use]
+    pub fn new(s: u64) -> Self {
+        SobolKeys {
+            index: s as u32,
+            x: (s >> 32) as u32,
+            y: hash64(s) as u32,
+        }
+    }
+
+    /// Point `index` as 32-bit fixed-point coordinates:
+    /// `nested_uniform_scramble(sobol(nested_uniform_scramble(index)))` per
+    /// coordinate, kept in reversed bit order in between; dimension 0's
+    /// matrix product is the bit reversal and dimension 1's
+    /// [`pascal_reversed`].
+    #[inline(always)]
+    fn point(self, index: u32) -> (u32, u32) {
+        let q = laine_karras(index.reverse_bits(), self.index).reverse_bits();
+        let x = laine_karras(q, self.x).reverse_bits();
+        let y = laine_karras(pascal_reversed(q), self.y).reverse_bits();
+        (x, y)
+    }
+}
+
 /// Sobol pairs of many samples at once: `(x[k], y[k])` is
-/// `pair_point_seeded(Sequence::Sobol, seeds[k], _, index[k])`, bit for
-/// bit, computed in SIMD lanes at `level` (AVX-512 / AVX2 where the CPU
-/// has it, else portable code): no table lookups, dimension 0's matrix
-/// product is a bit reversal and dimension 1's five shift-and-xor steps
-/// (`pascal_reversed`).
+/// `pair_point_seeded(Sequence::Sobol, s, _, index[k])` for
+/// `keys[k] = SobolKeys::new(s)`, bit for bit, computed in 32-bit SIMD
+/// lanes at `level` (AVX-512 / AVX2 where the CPU has it, else portable
+/// code): no table lookups, dimension 0's matrix product is a bit reversal
+/// and dimension 1's five shift-and-xor steps (`pascal_reversed`).
 ///
 /// # Panics
 /// If the four slices differ in length.
 pub fn sobol_pairs(
     level: crate::batch::SimdLevel,
-    seeds: &[u64],
+    seeds: &[SobolKeys],
     index: &[u32],
     x: &mut [f64],
     y: &mut [f64],
@@ -494,13 +530,13 @@ pub fn sobol_pairs(
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
-fn sobol_pairs_avx2(seeds: &[u64], index: &[u32], x: &mut [f64], y: &mut [f64]) {
+fn sobol_pairs_avx2(seeds: &[SobolKeys], index: &[u32], x: &mut [f64], y: &mut [f64]) {
     sobol_pairs_lanes(seeds, index, x, y);
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,avx512dq,avx512bw,avx512vl,avx2,fma")]
-fn sobol_pairs_avx512(seeds: &[u64], index: &[u32], x: &mut [f64], y: &mut [f64]) {
+fn sobol_pairs_avx512(seeds: &[SobolKeys], index: &[u32], x: &mut [f64], y: &mut [f64]) {
     sobol_pairs_lanes(seeds, index, x, y);
 }
 
@@ -523,12 +559,10 @@ fn pascal_reversed(q: u32) -> u32 {
 /// [`sobol_pairs`] as one plain loop over the lanes (which the compiler
 /// vectorizes at the caller's SIMD level).
 #[inline(always)]
-fn sobol_pairs_lanes(seeds: &[u64], index: &[u32], x: &mut [f64], y: &mut [f64]) {
+fn sobol_pairs_lanes(seeds: &[SobolKeys], index: &[u32], x: &mut [f64], y: &mut [f64]) {
     let k = 1.0 / 4_294_967_296.0;
     for (((&s, &i), xo), yo) in seeds.iter().zip(index).zip(x).zip(y) {
-        let q = laine_karras(i.reverse_bits(), s as u32).reverse_bits();
-        let xv = laine_karras(q, (s >> 32) as u32).reverse_bits();
-        let yv = laine_karras(pascal_reversed(q), hash64(s) as u32).reverse_bits();
+        let (xv, yv) = s.point(i);
         *xo = f64::from(xv) * k;
         *yo = f64::from(yv) * k;
     }
@@ -561,12 +595,13 @@ mod tests {
         // Lengths around the chunk size, indices of every magnitude.
         for n in [0usize, 1, 63, 64, 65, 200] {
             let seeds: Vec<u64> = (0..n as u64).map(|k| hash64(k / 7 + 3)).collect();
+            let keys: Vec<SobolKeys> = seeds.iter().map(|&s| SobolKeys::new(s)).collect();
             let index: Vec<u32> = (0..n as u32)
                 .map(|k| if k % 5 == 4 { u32::MAX - k } else { k * 977 })
                 .collect();
             for level in SimdLevel::ALL.into_iter().filter(|l| l.is_available()) {
                 let (mut x, mut y) = (vec![0.0; n], vec![0.0; n]);
-                sobol_pairs(level, &seeds, &index, &mut x, &mut y);
+                sobol_pairs(level, &keys, &index, &mut x, &mut y);
                 for k in 0..n {
                     let want = pair_point_seeded(Sequence::Sobol, seeds[k], 1, u64::from(index[k]));
                     assert_eq!([x[k], y[k]], want, "{level:?} lane {k} of {n}");

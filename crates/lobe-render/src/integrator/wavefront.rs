@@ -10,12 +10,12 @@ use crate::lanes::{HitLanes, NO_HIT, RayLanes, Vec3Lanes, spawn_many};
 use crate::scene::Scene;
 use glam::{DVec2, DVec3};
 use lobe::batch::{
-    BatchSampler, Dirs, DirsMut, EvalPdfOutput, RgbMut, SampleInput, SampleOutput, SimdLevel,
+    BatchSampler, Dirs, DirsMut, EvalPdfOutput, RgbMut, SampleInput, SampleOutput, SimdLevel, Step,
 };
 use lobe::envmap::{EnvLookup, EnvMap};
 use lobe::estimator::{Allocation, Heuristic, MisForm, Pilot, Strategy};
 use lobe::math::{Rgb, luminance};
-use lobe::sequence::{Sequence, hash64, pair_point_seeded, pair_seed, sobol_pairs};
+use lobe::sequence::{Sequence, SobolKeys, hash64, pair_point_seeded, pair_seed, sobol_pairs};
 use lobe::{BsdfStrategy, Frame};
 
 /// Samples shaded together: camera rays, then every BSDF draw of the block
@@ -194,13 +194,13 @@ struct Lanes {
     starts: Vec<usize>,
     /// The block's Sobol pairs: per sample, the seeds of its [`PAIRS`]
     /// pairs, its index, and the points.
-    pair_seeds: [Vec<u64>; PAIRS],
+    pair_seeds: [Vec<SobolKeys>; PAIRS],
     pair_index: Vec<u32>,
     pair_x: [Vec<f64>; PAIRS],
     pair_y: [Vec<f64>; PAIRS],
     /// The seeds (pairs 1.. of [`PixelSeeds::all`]) and indices of the
     /// samples that hit.
-    hit_seeds: [Vec<u64>; PAIRS],
+    hit_seeds: [Vec<SobolKeys>; PAIRS],
     hit_index: Vec<u32>,
     /// The block's light draws `(compensated, u)`, their results, and
     /// (here and for `bsdf_dirs`) their draw indices.
@@ -298,7 +298,50 @@ impl Batch<'_> {
     /// [`FirstBounce::Pilot`]), each sample's draws are recorded in its
     /// pixel's [`Pilot`] as [`lobe::estimator::ShadingEstimator::estimate_pilot`]
     /// records them.
+    ///
+    /// The whole row runs at the block's SIMD level ([`SimdLevel::run`]):
+    /// the glue between the batch calls is compiled with the level's
+    /// instructions too (the same arithmetic, so the same bits).
     pub(super) fn row(
+        &self,
+        ctx: &Context<'_>,
+        y: usize,
+        row: &mut [Rgb],
+        mode: &(dyn Fn(usize) -> FirstBounce + Sync),
+        pilots: Option<&mut [Pilot]>,
+    ) -> RenderStats {
+        struct Row<'r, 'b, 'c> {
+            batch: &'r Batch<'b>,
+            ctx: &'r Context<'c>,
+            y: usize,
+            row: &'r mut [Rgb],
+            mode: &'r (dyn Fn(usize) -> FirstBounce + Sync),
+            pilots: Option<&'r mut [Pilot]>,
+            stats: &'r mut RenderStats,
+        }
+        impl Step for Row<'_, '_, '_> {
+            #[inline(always)]
+            fn run(self) {
+                *self.stats =
+                    self.batch
+                        .row_at_level(self.ctx, self.y, self.row, self.mode, self.pilots);
+            }
+        }
+        let mut stats = RenderStats::default();
+        self.level.run(Row {
+            batch: self,
+            ctx,
+            y,
+            row,
+            mode,
+            pilots,
+            stats: &mut stats,
+        });
+        stats
+    }
+
+    #[inline(always)]
+    fn row_at_level(
         &self,
         ctx: &Context<'_>,
         y: usize,
@@ -349,7 +392,7 @@ impl Batch<'_> {
                 }
                 if sobol {
                     for (v, s) in lanes.pair_seeds.iter_mut().zip(seeds.all()) {
-                        v.extend(std::iter::repeat_n(s, run));
+                        v.extend(std::iter::repeat_n(SobolKeys::new(s), run));
                     }
                 }
                 f += run as u64;
@@ -431,6 +474,7 @@ impl Batch<'_> {
     /// radiance for a sample whose ray escapes, else zero. With
     /// independent or stratified numbers (`lanes.each`) the points also get
     /// their draws' numbers.
+    #[inline(always)]
     fn camera_points(
         &self,
         ctx: &Context<'_>,
@@ -500,6 +544,7 @@ impl Batch<'_> {
     /// [`PixelSeeds::all`]), as the scalar loop takes them: the BSDF point
     /// `[bsdf_uc.x, bsdf_u]`, the light point `[bsdf_uc.y, light]`; light
     /// sampling alone takes the light point.
+    #[inline(always)]
     fn assign_u(&self, pt: &mut Point, pair: impl Fn(usize) -> DVec2) {
         let plan = pt.plan;
         let light_alone = matches!(self.kind, Kind::Light);
@@ -530,6 +575,7 @@ impl Batch<'_> {
     /// The draws of a block: BSDF samples and light samples' `f` and pdf
     /// in batches per object, then the shadow rays and the estimates (into
     /// `lanes.value`, at each point's sample).
+    #[inline(always)]
     fn shade(
         &self,
         scene: &Scene,
@@ -731,6 +777,7 @@ impl Batch<'_> {
 
     /// The draws `keys[range]` (all of object `obj`): BSDF draws sampled,
     /// light draws evaluated, each kind in one batch call.
+    #[inline(always)]
     fn batch_group(
         &self,
         obj: usize,
