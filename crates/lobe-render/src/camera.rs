@@ -129,9 +129,93 @@ impl Camera {
     }
 }
 
+impl Camera {
+    /// A film-space box `[x0, x1, y0, y1]` (pixels) outside of which no
+    /// camera ray meets the axis-aligned box `lo..=hi`: the bounds of its
+    /// eight corners' projections (the projection of a convex box is the
+    /// hull of its corners'), widened by a pixel; `None` when a corner is
+    /// not in front of the camera (no such bound).
+    #[must_use]
+    pub fn film_bounds(&self, lo: DVec3, hi: DVec3) -> Option<[f64; 4]> {
+        let mut b = [
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+        ];
+        for k in 0..8 {
+            let c = DVec3::new(
+                if k & 1 == 0 { lo.x } else { hi.x },
+                if k & 2 == 0 { lo.y } else { hi.y },
+                if k & 4 == 0 { lo.z } else { hi.z },
+            );
+            // In front with a margin: a corner near the eye plane
+            // projects far off and gives no useful bound anyway.
+            if (c - self.origin).dot(self.forward) <= 1e-6 * (1.0 + c.length()) {
+                return None;
+            }
+            let (x, y) = self.project(c)?;
+            b = [b[0].min(x), b[1].max(x), b[2].min(y), b[3].max(y)];
+        }
+        b.iter()
+            .all(|v| v.is_finite())
+            .then(|| [b[0] - 1.0, b[1] + 1.0, b[2] - 1.0, b[3] + 1.0])
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::geometry::Sphere;
+
+    #[test]
+    fn film_bounds_hold_every_ray_that_meets_the_sphere() {
+        let cam = Camera::new(
+            DVec3::new(0.3, 1.0, 5.5),
+            DVec3::new(0.0, 1.0, 0.0),
+            DVec3::Y,
+            36.0,
+            160,
+            120,
+        )
+        .unwrap();
+        for (center, radius) in [
+            (DVec3::new(-1.05, 1.0, 0.0), 0.9),
+            (DVec3::new(1.6, 0.2, 3.0), 0.5),
+            (DVec3::new(0.0, 1.0, 4.0), 1.0),
+        ] {
+            let s = Sphere { center, radius };
+            let r = DVec3::splat(radius);
+            let b = cam.film_bounds(center - r, center + r).expect("in front");
+            // The benchmark's sphere: a box well inside the film.
+            if radius == 0.9 {
+                assert!(b[1] - b[0] < 80.0 && b[3] - b[2] < 80.0, "{b:?}");
+            }
+            let (mut inside, mut outside) = (0, 0);
+            for j in 0..600 {
+                for i in 0..800 {
+                    let (x, y) = (i as f64 * 0.2, j as f64 * 0.2);
+                    if s.intersect(&cam.ray(x, y), f64::INFINITY).is_none() {
+                        continue;
+                    }
+                    if (b[0]..=b[1]).contains(&x) && (b[2]..=b[3]).contains(&y) {
+                        inside += 1;
+                    } else {
+                        outside += 1;
+                    }
+                }
+            }
+            assert!(inside > 100, "{center}: {inside} hits");
+            assert_eq!(outside, 0, "{center}: hits outside {b:?}");
+        }
+        // Around or behind the camera: no bound.
+        let o = cam.origin;
+        assert_eq!(cam.film_bounds(o - 1.0, o + 1.0), None);
+        assert_eq!(
+            cam.film_bounds(o + DVec3::new(0.0, 0.0, 1.0), o + 2.0),
+            None
+        );
+    }
 
     #[test]
     fn right_is_right_and_up_is_up() {

@@ -294,11 +294,28 @@ impl Scene {
     /// [`Scene::intersect`] of every ray of `rays` with `t_max = ∞`, into
     /// `out` (resized to their number): the same hits, bit for bit.
     pub fn intersect_many(&self, level: SimdLevel, rays: &RayLanes, out: &mut HitLanes) {
+        self.intersect_many_where(level, rays, out, |_| true);
+    }
+
+    /// [`Scene::intersect_many`] with the objects `k` for which `may_hit(k)`
+    /// is false left out: the same hits when no ray meets those (a caller
+    /// that knows where the rays go, such as a block of camera rays and
+    /// [`crate::camera::Camera::film_bounds`]).
+    pub fn intersect_many_where(
+        &self,
+        level: SimdLevel,
+        rays: &RayLanes,
+        out: &mut HitLanes,
+        may_hit: impl Fn(usize) -> bool,
+    ) {
         let n = rays.len();
         out.resize(n);
         out.t[..n].fill(f64::INFINITY);
         out.obj[..n].fill(NO_HIT);
         for (k, o) in self.objects.iter().enumerate() {
+            if !may_hit(k) {
+                continue;
+            }
             match &o.shape {
                 Shape::Sphere(s) => level.run(SphereHits(s, k as u32, rays, out)),
                 Shape::Plane(p) => level.run(PlaneHits(p, k as u32, rays, out)),

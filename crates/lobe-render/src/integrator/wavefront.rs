@@ -7,7 +7,7 @@
 
 use super::{Context, FirstBounce, RenderStats, dims, pixel_seed};
 use crate::lanes::{HitLanes, NO_HIT, RayLanes, Vec3Lanes, spawn_many};
-use crate::scene::Scene;
+use crate::scene::{Scene, Shape};
 use glam::{DVec2, DVec3};
 use lobe::batch::{
     BatchSampler, Dirs, DirsMut, EvalPdfOutput, RgbMut, SampleInput, SampleOutput, SimdLevel, Step,
@@ -61,6 +61,10 @@ pub(super) struct Batch<'a> {
     env: &'a EnvMap,
     /// The SIMD level of the block's Sobol points (the BSDF kernels').
     level: SimdLevel,
+    /// Per object, the film box outside of which no camera ray meets it
+    /// ([`crate::camera::Camera::film_bounds`] of a sphere's bounding box),
+    /// or `None` (planes, meshes, a sphere behind or around the camera).
+    film_bounds: Vec<Option<[f64; 4]>>,
 }
 
 /// Why the batch loop does not render `scene` with `strategy` and
@@ -118,11 +122,23 @@ impl<'a> Batch<'a> {
         let level = samplers
             .first()
             .map_or_else(SimdLevel::best, BatchSampler::level);
+        let film_bounds = scene
+            .objects
+            .iter()
+            .map(|o| match &o.shape {
+                Shape::Sphere(s) => {
+                    let r = DVec3::splat(s.radius * (1.0 + 1e-9));
+                    scene.camera.film_bounds(s.center - r, s.center + r)
+                }
+                Shape::Plane(_) | Shape::Mesh(_) => None,
+            })
+            .collect();
         Ok(Batch {
             samplers,
             kind,
             env: &scene.environment,
             level,
+            film_bounds,
         })
     }
 
@@ -488,8 +504,16 @@ impl Batch<'_> {
             .rays_many(self.level, &lanes.film.0, &lanes.film.1, &mut lanes.rays);
         stats.camera_rays += n as u64;
         stats.rays += n as u64;
+        // The objects whose film box the block's pixels overlap (the block
+        // covers [x0, x1 + 1) × [y, y + 1) of the film).
+        let (x0, x1) = (lanes.px[0], lanes.px[n - 1] + 1.0);
+        let y = lanes.film.1[0].floor();
+        let may_hit = |k: usize| {
+            self.film_bounds[k]
+                .is_none_or(|b| x1 >= b[0] && x0 <= b[1] && y + 1.0 >= b[2] && y <= b[3])
+        };
         ctx.scene
-            .intersect_many(self.level, &lanes.rays, &mut lanes.hits);
+            .intersect_many_where(self.level, &lanes.rays, &mut lanes.hits, may_hit);
         lanes.bsdf_dirs.clear();
         lanes.draw_index.clear();
         lanes.value.clear();
