@@ -43,6 +43,13 @@ impl Vec3Lanes {
         self.z.push(v.z);
     }
 
+    /// The first `n` entries kept.
+    pub fn truncate(&mut self, n: usize) {
+        self.x.truncate(n);
+        self.y.truncate(n);
+        self.z.truncate(n);
+    }
+
     /// `n` entries (zeros where new).
     pub fn resize(&mut self, n: usize) {
         self.x.resize(n, 0.0);

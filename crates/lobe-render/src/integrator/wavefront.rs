@@ -36,12 +36,17 @@ enum Kind {
     Adaptive,
 }
 
-/// What one of a sample's two draws is.
+/// What one of a sample's two draws is (a plain `u8`: the loop compares
+/// them often).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[repr(u8)]
 enum Slot {
     Unused,
     Bsdf,
-    Light { compensated: bool },
+    /// A light draw from the plain distribution.
+    Light,
+    /// A light draw from the MIS-compensated distribution.
+    LightCompensated,
 }
 
 /// A pixel's draws and how they combine.
@@ -145,10 +150,10 @@ impl<'a> Batch<'a> {
     fn plan(&self, mode: FirstBounce) -> PixelPlan {
         let mean = |slots| PixelPlan { slots, mis: None };
         let mis = |h| PixelPlan {
-            slots: [Slot::Bsdf, Slot::Light { compensated: true }],
+            slots: [Slot::Bsdf, Slot::LightCompensated],
             mis: Some(h),
         };
-        let plain = Slot::Light { compensated: false };
+        let plain = Slot::Light;
         match (self.kind, mode) {
             (Kind::Bsdf, _) => mean([Slot::Bsdf, Slot::Unused]),
             (Kind::Light, _) => mean([plain, Slot::Unused]),
@@ -236,6 +241,8 @@ struct Lanes {
     /// Each sample's pixel column, plan, and value (the map's radiance
     /// where its camera ray escapes, else its estimate).
     px: Vec<f64>,
+    /// The block's pixels in order: `(column, samples of it)`.
+    runs: Vec<(usize, usize)>,
     plans: Vec<PixelPlan>,
     value: Vec<Rgb>,
     /// The block's camera rays and their hits; then its shadow rays.
@@ -279,6 +286,7 @@ impl Lanes {
             film: (Vec::with_capacity(BLOCK), Vec::with_capacity(BLOCK)),
             each: Vec::with_capacity(BLOCK),
             px: Vec::with_capacity(BLOCK),
+            runs: Vec::with_capacity(BLOCK),
             plans: Vec::with_capacity(BLOCK),
             value: Vec::with_capacity(BLOCK),
             rays: RayLanes::default(),
@@ -384,6 +392,7 @@ impl Batch<'_> {
             }
             lanes.pair_index.clear();
             lanes.px.clear();
+            lanes.runs.clear();
             lanes.plans.clear();
             lanes.each.clear();
             let mut f = k;
@@ -393,6 +402,7 @@ impl Batch<'_> {
                 let seeds = pixel_seeds(ctx, x, y);
                 let plan = self.plan(mode(x));
                 lanes.px.extend(std::iter::repeat_n(x as f64, run));
+                lanes.runs.push((x, run));
                 lanes.plans.extend(std::iter::repeat_n(plan, run));
                 for i in i0..i0 + run as u64 {
                     let index = match ctx.sequence {
@@ -471,12 +481,20 @@ impl Batch<'_> {
                 &mut stats,
                 pilots.as_deref_mut(),
             );
-            for (&x, v) in lanes.px.iter().zip(&lanes.value) {
-                if v.is_finite() {
-                    row[x as usize] += *v;
-                } else {
-                    stats.nonfinite += 1;
+            // Each pixel's values added to its sum in sample order, the sum
+            // held in a register over the pixel's run.
+            let mut m = 0;
+            for &(x, run) in &lanes.runs {
+                let mut acc = row[x];
+                for v in &lanes.value[m..m + run] {
+                    if v.is_finite() {
+                        acc += *v;
+                    } else {
+                        stats.nonfinite += 1;
+                    }
                 }
+                row[x] = acc;
+                m += run;
             }
             (ctx.progress)(end - k);
             k = end;
@@ -614,14 +632,21 @@ impl Batch<'_> {
         lanes.keys.clear();
         lanes.light_u.clear();
         lanes.draw_index.clear();
-        let key = |obj: u32, di: usize| (u64::from(obj) << 32) | di as u64;
+        // A draw's key: its bucket (object, then BSDF 0 / light 1) above
+        // its draw index.
+        let key = |obj: u32, light: bool, di: usize| {
+            ((2 * u64::from(obj) + u64::from(light)) << 32) | di as u64
+        };
         for (i, pt) in pts.iter().enumerate() {
             for s in 0..2 {
-                draws[2 * i + s] = Draw::default();
+                // Every other field of a draw is written before it is read
+                // (a light draw that gets no direction stays not `ok`).
+                draws[2 * i + s].ok = false;
                 match pt.plan.slots[s] {
                     Slot::Unused => {}
-                    Slot::Bsdf => lanes.keys.push(key(pt.obj, 2 * i + s)),
-                    Slot::Light { compensated } => {
+                    Slot::Bsdf => lanes.keys.push(key(pt.obj, false, 2 * i + s)),
+                    slot @ (Slot::Light | Slot::LightCompensated) => {
+                        let compensated = slot == Slot::LightCompensated;
                         lanes
                             .light_u
                             .push((compensated, DVec2::new(pt.u[s][1], pt.u[s][2])));
@@ -647,46 +672,49 @@ impl Batch<'_> {
             d.dir = dir;
             d.wi = wi;
             d.light = Some(l);
-            lanes.keys.push(key(pt.obj, di));
+            lanes.keys.push(key(pt.obj, true, di));
         }
-        // Grouped by object, each group's BSDF draws and light draws in
-        // draw order (as they were pushed), so each batch call's lanes are
-        // in draw order.
-        let objects = self.samplers.len();
+        // Grouped by bucket (a stable counting sort), each bucket's draws in
+        // draw order, so each batch call's lanes are in draw order.
+        let buckets = 2 * self.samplers.len();
         lanes.starts.clear();
-        lanes.starts.resize(objects + 1, 0);
+        lanes.starts.resize(buckets + 1, 0);
         for &key in &lanes.keys {
             lanes.starts[(key >> 32) as usize + 1] += 1;
         }
-        for o in 0..objects {
-            lanes.starts[o + 1] += lanes.starts[o];
+        for b in 0..buckets {
+            lanes.starts[b + 1] += lanes.starts[b];
         }
         lanes.sorted.clear();
         lanes.sorted.resize(lanes.keys.len(), 0);
-        // Each group's start as its cursor, which ends at the next
-        // group's start; then shifted back.
+        // Each bucket's start as its cursor, which ends at the next
+        // bucket's start; then shifted back.
         for &key in &lanes.keys {
-            let o = (key >> 32) as usize;
-            lanes.sorted[lanes.starts[o]] = key;
-            lanes.starts[o] += 1;
+            let b = (key >> 32) as usize;
+            lanes.sorted[lanes.starts[b]] = key;
+            lanes.starts[b] += 1;
         }
-        lanes.starts.copy_within(0..objects, 1);
+        lanes.starts.copy_within(0..buckets, 1);
         lanes.starts[0] = 0;
         std::mem::swap(&mut lanes.keys, &mut lanes.sorted);
         // One batch call per object and kind of draw.
-        for obj in 0..objects {
-            let (g, e) = (lanes.starts[obj], lanes.starts[obj + 1]);
+        for b in 0..buckets {
+            let (g, e) = (lanes.starts[b], lanes.starts[b + 1]);
             if g < e {
-                self.batch_group(obj, g..e, pts, draws, lanes);
+                self.batch_group(b / 2, b % 2 == 0, g..e, pts, draws, lanes);
             }
         }
         // The shadow rays of the block, traced together: the BSDF draws'
         // (a failed draw when blocked), and the light draws' that carry
         // light (`f ≠ 0`).
-        lanes.shadow_p.clear();
-        lanes.shadow_ng.clear();
-        lanes.shadow_dir.clear();
-        lanes.shadow_draw.clear();
+        // Written by index into arrays of the most rays there can be, then
+        // cut to the rays there are.
+        let most = 2 * pts.len();
+        lanes.shadow_p.resize(most);
+        lanes.shadow_ng.resize(most);
+        lanes.shadow_dir.resize(most);
+        lanes.shadow_draw.resize(most, 0);
+        let mut r = 0;
         for (i, pt) in pts.iter().enumerate() {
             for s in 0..2 {
                 let di = 2 * i + s;
@@ -697,15 +725,20 @@ impl Batch<'_> {
                         d.dir = pt.frame.to_world(d.dir).normalize();
                         d.dir
                     }
-                    Slot::Light { .. } if d.ok && d.f != Rgb::ZERO => d.dir,
+                    Slot::Light | Slot::LightCompensated if d.ok && d.f != Rgb::ZERO => d.dir,
                     _ => continue,
                 };
-                lanes.shadow_p.push(pt.p);
-                lanes.shadow_ng.push(pt.ng);
-                lanes.shadow_dir.push(dir);
-                lanes.shadow_draw.push(di);
+                lanes.shadow_p.set(r, pt.p);
+                lanes.shadow_ng.set(r, pt.ng);
+                lanes.shadow_dir.set(r, dir);
+                lanes.shadow_draw[r] = di;
+                r += 1;
             }
         }
+        lanes.shadow_p.truncate(r);
+        lanes.shadow_ng.truncate(r);
+        lanes.shadow_dir.truncate(r);
+        lanes.shadow_draw.truncate(r);
         stats.rays += lanes.shadow_draw.len() as u64;
         spawn_many(
             self.level,
@@ -769,7 +802,8 @@ impl Batch<'_> {
                             Some(h) => v * h.weight(d.pdf, l.pdf_compensated),
                         };
                     }
-                    Slot::Light { compensated } => {
+                    Slot::Light | Slot::LightCompensated => {
+                        let compensated = slot == Slot::LightCompensated;
                         let l = d.light.expect("a light draw");
                         if d.f == Rgb::ZERO {
                             continue;
@@ -799,129 +833,123 @@ impl Batch<'_> {
         }
     }
 
-    /// The draws `keys[range]` (all of object `obj`): BSDF draws sampled,
-    /// light draws evaluated, each kind in one batch call.
+    /// The draws `keys[range]`, all of object `obj` and of one kind, in one
+    /// batch call: BSDF draws (`bsdf`) sampled, light draws evaluated.
     #[inline(always)]
     fn batch_group(
         &self,
         obj: usize,
+        bsdf: bool,
         range: std::ops::Range<usize>,
         pts: &[Point],
         draws: &mut [Draw],
         lanes: &mut Lanes,
     ) {
         let sampler = &self.samplers[obj];
-        for bsdf in [true, false] {
-            let mut m = 0;
-            for &key in &lanes.keys[range.clone()] {
-                let di = (key & 0xffff_ffff) as usize;
-                let (pt, s) = (&pts[di / 2], di % 2);
-                if (pt.plan.slots[s] == Slot::Bsdf) != bsdf {
-                    continue;
-                }
-                let a = &mut lanes.a;
-                a[0][m] = pt.wo.x as f32;
-                a[1][m] = pt.wo.y as f32;
-                a[2][m] = pt.wo.z as f32;
-                if bsdf {
-                    a[3][m] = pt.u[s][1] as f32;
-                    a[4][m] = pt.u[s][2] as f32;
-                    a[5][m] = pt.u[s][0] as f32;
-                } else {
-                    let wi = draws[di].wi;
-                    a[3][m] = wi.x as f32;
-                    a[4][m] = wi.y as f32;
-                    a[5][m] = wi.z as f32;
-                }
-                m += 1;
+        let mut m = 0;
+        for &key in &lanes.keys[range.clone()] {
+            let di = (key & 0xffff_ffff) as usize;
+            let (pt, s) = (&pts[di / 2], di % 2);
+            debug_assert_eq!(pt.plan.slots[s] == Slot::Bsdf, bsdf);
+            let a = &mut lanes.a;
+            a[0][m] = pt.wo.x as f32;
+            a[1][m] = pt.wo.y as f32;
+            a[2][m] = pt.wo.z as f32;
+            if bsdf {
+                a[3][m] = pt.u[s][1] as f32;
+                a[4][m] = pt.u[s][2] as f32;
+                a[5][m] = pt.u[s][0] as f32;
+            } else {
+                let wi = draws[di].wi;
+                a[3][m] = wi.x as f32;
+                a[4][m] = wi.y as f32;
+                a[5][m] = wi.z as f32;
             }
-            if m == 0 {
-                continue;
-            }
-            let [a0, a1, a2, a3, a4, a5] = &lanes.a;
-            let [o0, o1, o2, o3, o4, o5, o6, o7, o8, o9] = &mut lanes.out;
-            let wo = Dirs {
-                x: &a0[..m],
-                y: &a1[..m],
-                z: &a2[..m],
+            m += 1;
+        }
+        if m == 0 {
+            return;
+        }
+        let [a0, a1, a2, a3, a4, a5] = &lanes.a;
+        let [o0, o1, o2, o3, o4, o5, o6, o7, o8, o9] = &mut lanes.out;
+        let wo = Dirs {
+            x: &a0[..m],
+            y: &a1[..m],
+            z: &a2[..m],
+        };
+        if bsdf {
+            sampler
+                .sample(
+                    SampleInput {
+                        wo,
+                        u1: &a3[..m],
+                        u2: &a4[..m],
+                        uc: Some(&a5[..m]),
+                    },
+                    SampleOutput {
+                        wi: DirsMut {
+                            x: &mut o0[..m],
+                            y: &mut o1[..m],
+                            z: &mut o2[..m],
+                        },
+                        f: RgbMut {
+                            r: &mut o3[..m],
+                            g: &mut o4[..m],
+                            b: &mut o5[..m],
+                        },
+                        pdf: &mut o6[..m],
+                        weight: RgbMut {
+                            r: &mut o7[..m],
+                            g: &mut o8[..m],
+                            b: &mut o9[..m],
+                        },
+                        valid: &mut lanes.valid[..m],
+                    },
+                )
+                .expect("equal lengths, uc given");
+        } else {
+            sampler
+                .eval_pdf(
+                    wo,
+                    Dirs {
+                        x: &a3[..m],
+                        y: &a4[..m],
+                        z: &a5[..m],
+                    },
+                    EvalPdfOutput {
+                        f: RgbMut {
+                            r: &mut o3[..m],
+                            g: &mut o4[..m],
+                            b: &mut o5[..m],
+                        },
+                        pdf: &mut o6[..m],
+                    },
+                )
+                .expect("equal lengths");
+        }
+        let mut m = 0;
+        for &key in &lanes.keys[range.clone()] {
+            let di = (key & 0xffff_ffff) as usize;
+            debug_assert_eq!(pts[di / 2].plan.slots[di % 2] == Slot::Bsdf, bsdf);
+            let o = &lanes.out;
+            let d = &mut draws[di];
+            let rgb = |k: usize| {
+                Rgb::new(
+                    f64::from(o[k][m]),
+                    f64::from(o[k + 1][m]),
+                    f64::from(o[k + 2][m]),
+                )
             };
             if bsdf {
-                sampler
-                    .sample(
-                        SampleInput {
-                            wo,
-                            u1: &a3[..m],
-                            u2: &a4[..m],
-                            uc: Some(&a5[..m]),
-                        },
-                        SampleOutput {
-                            wi: DirsMut {
-                                x: &mut o0[..m],
-                                y: &mut o1[..m],
-                                z: &mut o2[..m],
-                            },
-                            f: RgbMut {
-                                r: &mut o3[..m],
-                                g: &mut o4[..m],
-                                b: &mut o5[..m],
-                            },
-                            pdf: &mut o6[..m],
-                            weight: RgbMut {
-                                r: &mut o7[..m],
-                                g: &mut o8[..m],
-                                b: &mut o9[..m],
-                            },
-                            valid: &mut lanes.valid[..m],
-                        },
-                    )
-                    .expect("equal lengths, uc given");
+                d.ok = lanes.valid[m] == 1;
+                d.dir = DVec3::new(f64::from(o[0][m]), f64::from(o[1][m]), f64::from(o[2][m]));
+                d.f = rgb(7);
             } else {
-                sampler
-                    .eval_pdf(
-                        wo,
-                        Dirs {
-                            x: &a3[..m],
-                            y: &a4[..m],
-                            z: &a5[..m],
-                        },
-                        EvalPdfOutput {
-                            f: RgbMut {
-                                r: &mut o3[..m],
-                                g: &mut o4[..m],
-                                b: &mut o5[..m],
-                            },
-                            pdf: &mut o6[..m],
-                        },
-                    )
-                    .expect("equal lengths");
+                d.ok = true;
+                d.f = rgb(3);
             }
-            let mut m = 0;
-            for &key in &lanes.keys[range.clone()] {
-                let di = (key & 0xffff_ffff) as usize;
-                let (pt, s) = (&pts[di / 2], di % 2);
-                if (pt.plan.slots[s] == Slot::Bsdf) != bsdf {
-                    continue;
-                }
-                let o = &lanes.out;
-                let d = &mut draws[di];
-                let rgb = |k: usize| {
-                    Rgb::new(
-                        f64::from(o[k][m]),
-                        f64::from(o[k + 1][m]),
-                        f64::from(o[k + 2][m]),
-                    )
-                };
-                if bsdf {
-                    d.ok = lanes.valid[m] == 1;
-                    d.dir = DVec3::new(f64::from(o[0][m]), f64::from(o[1][m]), f64::from(o[2][m]));
-                    d.f = rgb(7);
-                } else {
-                    d.ok = true;
-                    d.f = rgb(3);
-                }
-                d.pdf = f64::from(o[6][m]);
-                m += 1;
-            }
+            d.pdf = f64::from(o[6][m]);
+            m += 1;
         }
     }
 }
