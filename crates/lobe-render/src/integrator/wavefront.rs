@@ -70,6 +70,8 @@ pub(super) struct Batch<'a> {
     /// ([`crate::camera::Camera::film_bounds`] of a sphere's bounding box),
     /// or `None` (planes, meshes, a sphere behind or around the camera).
     film_bounds: Vec<Option<[f64; 4]>>,
+    /// Whether a material of the scene chooses a lobe (reads `uc`).
+    lobe_choice: bool,
 }
 
 /// Why the batch loop does not render `scene` with `strategy` and
@@ -138,7 +140,9 @@ impl<'a> Batch<'a> {
                 Shape::Plane(_) | Shape::Mesh(_) => None,
             })
             .collect();
+        let lobe_choice = samplers.iter().any(BatchSampler::chooses_lobe);
         Ok(Batch {
+            lobe_choice,
             samplers,
             kind,
             env: &scene.environment,
@@ -454,12 +458,12 @@ impl Batch<'_> {
                 for pt in &pts {
                     let m = pt.m as usize;
                     lanes.hit_index.push(lanes.pair_index[m]);
-                    for p in 1..PAIRS {
+                    for p in self.shading_pairs() {
                         lanes.hit_seeds[p].push(lanes.pair_seeds[p][m]);
                     }
                 }
                 let n = lanes.hit_index.len();
-                for p in 1..PAIRS {
+                for p in self.shading_pairs() {
                     sobol_pairs(
                         self.level,
                         &lanes.hit_seeds[p],
@@ -582,6 +586,14 @@ impl Batch<'_> {
         }
     }
 
+    /// The pairs of [`PixelSeeds::all`] a sample that hits draws: all but
+    /// the camera's, and not the lobe choice's when no material chooses a
+    /// lobe (nothing reads it).
+    fn shading_pairs(&self) -> impl Iterator<Item = usize> + use<> {
+        let lobe_choice = self.lobe_choice;
+        (1..PAIRS).filter(move |&p| p != 2 || lobe_choice)
+    }
+
     /// The numbers of `pt`'s draws from its pairs (`pair(p)`, pair `p` of
     /// [`PixelSeeds::all`]), as the scalar loop takes them: the BSDF point
     /// `[bsdf_uc.x, bsdf_u]`, the light point `[bsdf_uc.y, light]`; light
@@ -590,8 +602,9 @@ impl Batch<'_> {
     fn assign_u(&self, pt: &mut Point, pair: impl Fn(usize) -> DVec2) {
         let plan = pt.plan;
         let light_alone = matches!(self.kind, Kind::Light);
-        // Light draws do not read `uc`.
-        let uc = if plan.slots.contains(&Slot::Bsdf) {
+        // Light draws do not read `uc`, nor a BSDF draw of a scene where no
+        // material chooses a lobe.
+        let uc = if self.lobe_choice && plan.slots.contains(&Slot::Bsdf) {
             pair(2)
         } else {
             DVec2::ZERO
