@@ -65,9 +65,10 @@ printed and adds in quadrature to every measured error.
 
 Time to 1%: for each renderer, spp doubles from --start-spp until the error is
 at most --target (default 0.01); "spp" and "time" are the first ladder step
-that reaches it (its warm render time: Mitsuba renders once more, with
-another seed, when the first render of a spp compiled a kernel, as Dr.Jit's
-kernel history shows; stratified samplers compile one kernel per spp). The
+that reaches it (its warm render time: Mitsuba renders every spp twice, a
+warm-up that compiles the kernels unless Dr.Jit's cache has them, then the
+timed render with a fixed seed per step, so that its error does not depend on
+the cache; stratified samplers compile one kernel per spp). The
 "interp." columns interpolate between the last two steps (error as a power of
 spp, time linear in spp), since doubling alone can overstate the time by up
 to 2x. A ladder stops early when one render takes more than --max-seconds.
@@ -452,9 +453,14 @@ def main():
         scene = build_mitsuba_scene(cam, spheres, maps["mitsuba"], s, args.start_spp, comp)
 
         def render(spp, k, scene=scene):
-            img, t, compiled, used = mi_render(scene, spp, 2 * k + 1)
-            if compiled:  # time it warm
-                img, t, compiled, used = mi_render(scene, spp, 2 * k + 2)
+            # Always a warm-up render first (it compiles the kernels unless
+            # Dr.Jit's cache has them), then the timed one: warm, and with
+            # the same seed whatever the cache held, so that the error of a
+            # step is the same in every run of the script.
+            mi_render(scene, spp, 2 * k + 1)
+            img, t, compiled, used = mi_render(scene, spp, 2 * k + 2)
+            if compiled:
+                print(f"  (spp {spp}: the timed render compiled a kernel too)", file=sys.stderr)
             return img, t, used
 
         results[name] = ladder(name, render, args.start_spp, args.target,
