@@ -80,8 +80,10 @@
 //! direct lighting (`max_depth = 1`) with a BSDF strategy, `light`, or MIS
 //! with one BSDF and one light draw (`mis`, `mis-balance`, `mis-power`),
 //! each row is rendered in blocks of [`BLOCK`] samples (consecutive samples
-//! of consecutive pixels): the camera rays and their hits (f64 lanes,
-//! [`crate::lanes`]; the escaping rays' radiance from
+//! of consecutive pixels), the whole row at the block's SIMD level: the
+//! camera rays and their hits (f64 lanes, [`crate::lanes`], testing only
+//! the spheres whose film box ([`crate::camera::Camera::film_bounds`]) the
+//! block's pixels overlap; the escaping rays' radiance from
 //! [`lobe::envmap::EnvMap::eval_many`]), then every BSDF draw of the block in one
 //! [`lobe::batch::BatchSampler::sample`] call per object and every light
 //! draw's `f` and BSDF pdf in one [`lobe::batch::BatchSampler::eval_pdf`]

@@ -210,15 +210,15 @@ struct Lanes {
     a: [Vec<f32>; 6],
     out: [Vec<f32>; 10],
     valid: Vec<u8>,
-    /// (object, draw index) of every BSDF or light draw, grouped by
-    /// object (a stable counting sort, through `sorted` and the per-object
-    /// `starts`): in each group the BSDF draws and the light draws each
-    /// in draw order.
+    /// (bucket, draw index) of every BSDF or light draw, the bucket
+    /// `2 · object + (1 for a light draw)`, grouped by bucket (a stable
+    /// counting sort, through `sorted` and the per-bucket `starts`): in
+    /// each bucket the draws in draw order.
     keys: Vec<u64>,
     sorted: Vec<u64>,
     starts: Vec<usize>,
-    /// The block's Sobol pairs: per sample, the seeds of its [`PAIRS`]
-    /// pairs, its index, and the points.
+    /// The block's Sobol pairs: per sample, the scramble keys of its
+    /// [`PAIRS`] pairs, its index, and the points.
     pair_seeds: [Vec<SobolKeys>; PAIRS],
     pair_index: Vec<u32>,
     pair_x: [Vec<f64>; PAIRS],
