@@ -304,6 +304,13 @@ impl Lanes {
     }
 }
 
+thread_local! {
+    /// A worker thread's row buffers, kept between the rows it renders (a
+    /// row's would otherwise be allocated and zeroed for each row).
+    static ROW_BUFFERS: std::cell::Cell<Option<(Lanes, Vec<Point>, Vec<Draw>)>> =
+        const { std::cell::Cell::new(None) };
+}
+
 /// The pair seeds of one pixel.
 #[derive(Debug, Clone, Copy)]
 struct PixelSeeds {
@@ -378,9 +385,15 @@ impl Batch<'_> {
         mut pilots: Option<&mut [Pilot]>,
     ) -> RenderStats {
         let mut stats = RenderStats::default();
-        let mut lanes = Lanes::new();
-        let mut pts: Vec<Point> = Vec::with_capacity(BLOCK);
-        let mut draws = vec![Draw::default(); 2 * BLOCK];
+        // The thread's buffers from its last row (every block writes what
+        // it reads), or new ones.
+        let (mut lanes, mut pts, mut draws) = ROW_BUFFERS.take().unwrap_or_else(|| {
+            (
+                Lanes::new(),
+                Vec::with_capacity(BLOCK),
+                vec![Draw::default(); 2 * BLOCK],
+            )
+        });
         let spp = ctx.spp;
         let total = row.len() as u64 * spp;
         let mut k = 0u64;
@@ -503,6 +516,7 @@ impl Batch<'_> {
             (ctx.progress)(end - k);
             k = end;
         }
+        ROW_BUFFERS.set(Some((lanes, pts, draws)));
         stats
     }
 
