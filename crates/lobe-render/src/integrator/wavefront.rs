@@ -304,11 +304,13 @@ impl Lanes {
     }
 }
 
+/// A row's reusable buffers: its lanes, points and draws.
+type RowBuffers = (Lanes, Vec<Point>, Vec<Draw>);
+
 thread_local! {
     /// A worker thread's row buffers, kept between the rows it renders (a
     /// row's would otherwise be allocated and zeroed for each row).
-    static ROW_BUFFERS: std::cell::Cell<Option<(Lanes, Vec<Point>, Vec<Draw>)>> =
-        const { std::cell::Cell::new(None) };
+    static ROW_BUFFERS: std::cell::Cell<Option<RowBuffers>> = const { std::cell::Cell::new(None) };
 }
 
 /// The pair seeds of one pixel.
@@ -954,8 +956,7 @@ impl Batch<'_> {
                 )
                 .expect("equal lengths");
         }
-        let mut m = 0;
-        for &key in &lanes.keys[range.clone()] {
+        for (m, &key) in lanes.keys[range].iter().enumerate() {
             let di = (key & 0xffff_ffff) as usize;
             debug_assert_eq!(pts[di / 2].plan.slots[di % 2] == Slot::Bsdf, bsdf);
             let o = &lanes.out;
@@ -976,7 +977,6 @@ impl Batch<'_> {
                 d.f = rgb(3);
             }
             d.pdf = f64::from(o[6][m]);
-            m += 1;
         }
     }
 }
