@@ -371,7 +371,8 @@ def main():
     p.add_argument("--threads", type=int, default=os.cpu_count() or 1,
                    help="threads of both renderers (default: every CPU)")
     p.add_argument("--samplers", default=",".join(SAMPLERS))
-    p.add_argument("--lobe-strategy", default="mis", help="lobe render --strategy (default mis)")
+    p.add_argument("--lobe-strategy", default="mis",
+                   help="lobe render --strategy, or several separated by commas, a row each (default mis)")
     p.add_argument("--lobe-sequence", default="",
                    help="comma-separated `lobe render --sequence` values (sobol, stratified, independent), "
                         "one lobe row each (default: lobe's default, sobol)")
@@ -478,16 +479,17 @@ def main():
 
     seqs = [q.strip() for q in args.lobe_sequence.split(",") if q.strip()] or [None]
     loops = [q.strip() for q in args.lobe_loop.split(",") if q.strip()] or [None]
-    for seq, lp in [] if args.skip_lobe else [(q, l) for q in seqs for l in loops]:
-        name = (f"lobe {args.lobe_strategy}" + (f" --sequence {seq}" if seq else "")
+    strats = [q.strip() for q in args.lobe_strategy.split(",") if q.strip()] or ["mis"]
+    for st, seq, lp in [] if args.skip_lobe else [(a, q, l) for a in strats for q in seqs for l in loops]:
+        name = (f"lobe {st}" + (f" --sequence {seq}" if seq else "")
                 + (f" --loop {lp}" if lp else ""))
         print(name, file=sys.stderr, flush=True)
 
-        def render_lobe(spp, k, seq=seq, lp=lp):
-            tag = (seq + "-" if seq else "") + (lp + "-" if lp else "")
+        def render_lobe(spp, k, st=st, seq=seq, lp=lp):
+            tag = (st + "-" if st != "mis" else "") + (seq + "-" if seq else "") + (lp + "-" if lp else "")
             out = os.path.join(args.out, f"lobe-{tag}{spp}")
             cmd = [args.lobe, "render", lobe_scene, "--spp", str(spp), "--seed", str(k + 1),
-                   "--threads", str(args.threads), "--strategy", args.lobe_strategy,
+                   "--threads", str(args.threads), "--strategy", st,
                    "--out", out, "-q"] + (["--sequence", seq] if seq else []) + (["--loop", lp] if lp else [])
             t = float("inf")
             for _ in range(args.repeat):
@@ -520,7 +522,7 @@ def main():
     print(f"Scene bench/two_spheres.toml, {cam.get('width')}x{cam.get('height')}, {int(mask.sum())} sphere "
           f"pixels; CPU {cpu}, {args.threads} threads; Mitsuba {mi.__version__} llvm_ad_rgb `direct` "
           f"(1 emitter + 1 BSDF sample per spp); lobe commit {lobe_ver}, `lobe render --strategy "
-          f"{args.lobe_strategy}`.  ")
+          f"{' / '.join(strats)}`.  ")
     print(f"Reference: Mitsuba {args.ref_sampler}, {args.ref_passes} x {per} spp, its own rel. RMSE "
           f"{100 * ref_err:.3f}%. Load average at the end {load}. Target: rel. RMSE "
           f"{100 * args.target:g}% over the sphere pixels.")
