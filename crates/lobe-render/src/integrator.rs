@@ -357,11 +357,18 @@ fn is_adaptive(s: Strategy) -> bool {
 
 /// Pilot samples per pixel of adaptive MIS for passes of `spp`: extra
 /// samples of their own randomization, drawn once before pass 0 and not
-/// part of the image.
+/// part of the image: an eighth of `spp`, at least 1 and at most
+/// [`MAX_PILOT_SPP`].
 #[must_use]
 pub fn pilot_spp(spp: u64) -> u64 {
-    (spp / 8).max(1)
+    (spp / 8).clamp(1, MAX_PILOT_SPP)
 }
+
+/// The most pilot samples per pixel: the allocation of a pixel pools the
+/// pilots of 7 × 7 pixels ([`PILOT_RADIUS`]), 392 samples at this cap, which
+/// tell three allocations' variances apart well enough; more would only
+/// add time (at 256 spp an eighth was 32 per pixel, 12% of the render).
+pub const MAX_PILOT_SPP: u64 = 8;
 
 /// Half the side of the window of pixels whose pilots decide a pixel's
 /// allocation (7 × 7 pixels).

@@ -487,6 +487,19 @@ fn adaptive_mis_on_a_shiny_sphere_under_an_even_sky() {
     );
 }
 
+/// Adaptive MIS's pilot: an eighth of the spp, at least one sample per
+/// pixel and at most `MAX_PILOT_SPP` (the allocation pools 7 × 7 pixels'
+/// pilots, so a few samples each suffice; the test above runs at 4).
+#[test]
+fn the_pilot_is_an_eighth_of_the_spp_within_its_bounds() {
+    use lobe_render::integrator::{MAX_PILOT_SPP, pilot_spp};
+    assert_eq!(pilot_spp(1), 1);
+    assert_eq!(pilot_spp(15), 1);
+    assert_eq!(pilot_spp(32), 4);
+    assert_eq!(pilot_spp(64), MAX_PILOT_SPP);
+    assert_eq!(pilot_spp(1 << 20), MAX_PILOT_SPP);
+}
+
 /// `render_progressive` returns the mean of whole passes, the same bits as
 /// averaging `render_pass` 0, 1, 2 by hand, whatever the time it was given.
 #[test]
