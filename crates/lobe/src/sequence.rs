@@ -492,7 +492,7 @@ impl SobolKeys {
 
 /// Sobol pairs of many samples at once: `(x[k], y[k])` is
 /// `pair_point_seeded(Sequence::Sobol, s, _, index[k])` for
-/// `keys[k] = SobolKeys::new(s)`, bit for bit, computed in 32-bit SIMD
+/// `seeds[k] = SobolKeys::new(s)`, bit for bit, computed in 32-bit SIMD
 /// lanes at `level` (AVX-512 / AVX2 where the CPU has it, else portable
 /// code): no table lookups, dimension 0's matrix product is a bit reversal
 /// and dimension 1's five shift-and-xor steps (`pascal_reversed`).
