@@ -127,14 +127,13 @@ impl Camera {
         let sy = d.dot(self.up) / z / self.tan_half;
         Some((0.5 * (sx + 1.0) * w, 0.5 * (1.0 - sy) * h))
     }
-}
 
-impl Camera {
     /// A film-space box `[x0, x1, y0, y1]` (pixels) outside of which no
     /// camera ray meets the axis-aligned box `lo..=hi`: the bounds of its
     /// eight corners' projections (the projection of a convex box is the
     /// hull of its corners'), widened by a pixel; `None` when a corner is
-    /// not in front of the camera (no such bound).
+    /// not in front of the camera ([`Camera::project`] refuses it) or
+    /// projects beyond the floats (no such bound).
     #[must_use]
     pub fn film_bounds(&self, lo: DVec3, hi: DVec3) -> Option<[f64; 4]> {
         let mut b = [
@@ -149,11 +148,6 @@ impl Camera {
                 if k & 2 == 0 { lo.y } else { hi.y },
                 if k & 4 == 0 { lo.z } else { hi.z },
             );
-            // In front with a margin: a corner near the eye plane
-            // projects far off and gives no useful bound anyway.
-            if (c - self.origin).dot(self.forward) <= 1e-6 * (1.0 + c.length()) {
-                return None;
-            }
             let (x, y) = self.project(c)?;
             b = [b[0].min(x), b[1].max(x), b[2].min(y), b[3].max(y)];
         }

@@ -463,7 +463,7 @@ impl Batch<'_> {
                 .0
                 .extend(lanes.px.iter().zip(jx).map(|(&x, &j)| x + j));
             lanes.film.1.extend(jy.iter().map(|&j| yf + j));
-            self.camera_points(ctx, &mut pts, &mut lanes, &mut stats);
+            self.camera_points(ctx, y, &mut pts, &mut lanes, &mut stats);
             if sobol {
                 // The shading pairs of the samples that hit, compacted.
                 for v in &mut lanes.hit_seeds {
@@ -522,7 +522,7 @@ impl Batch<'_> {
         stats
     }
 
-    /// The camera rays of a block (film positions `lanes.film`), their
+    /// The camera rays of a block of row `y` (film positions `lanes.film`), their
     /// hits and shading frames: a [`Point`] in `pts` per sample that hits
     /// and faces the camera, in sample order; `lanes.value` the map's
     /// radiance for a sample whose ray escapes, else zero. With
@@ -532,6 +532,7 @@ impl Batch<'_> {
     fn camera_points(
         &self,
         ctx: &Context<'_>,
+        y: usize,
         pts: &mut Vec<Point>,
         lanes: &mut Lanes,
         stats: &mut RenderStats,
@@ -545,7 +546,7 @@ impl Batch<'_> {
         // The objects whose film box the block's pixels overlap (the block
         // covers [x0, x1 + 1) × [y, y + 1) of the film).
         let (x0, x1) = (lanes.px[0], lanes.px[n - 1] + 1.0);
-        let y = lanes.film.1[0].floor();
+        let y = y as f64;
         let may_hit = |k: usize| {
             self.film_bounds[k]
                 .is_none_or(|b| x1 >= b[0] && x0 <= b[1] && y + 1.0 >= b[2] && y <= b[3])
@@ -875,29 +876,26 @@ impl Batch<'_> {
         lanes: &mut Lanes,
     ) {
         let sampler = &self.samplers[obj];
-        let mut m = 0;
-        for &key in &lanes.keys[range.clone()] {
+        // One lane per draw of the bucket (never empty).
+        let m = range.len();
+        for (k, &key) in lanes.keys[range.clone()].iter().enumerate() {
             let di = (key & 0xffff_ffff) as usize;
             let (pt, s) = (&pts[di / 2], di % 2);
             debug_assert_eq!(pt.plan.slots[s] == Slot::Bsdf, bsdf);
             let a = &mut lanes.a;
-            a[0][m] = pt.wo.x as f32;
-            a[1][m] = pt.wo.y as f32;
-            a[2][m] = pt.wo.z as f32;
+            a[0][k] = pt.wo.x as f32;
+            a[1][k] = pt.wo.y as f32;
+            a[2][k] = pt.wo.z as f32;
             if bsdf {
-                a[3][m] = pt.u[s][1] as f32;
-                a[4][m] = pt.u[s][2] as f32;
-                a[5][m] = pt.u[s][0] as f32;
+                a[3][k] = pt.u[s][1] as f32;
+                a[4][k] = pt.u[s][2] as f32;
+                a[5][k] = pt.u[s][0] as f32;
             } else {
                 let wi = draws[di].wi;
-                a[3][m] = wi.x as f32;
-                a[4][m] = wi.y as f32;
-                a[5][m] = wi.z as f32;
+                a[3][k] = wi.x as f32;
+                a[4][k] = wi.y as f32;
+                a[5][k] = wi.z as f32;
             }
-            m += 1;
-        }
-        if m == 0 {
-            return;
         }
         let [a0, a1, a2, a3, a4, a5] = &lanes.a;
         let [o0, o1, o2, o3, o4, o5, o6, o7, o8, o9] = &mut lanes.out;
@@ -956,27 +954,27 @@ impl Batch<'_> {
                 )
                 .expect("equal lengths");
         }
-        for (m, &key) in lanes.keys[range].iter().enumerate() {
+        for (k, &key) in lanes.keys[range].iter().enumerate() {
             let di = (key & 0xffff_ffff) as usize;
             debug_assert_eq!(pts[di / 2].plan.slots[di % 2] == Slot::Bsdf, bsdf);
             let o = &lanes.out;
             let d = &mut draws[di];
-            let rgb = |k: usize| {
+            let rgb = |c: usize| {
                 Rgb::new(
-                    f64::from(o[k][m]),
-                    f64::from(o[k + 1][m]),
-                    f64::from(o[k + 2][m]),
+                    f64::from(o[c][k]),
+                    f64::from(o[c + 1][k]),
+                    f64::from(o[c + 2][k]),
                 )
             };
             if bsdf {
-                d.ok = lanes.valid[m] == 1;
-                d.dir = DVec3::new(f64::from(o[0][m]), f64::from(o[1][m]), f64::from(o[2][m]));
+                d.ok = lanes.valid[k] == 1;
+                d.dir = DVec3::new(f64::from(o[0][k]), f64::from(o[1][k]), f64::from(o[2][k]));
                 d.f = rgb(7);
             } else {
                 d.ok = true;
                 d.f = rgb(3);
             }
-            d.pdf = f64::from(o[6][m]);
+            d.pdf = f64::from(o[6][k]);
         }
     }
 }
