@@ -219,7 +219,7 @@
 //! machine.
 //! The heaviest are the Blinn-Phong NDF (its `cos^e` is a `pow_cos`, and
 //! its Smith term is Beckmann's, `erfc` and `exp` twice) and Beckmann vndf
-//! (the Newton inversion). `cargo bench -p lobe --bench batch` times the
+//! (the Newton inversion). `cargo bench -p lobe-bench --bench batch` times the
 //! same work per material (blocks of 4096, criterion).
 //!
 //! The portable level uses `f32::mul_add` for bit-identical results: on an

@@ -20,7 +20,7 @@ fn run(cases: Vec<Case>) {
     let cfg = Chi2Config::default();
     let jobs: Vec<(&Case, BsdfStrategy, f64)> = cases
         .iter()
-        .flat_map(|c| plan(&c.material).into_iter().map(move |(s, t)| (c, s, t)))
+        .flat_map(|c| plan(c).into_iter().map(move |(s, t)| (c, s, t)))
         .collect();
     let count = jobs.len();
     let failures: Vec<String> = jobs

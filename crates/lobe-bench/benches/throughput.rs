@@ -4,8 +4,8 @@
 //! precomputed random `(wo, uc, u)` triples.
 //!
 //! ```text
-//! cargo bench -p lobe --bench throughput
-//! cargo bench -p lobe --bench throughput -- ggx-alpha0.2/vndf   # one benchmark
+//! cargo bench -p lobe-bench --bench throughput
+//! cargo bench -p lobe-bench --bench throughput -- ggx-alpha0.2/vndf   # one benchmark
 //! ```
 //!
 //! Criterion reports elements/s; one element is one *attempted* sample

@@ -6,8 +6,8 @@
 //! `LOBE_SIMD=scalar|avx2|avx512` forces one (printed once).
 //!
 //! ```text
-//! cargo bench -p lobe --bench batch
-//! LOBE_SIMD=avx2 cargo bench -p lobe --bench batch -- ggx-alpha0.2/vndf
+//! cargo bench -p lobe-bench --bench batch
+//! LOBE_SIMD=avx2 cargo bench -p lobe-bench --bench batch -- ggx-alpha0.2/vndf
 //! ```
 //!
 //! Criterion reports elements/s; one element is one attempted sample.
