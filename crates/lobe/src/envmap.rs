@@ -46,25 +46,34 @@ impl Distribution1D {
     /// sum every bin has probability 0 and `sample` returns `None`.
     #[must_use]
     pub fn new(weights: &[f64]) -> Self {
+        Self::from_weights(weights.iter().copied())
+    }
+
+    /// [`Distribution1D::new`] of the weights an iterator gives (no slice
+    /// of them needed).
+    #[must_use]
+    pub fn from_weights(weights: impl ExactSizeIterator<Item = f64>) -> Self {
         let mut cdf = Vec::with_capacity(weights.len() + 1);
         let mut acc = 0.0;
         cdf.push(0.0);
-        for &w in weights {
+        for w in weights {
             acc += w.max(0.0);
             cdf.push(acc);
         }
+        let n = cdf.len() - 1;
         if acc > 0.0 {
             for c in &mut cdf {
                 *c /= acc;
             }
             *cdf.last_mut().expect("non-empty") = 1.0;
         }
-        let n = weights.len();
         let mut guide = Vec::with_capacity(n);
         let mut i = 0usize;
+        // `upper[i]` = `cdf[i + 1]` for the bins before the last.
+        let upper = &cdf[1..n.max(1)];
         for k in 0..n {
             let u = k as f64 / n as f64;
-            while i + 1 < n && cdf[i + 1] <= u {
+            while i < upper.len() && upper[i] <= u {
                 i += 1;
             }
             guide.push(i as u32);
@@ -315,11 +324,11 @@ impl TexelSampler {
         let dphi = 2.0 * PI / width as f64;
         let row = |j: usize| {
             let omega = dphi * EnvMap::band(height, j);
-            let w: Vec<f64> = texels[j * width..(j + 1) * width]
-                .iter()
-                .map(|t| Self::weight_of(shift, t.lum()) * omega)
-                .collect();
-            Distribution1D::new(&w)
+            Distribution1D::from_weights(
+                texels[j * width..(j + 1) * width]
+                    .iter()
+                    .map(|t| Self::weight_of(shift, t.lum()) * omega),
+            )
         };
         // Each row's distribution is its own computation: the same numbers
         // in parallel or not.
@@ -424,13 +433,53 @@ impl EnvMap {
         scale: f64,
         rotation_y_deg: f64,
     ) -> Result<(Self, usize), EnvMapError> {
-        Self::from_channels(
-            width,
-            height,
-            texels.iter().map(|t| t.map(f64::from)),
-            scale,
-            rotation_y_deg,
-        )
+        Self::check(width, height, texels.len(), scale, rotation_y_deg)?;
+        // As `from_channels` clamps, in `f32` (a finite `f32` is at most
+        // `f32::MAX`): the same texels without a round trip through `f64`.
+        // A count of the texels to clamp first, in a loop without branches
+        // (vectorized), then a plain copy unless there are any.
+        let bad = |c: f32| !(c >= 0.0 && c.is_finite());
+        let clamped: usize = texels
+            .iter()
+            .map(|t| usize::from(bad(t[0]) | bad(t[1]) | bad(t[2])))
+            .sum();
+        let texels: Vec<Texel> = if clamped == 0 {
+            texels.iter().map(|&rgb| Texel { rgb }).collect()
+        } else {
+            texels
+                .iter()
+                .map(|t| Texel {
+                    rgb: t.map(|c| if bad(c) { 0.0 } else { c }),
+                })
+                .collect()
+        };
+        Ok((
+            Self::from_texels(width, height, texels, scale, rotation_y_deg),
+            clamped,
+        ))
+    }
+
+    /// The errors of a map's size and parameters.
+    fn check(
+        width: usize,
+        height: usize,
+        got: usize,
+        scale: f64,
+        rotation_y_deg: f64,
+    ) -> Result<(), EnvMapError> {
+        if width == 0 || height == 0 {
+            return Err(EnvMapError::Empty { width, height });
+        }
+        if got != width * height {
+            return Err(EnvMapError::Size { width, height, got });
+        }
+        if !scale.is_finite() || scale < 0.0 {
+            return Err(EnvMapError::Scale(scale));
+        }
+        if !rotation_y_deg.is_finite() {
+            return Err(EnvMapError::Rotation(rotation_y_deg));
+        }
+        Ok(())
     }
 
     fn from_channels(
@@ -440,22 +489,7 @@ impl EnvMap {
         scale: f64,
         rotation_y_deg: f64,
     ) -> Result<(Self, usize), EnvMapError> {
-        if width == 0 || height == 0 {
-            return Err(EnvMapError::Empty { width, height });
-        }
-        if texels.len() != width * height {
-            return Err(EnvMapError::Size {
-                width,
-                height,
-                got: texels.len(),
-            });
-        }
-        if !scale.is_finite() || scale < 0.0 {
-            return Err(EnvMapError::Scale(scale));
-        }
-        if !rotation_y_deg.is_finite() {
-            return Err(EnvMapError::Rotation(rotation_y_deg));
-        }
+        Self::check(width, height, texels.len(), scale, rotation_y_deg)?;
         let mut clamped = 0;
         let top = f64::from(f32::MAX);
         let texels: Vec<Texel> = texels
@@ -476,6 +510,20 @@ impl EnvMap {
                 }
             })
             .collect();
+        Ok((
+            Self::from_texels(width, height, texels, scale, rotation_y_deg),
+            clamped,
+        ))
+    }
+
+    /// The map of valid texels (clamped) and parameters (checked).
+    fn from_texels(
+        width: usize,
+        height: usize,
+        texels: Vec<Texel>,
+        scale: f64,
+        rotation_y_deg: f64,
+    ) -> Self {
         let plain = TexelSampler::new(width, height, None, &texels);
         // Mean luminance over the sphere, then the part above it.
         let mean = plain.norm / (4.0 * PI);
@@ -485,24 +533,21 @@ impl EnvMap {
             plain.clone()
         };
         let r = rotation_y_deg.to_radians();
-        Ok((
-            EnvMap {
-                width,
-                height,
-                row_cos: (0..=height)
-                    .map(|j| (PI * j as f64 / height as f64).cos())
-                    .collect(),
-                col_cs: (0..=width)
-                    .map(|i| (2.0 * PI * i as f64 / width as f64).sin_cos())
-                    .collect(),
-                texels,
-                scale,
-                rot: (r.cos(), r.sin()),
-                plain,
-                compensated,
-            },
-            clamped,
-        ))
+        EnvMap {
+            width,
+            height,
+            row_cos: (0..=height)
+                .map(|j| (PI * j as f64 / height as f64).cos())
+                .collect(),
+            col_cs: (0..=width)
+                .map(|i| (2.0 * PI * i as f64 / width as f64).sin_cos())
+                .collect(),
+            texels,
+            scale,
+            rot: (r.cos(), r.sin()),
+            plain,
+            compensated,
+        }
     }
 
     /// A map of one constant radiance (one texel).
