@@ -222,8 +222,14 @@ pub fn parse_material_arg(arg: &str) -> Result<(MaterialDesc, String), Error> {
     Ok((desc, origin))
 }
 
-/// `field `a.b`: ` for an error below the top level, else nothing.
+/// `field `a.b`: ` for an error below the top level, else nothing (also
+/// for a path of unknown segments only, as a syntax error's can be: it
+/// names no field).
 fn field_prefix(path: &serde_path_to_error::Path) -> String {
+    use serde_path_to_error::Segment;
+    if path.iter().all(|s| matches!(s, Segment::Unknown)) {
+        return String::new();
+    }
     let path = path.to_string();
     if path == "." || path.is_empty() {
         String::new()
@@ -423,6 +429,9 @@ mod tests {
         assert!(err(r#"{"type":"glass"}"#).contains("`type`"));
         assert!(err(r#"{"type":"phong","ks":[1,2]}"#).contains("ks"));
         assert!(err(r#"{"type":"phong","exponnt":3}"#).contains("unknown field `exponnt`"));
+        // A syntax error at the top level names no field (not "field `?`").
+        let e = err(r#"{"type":"phong","#);
+        assert!(e.contains("invalid JSON") && !e.contains("field"), "{e}");
         assert!(
             err(r#"{"type":"cook-torrance","fresnel":{"type":"conductor","f0":0.5}}"#)
                 .contains("fresnel.f0")
