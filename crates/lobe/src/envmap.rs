@@ -306,6 +306,56 @@ impl Texel {
     }
 }
 
+/// The texels of a map being decoded, in the map's own storage, zero until
+/// set: a decoder writes each texel where it belongs ([`TexelBuffer::set`])
+/// and [`EnvMap::from_texel_buffer`] takes the storage as it is.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TexelBuffer {
+    width: usize,
+    height: usize,
+    texels: Vec<Texel>,
+}
+
+impl TexelBuffer {
+    /// `width × height` black texels.
+    ///
+    /// # Panics
+    /// If `width × height` overflows `usize`.
+    #[must_use]
+    pub fn new(width: usize, height: usize) -> Self {
+        let n = width
+            .checked_mul(height)
+            .expect("TexelBuffer: width × height overflows");
+        TexelBuffer {
+            width,
+            height,
+            texels: vec![Texel { rgb: [0.0; 3] }; n],
+        }
+    }
+
+    /// Set texel `(i, j)` (column, row from the top) to `rgb` (before the
+    /// map's scale; clamped as [`EnvMap::new`] clamps when the map is built).
+    ///
+    /// # Panics
+    /// If `(i, j)` is outside the buffer.
+    #[inline]
+    pub fn set(&mut self, i: usize, j: usize, rgb: [f32; 3]) {
+        assert!(
+            i < self.width && j < self.height,
+            "TexelBuffer::set: ({i}, {j}) outside {}×{}",
+            self.width,
+            self.height
+        );
+        self.texels[j * self.width + i] = Texel { rgb };
+    }
+
+    /// `(width, height)`.
+    #[must_use]
+    pub fn size(&self) -> (usize, usize) {
+        (self.width, self.height)
+    }
+}
+
 /// A piecewise-constant density over the texels: texel weights times their
 /// solid angles, a marginal over rows and a conditional within each row.
 #[derive(Debug, Clone, PartialEq)]
@@ -434,25 +484,45 @@ impl EnvMap {
         rotation_y_deg: f64,
     ) -> Result<(Self, usize), EnvMapError> {
         Self::check(width, height, texels.len(), scale, rotation_y_deg)?;
+        let texels: Vec<Texel> = texels.iter().map(|&rgb| Texel { rgb }).collect();
+        Self::from_texel_buffer(
+            TexelBuffer {
+                width,
+                height,
+                texels,
+            },
+            scale,
+            rotation_y_deg,
+        )
+    }
+
+    /// [`EnvMap::new`] from a [`TexelBuffer`] a decoder has filled, taking
+    /// its storage as the map's (no copy of the texels).
+    pub fn from_texel_buffer(
+        buffer: TexelBuffer,
+        scale: f64,
+        rotation_y_deg: f64,
+    ) -> Result<(Self, usize), EnvMapError> {
+        let TexelBuffer {
+            width,
+            height,
+            mut texels,
+        } = buffer;
+        Self::check(width, height, texels.len(), scale, rotation_y_deg)?;
         // As `from_channels` clamps, in `f32` (a finite `f32` is at most
         // `f32::MAX`): the same texels without a round trip through `f64`.
         // A count of the texels to clamp first, in a loop without branches
-        // (vectorized), then a plain copy unless there are any.
+        // (vectorized), then the clamping only if there are any.
         let bad = |c: f32| !(c >= 0.0 && c.is_finite());
         let clamped: usize = texels
             .iter()
-            .map(|t| usize::from(bad(t[0]) | bad(t[1]) | bad(t[2])))
+            .map(|t| usize::from(bad(t.rgb[0]) | bad(t.rgb[1]) | bad(t.rgb[2])))
             .sum();
-        let texels: Vec<Texel> = if clamped == 0 {
-            texels.iter().map(|&rgb| Texel { rgb }).collect()
-        } else {
-            texels
-                .iter()
-                .map(|t| Texel {
-                    rgb: t.map(|c| if bad(c) { 0.0 } else { c }),
-                })
-                .collect()
-        };
+        if clamped > 0 {
+            for t in &mut texels {
+                t.rgb = t.rgb.map(|c| if bad(c) { 0.0 } else { c });
+            }
+        }
         Ok((
             Self::from_texels(width, height, texels, scale, rotation_y_deg),
             clamped,
@@ -1151,6 +1221,15 @@ mod tests {
         let b = EnvMap::new(32, 16, wide, 1.5, 20.0).unwrap();
         assert_eq!(a.1, 12);
         assert_eq!(a, b);
+        // Filled texel by texel, in any order, as a decoder fills it.
+        let mut buf = TexelBuffer::new(32, 16);
+        assert_eq!(buf.size(), (32, 16));
+        for k in (0..rgb.len()).rev() {
+            buf.set(k % 32, k / 32, rgb[k]);
+        }
+        assert_eq!(EnvMap::from_texel_buffer(buf, 1.5, 20.0).unwrap(), a);
+        let short = TexelBuffer::new(32, 15);
+        assert!(EnvMap::from_texel_buffer(short, 1.0, f64::NAN).is_err());
         assert!(EnvMap::from_rgb32f(32, 15, &rgb, 1.0, 0.0).is_err());
     }
 
