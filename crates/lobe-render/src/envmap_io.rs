@@ -114,7 +114,9 @@ fn read_exr_rgb(path: &Path) -> Result<TexelBuffer, String> {
         .first_valid_layer()
         .all_attributes()
         .from_file(path)
-        .map_err(|e| format!("cannot decode: {e}"))?;
+        .map_err(|e| {
+            format!("cannot decode: {e} (lobe reads the first layer with R, G and B channels)")
+        })?;
     let size = image.layer_data.size;
     image.layer_data.channel_data.pixels.ok_or_else(|| {
         format!(
@@ -319,6 +321,27 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// A file without R, G and B channels (luminance only) is an error that
+    /// says what lobe reads.
+    #[test]
+    fn an_exr_without_rgb_channels_is_a_clear_error() {
+        use exr::prelude::*;
+        let y = AnyChannel::new("Y", FlatSamples::F32(vec![1.0; 8 * 4]));
+        let layer = Layer::new(
+            (8, 4),
+            LayerAttributes::named("y"),
+            Encoding::UNCOMPRESSED,
+            AnyChannels::sort(SmallVec::from_vec(vec![y])),
+        );
+        let p = tmp("luminance.exr");
+        Image::from_layer(layer).write().to_file(&p).unwrap();
+        let e = load_envmap(&p, 1.0, 0.0).unwrap_err().to_string();
+        assert!(
+            e.contains("luminance.exr") && e.contains("R, G and B channels"),
+            "{e}"
+        );
     }
 
     #[test]
