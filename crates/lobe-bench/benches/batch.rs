@@ -16,46 +16,15 @@
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use lobe::batch::{BatchSampler, Dirs, EvalPdfBuffers, SampleBuffers, SampleInput};
-use lobe::{Material, MaterialDesc};
 use rand::RngExt;
 use std::hint::black_box;
 use std::time::Duration;
 
+mod common;
+use common::{MATERIALS, material};
+
 /// Samples per call (the outputs stay in the L1/L2 caches).
 const BLOCK: usize = 4096;
-
-/// The benchmarked materials: the `throughput` bench's.
-const MATERIALS: &[(&str, &str)] = &[
-    ("lambert", r#"{"type":"lambert"}"#),
-    (
-        "phong-n100",
-        r#"{"type":"phong","exponent":100,"normalized":true}"#,
-    ),
-    (
-        "blinn-phong-n100",
-        r#"{"type":"blinn-phong","exponent":100}"#,
-    ),
-    (
-        "ggx-alpha0.2",
-        r#"{"type":"cook-torrance","distribution":"ggx","alpha":0.2}"#,
-    ),
-    (
-        "ggx-aniso-0.1x0.4",
-        r#"{"type":"cook-torrance","distribution":"ggx","alpha_u":0.1,"alpha_v":0.4}"#,
-    ),
-    (
-        "beckmann-alpha0.2",
-        r#"{"type":"cook-torrance","distribution":"beckmann","alpha":0.2}"#,
-    ),
-    (
-        "bp-ndf-alpha0.2",
-        r#"{"type":"cook-torrance","distribution":"blinn-phong","alpha":0.2}"#,
-    ),
-    (
-        "kd0.3-ggx-alpha0.2",
-        r#"{"type":"cook-torrance","distribution":"ggx","alpha":0.2,"kd":0.3}"#,
-    ),
-];
 
 /// Precomputed inputs, structure of arrays: `wo` uniform over the upper
 /// hemisphere (random azimuth), `u1`, `u2`, `uc` uniform; fixed seed.
@@ -86,12 +55,6 @@ fn inputs() -> Inputs {
         v.uc.push(rng.random());
     }
     v
-}
-
-fn material(json: &str) -> Material {
-    MaterialDesc::from_json(json)
-        .and_then(|d| d.build())
-        .unwrap_or_else(|e| panic!("{json}: {e}"))
 }
 
 /// The timed work: sample the block, then eval_pdf at the sampled `wi`

@@ -14,47 +14,17 @@
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use glam::{DVec2, DVec3};
-use lobe::{BsdfStrategy, Material, MaterialDesc, Rgb};
+use lobe::{BsdfStrategy, Material, Rgb};
 use rand::RngExt;
 use std::f64::consts::PI;
 use std::hint::black_box;
 use std::time::Duration;
 
+mod common;
+use common::{MATERIALS, material};
+
 /// Samples per timed iteration.
 const BATCH: usize = 4096;
-
-/// The benchmarked materials: a short name for the group, and the JSON.
-const MATERIALS: &[(&str, &str)] = &[
-    ("lambert", r#"{"type":"lambert"}"#),
-    (
-        "phong-n100",
-        r#"{"type":"phong","exponent":100,"normalized":true}"#,
-    ),
-    (
-        "blinn-phong-n100",
-        r#"{"type":"blinn-phong","exponent":100}"#,
-    ),
-    (
-        "ggx-alpha0.2",
-        r#"{"type":"cook-torrance","distribution":"ggx","alpha":0.2}"#,
-    ),
-    (
-        "ggx-aniso-0.1x0.4",
-        r#"{"type":"cook-torrance","distribution":"ggx","alpha_u":0.1,"alpha_v":0.4}"#,
-    ),
-    (
-        "beckmann-alpha0.2",
-        r#"{"type":"cook-torrance","distribution":"beckmann","alpha":0.2}"#,
-    ),
-    (
-        "bp-ndf-alpha0.2",
-        r#"{"type":"cook-torrance","distribution":"blinn-phong","alpha":0.2}"#,
-    ),
-    (
-        "kd0.3-ggx-alpha0.2",
-        r#"{"type":"cook-torrance","distribution":"ggx","alpha":0.2,"kd":0.3}"#,
-    ),
-];
 
 /// One precomputed input: view direction, lobe-choice number, direction numbers.
 #[derive(Clone, Copy)]
@@ -82,12 +52,6 @@ fn inputs() -> Vec<Input> {
             }
         })
         .collect()
-}
-
-fn material(json: &str) -> Material {
-    MaterialDesc::from_json(json)
-        .and_then(|d| d.build())
-        .unwrap_or_else(|e| panic!("{json}: {e}"))
 }
 
 /// The timed loop: sample, then eval and pdf for the sampled direction.
