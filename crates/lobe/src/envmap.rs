@@ -483,7 +483,7 @@ impl EnvMap {
         scale: f64,
         rotation_y_deg: f64,
     ) -> Result<(Self, usize), EnvMapError> {
-        Self::check(width, height, texels.len(), scale, rotation_y_deg)?;
+        // (`from_texel_buffer` checks the size and the parameters.)
         let texels: Vec<Texel> = texels.iter().map(|&rgb| Texel { rgb }).collect();
         Self::from_texel_buffer(
             TexelBuffer {
