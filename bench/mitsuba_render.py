@@ -379,6 +379,9 @@ def main():
     p.add_argument("--lobe-loop", default="",
                    help="comma-separated `lobe render --loop` values (batch, scalar), one lobe row each "
                         "per --lobe-sequence (default: lobe's default loop, batch)")
+    p.add_argument("--lobe-spp-allocation", default="",
+                   help="comma-separated `lobe render --spp-allocation` values (uniform, variance), one "
+                        "lobe row each per strategy, sequence and loop (default: lobe's default, uniform)")
     p.add_argument("--mis-compensation", choices=["off", "on", "both"], default="both",
                    help="Mitsuba envmap mis_compensation (Karlik et al. 2019; default: both, one row each)")
     p.add_argument("--ref-spp", type=int, default=16384)
@@ -480,17 +483,21 @@ def main():
     seqs = [q.strip() for q in args.lobe_sequence.split(",") if q.strip()] or [None]
     loops = [q.strip() for q in args.lobe_loop.split(",") if q.strip()] or [None]
     strats = [q.strip() for q in args.lobe_strategy.split(",") if q.strip()] or ["mis"]
-    for st, seq, lp in [] if args.skip_lobe else [(a, q, l) for a in strats for q in seqs for l in loops]:
+    allocs = [q.strip() for q in args.lobe_spp_allocation.split(",") if q.strip()] or [None]
+    for st, seq, lp, al in [] if args.skip_lobe else [(a, q, l, c) for a in strats for q in seqs
+                                                      for l in loops for c in allocs]:
         name = (f"lobe {st}" + (f" --sequence {seq}" if seq else "")
-                + (f" --loop {lp}" if lp else ""))
+                + (f" --loop {lp}" if lp else "") + (f" --spp-allocation {al}" if al else ""))
         print(name, file=sys.stderr, flush=True)
 
-        def render_lobe(spp, k, st=st, seq=seq, lp=lp):
-            tag = (st + "-" if st != "mis" else "") + (seq + "-" if seq else "") + (lp + "-" if lp else "")
+        def render_lobe(spp, k, st=st, seq=seq, lp=lp, al=al):
+            tag = ((st + "-" if st != "mis" else "") + (seq + "-" if seq else "") + (lp + "-" if lp else "")
+                   + (al + "-" if al else ""))
             out = os.path.join(args.out, f"lobe-{tag}{spp}")
-            cmd = [args.lobe, "render", lobe_scene, "--spp", str(spp), "--seed", str(k + 1),
-                   "--threads", str(args.threads), "--strategy", st,
-                   "--out", out, "-q"] + (["--sequence", seq] if seq else []) + (["--loop", lp] if lp else [])
+            cmd = ([args.lobe, "render", lobe_scene, "--spp", str(spp), "--seed", str(k + 1),
+                    "--threads", str(args.threads), "--strategy", st, "--out", out, "-q"]
+                   + (["--sequence", seq] if seq else []) + (["--loop", lp] if lp else [])
+                   + (["--spp-allocation", al] if al else []))
             t = float("inf")
             for _ in range(args.repeat):
                 c0 = cpu_time(resource.RUSAGE_CHILDREN)
@@ -562,7 +569,8 @@ def main():
             json.dump({"reference_err": ref_err, "ladders": results}, f, indent=2)
     for name in log["last_img"]:
         save_png(os.path.join(args.out, name.replace(" + ", "+").replace(" --sequence ", "-")
-                              .replace(" --loop ", "-").replace(" ", "-") + ".png"),
+                              .replace(" --loop ", "-").replace(" --spp-allocation ", "-")
+                              .replace(" ", "-") + ".png"),
                  log["last_img"][name])
 
 

@@ -4,7 +4,10 @@ use crate::common::progress;
 use anyhow::{Result, anyhow, bail};
 use clap::Args;
 use lobe::estimator::Strategy;
-use lobe_render::integrator::{RenderLoop, batch_refusal, render_progressive};
+use lobe_render::SppAllocation;
+use lobe_render::integrator::{
+    MAX_SPP_FACTOR, RenderLoop, batch_refusal, max_pixel_spp, render_progressive,
+};
 use lobe_render::{fallbacks, load_scene, render};
 use std::path::PathBuf;
 use std::time::Instant;
@@ -47,6 +50,13 @@ pub struct RenderArgs {
     /// the scene's render.sequence)
     #[arg(long)]
     pub sequence: Option<String>,
+    /// How the width × height × spp samples are shared out among the
+    /// pixels: uniform (spp each, the default) or variance (in proportion
+    /// to each pixel's noise as a pilot of spp/8, at most 8, extra samples
+    /// per pixel estimates it; at least spp/8 and at most 64 × spp per
+    /// pixel) (overrides the scene's render.spp_allocation)
+    #[arg(long, value_name = "ALLOCATION")]
+    pub spp_allocation: Option<String>,
     /// Render whole passes of --spp samples per pixel until SECONDS have
     /// passed (at least one pass), and print the spp reached; the image
     /// depends only on the number of passes
@@ -106,6 +116,7 @@ Scene file (TOML; unknown keys are errors; paths are relative to the scene file)
   seed = 1
   sequence = \"sobol\"   # sobol (default), stratified or independent
   max_depth = 1        # 1 = direct lighting; more adds bounces
+  spp_allocation = \"uniform\"  # uniform (default) or variance
 
 Materials take the keys of `lobe eval --help`.
 
@@ -113,7 +124,8 @@ Examples:
   lobe render examples/scene.toml
   lobe render examples/scene.toml --spp 16 --strategy light --out light-16
   lobe render examples/scene.toml --threads 1 --seed 7 --quiet
-  lobe render examples/scene.toml --spp 4 --time 10 --sequence sobol";
+  lobe render examples/scene.toml --spp 4 --time 10 --sequence sobol
+  lobe render examples/scene.toml --spp 16 --spp-allocation variance";
 
 /// The help of `--strategy`: every accepted name.
 fn strategy_help() -> String {
@@ -153,6 +165,9 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     if let Some(s) = &args.sequence {
         opts.sequence = crate::estimate::parse_sequence(s)?;
     }
+    if let Some(a) = &args.spp_allocation {
+        opts.spp_allocation = a.parse().map_err(|m| anyhow!("--spp-allocation: {m}"))?;
+    }
     let budget = match args.time {
         None => None,
         Some(t) if t.is_finite() && t > 0.0 && t <= 1e7 => {
@@ -187,11 +202,16 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             )
         })?;
     if opts.sequence == lobe::sequence::Sequence::Sobol
-        && opts.spp > lobe_render::integrator::SOBOL_MAX_SAMPLES
+        && max_pixel_spp(&opts) > lobe_render::integrator::SOBOL_MAX_SAMPLES
     {
         bail!(
-            "--spp {}: the sobol sequence has 2^32 points per pixel; use fewer spp or --sequence stratified",
-            opts.spp
+            "--spp {}: the sobol sequence has 2^32 points per pixel{}; use fewer spp or --sequence stratified",
+            opts.spp,
+            match opts.spp_allocation {
+                SppAllocation::Uniform => String::new(),
+                SppAllocation::Variance =>
+                    format!(" (the variance allocation gives a pixel up to {MAX_SPP_FACTOR} × spp)"),
+            }
         );
     }
     // Said after every check of the arguments, so that an error stays one line.
@@ -245,6 +265,10 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         )
     } else {
         format!("{} spp", opts.spp)
+    };
+    let spp = match opts.spp_allocation {
+        SppAllocation::Uniform => spp,
+        SppAllocation::Variance => format!("{spp} on average, allocated by variance"),
     };
     println!(
         "wrote {} and {} ({w}x{h}, {spp}, {}, {}, max_depth {}): {:.2} s, {:.2} M samples/s, {:.2} M rays/s",

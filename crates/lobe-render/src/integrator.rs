@@ -74,6 +74,20 @@
 //! whole passes until a time budget is spent; its image depends only on the
 //! number of passes.
 //!
+//! # Samples per pixel
+//!
+//! With [`SppAllocation::Uniform`] (the default) every pixel gets `spp`
+//! samples per pass. With [`SppAllocation::Variance`] a pilot (before pass
+//! 0: [`pilot_spp`] samples per pixel of their own randomization, not in
+//! the image; adaptive MIS's pilot when the strategy is `mis`) estimates
+//! each pixel's variance, pooled over the 3 × 3 pixels around it, and
+//! [`spp_counts`] shares the pass's `width × height × spp` samples out in
+//! proportion to the standard deviations, at least `spp / 8` (and 1) per
+//! pixel and at most [`MAX_SPP_FACTOR`] × `spp`. Pixel `(x, y)` then takes
+//! samples `p·n … (p+1)·n − 1` of its sequence in pass `p`, `n` its count,
+//! and its value is their mean: unbiased, because the counts come from
+//! samples apart from the image's. Every pass uses the same counts.
+//!
 //! # Batch loop
 //!
 //! [`RenderOptions::render_loop`] is [`RenderLoop::Batch`] by default: for
@@ -112,7 +126,7 @@
 //! for any thread count.
 
 use crate::geometry::{Hit, spawn_ray};
-pub use crate::options::{RenderLoop, RenderOptions};
+pub use crate::options::{RenderLoop, RenderOptions, SppAllocation};
 use crate::scene::Scene;
 use glam::{DVec2, DVec3};
 use lobe::estimator::{
@@ -120,7 +134,7 @@ use lobe::estimator::{
     Visibility,
 };
 use lobe::light::Light;
-use lobe::math::Rgb;
+use lobe::math::{Rgb, luminance};
 use lobe::sequence::{Sequence, hash64, pair_point};
 use lobe::{BsdfSampler, BsdfStrategy, Frame, Material};
 use rayon::prelude::*;
@@ -340,10 +354,10 @@ pub fn render_pass(
     progress: impl Fn(u64) + Sync,
 ) -> Image {
     on_pool(opts, || {
-        if pass > 0 && is_adaptive(opts.strategy) {
+        if pass > 0 && needs_pilot(opts) {
             // The allocations of later passes come from pass 0's pilot.
-            let pilots = pilot_phase(scene, opts).0;
-            render_on_pool(scene, opts, pass, &progress, Some(&pilots)).0
+            let prior = pilot_phase(scene, opts).0;
+            render_on_pool(scene, opts, pass, &progress, Some(&prior)).0
         } else {
             render_on_pool(scene, opts, pass, &progress, None).0
         }
@@ -353,6 +367,121 @@ pub fn render_pass(
 /// Whether `s` is adaptive MIS, whose first bounce a per-pixel pilot tunes.
 fn is_adaptive(s: Strategy) -> bool {
     matches!(s, Strategy::Mis(m) if m.form == MisForm::Adaptive)
+}
+
+/// Whether a render with `opts` starts with a pilot: adaptive MIS, or the
+/// variance allocation of samples.
+fn needs_pilot(opts: &RenderOptions) -> bool {
+    is_adaptive(opts.strategy) || opts.spp_allocation == SppAllocation::Variance
+}
+
+/// The most samples per pass one pixel gets under
+/// [`SppAllocation::Variance`], as a multiple of `spp`.
+pub const MAX_SPP_FACTOR: u64 = 64;
+
+/// The most samples per pass any pixel of a render with `opts` takes:
+/// `spp`, or [`MAX_SPP_FACTOR`] × `spp` under the variance allocation (a
+/// Sobol render needs it times the pass count ≤ [`SOBOL_MAX_SAMPLES`]).
+#[must_use]
+pub fn max_pixel_spp(opts: &RenderOptions) -> u64 {
+    let spp = opts.spp.max(1);
+    match opts.spp_allocation {
+        SppAllocation::Uniform => spp,
+        SppAllocation::Variance => spp.saturating_mul(MAX_SPP_FACTOR),
+    }
+}
+
+/// Samples per pixel under [`SppAllocation::Variance`]: `variance[y · w + x]`
+/// is an estimate of pixel `(x, y)`'s per-sample variance (negative or not
+/// finite counts as 0); each pixel's standard deviation is taken from the
+/// mean variance of the 3 × 3 pixels around it, and the `w · h · spp`
+/// samples are shared out as `floor + spare · σᵢ / Σσ` (`floor = max(1,
+/// spp / 8)`, `spare` the samples above the floors), at most
+/// [`MAX_SPP_FACTOR`] × `spp` per pixel (what a capped pixel does not take
+/// goes to the others), rounded so that the counts add up to exactly
+/// `w · h · spp`. Where every σ is 0 (or their sum overflows), `spp` each.
+///
+/// # Panics
+/// If `variance.len() != w * h`.
+#[must_use]
+pub fn spp_counts(variance: &[f64], w: usize, h: usize, spp: u64) -> Vec<u64> {
+    assert_eq!(variance.len(), w * h, "spp_counts: one variance per pixel");
+    let p = w * h;
+    let spp = spp.max(1);
+    let var = |i: usize| {
+        let v = variance[i];
+        if v.is_finite() && v > 0.0 { v } else { 0.0 }
+    };
+    // Pooled over 3 × 3 pixels (fewer at the edges).
+    let mut sigma = vec![0.0; p];
+    for y in 0..h {
+        for x in 0..w {
+            let (mut s, mut k) = (0.0, 0.0);
+            for yy in y.saturating_sub(1)..(y + 2).min(h) {
+                for xx in x.saturating_sub(1)..(x + 2).min(w) {
+                    s += var(yy * w + xx);
+                    k += 1.0;
+                }
+            }
+            sigma[y * w + x] = (s / k).sqrt();
+        }
+    }
+    let total = p as u64 * spp;
+    // (A sum that overflows: uniform too.)
+    let s: f64 = sigma.iter().sum();
+    if s <= 0.0 || !s.is_finite() {
+        return vec![spp; p];
+    }
+    let floor = (spp / 8).max(1);
+    let spare = (total - floor * p as u64) as f64;
+    let cap = (spp.saturating_mul(MAX_SPP_FACTOR) - floor) as f64;
+    // Water-filling: pixels whose share would pass the cap take the cap,
+    // the rest share what is left in proportion to σ.
+    let mut capped = vec![false; p];
+    let mut left = spare;
+    let sum = loop {
+        let sum = (0..p)
+            .filter(|&i| !capped[i])
+            .map(|i| sigma[i])
+            .sum::<f64>();
+        let mut changed = false;
+        for i in 0..p {
+            if !capped[i] && sum > 0.0 && left * sigma[i] / sum > cap {
+                capped[i] = true;
+                left -= cap;
+                changed = true;
+            }
+        }
+        if !changed {
+            break sum;
+        }
+    };
+    let extra = |i: usize| {
+        if capped[i] {
+            cap
+        } else if sum > 0.0 {
+            left * sigma[i] / sum
+        } else {
+            0.0
+        }
+    };
+    // Each pixel's extra samples as differences of the rounded-down running
+    // sum, which ends at exactly `spare`.
+    let spare = spare as u64;
+    let (mut run, mut prev) = (0.0, 0u64);
+    (0..p)
+        .map(|i| {
+            run += extra(i);
+            let cur = if i + 1 == p {
+                spare
+            } else {
+                (run.floor() as u64).min(spare)
+            };
+            let n = floor + cur.saturating_sub(prev);
+            prev = prev.max(cur);
+            n
+        })
+        .collect()
 }
 
 /// Pilot samples per pixel of adaptive MIS for passes of `spp`: extra
@@ -398,12 +527,12 @@ pub fn render_progressive(
 ) -> Image {
     let t0 = Instant::now();
     let max_passes = match opts.sequence {
-        Sequence::Sobol => max_passes.min(SOBOL_MAX_SAMPLES / opts.spp.max(1)),
+        Sequence::Sobol => max_passes.min(SOBOL_MAX_SAMPLES / max_pixel_spp(opts)),
         _ => max_passes,
     }
     .max(1);
     on_pool(opts, || {
-        let (mut sum, pilots) = render_on_pool(scene, opts, 0, &progress, None);
+        let (mut sum, prior) = render_on_pool(scene, opts, 0, &progress, None);
         let mut passes = 1;
         // Go on while another pass, at the mean pass time so far, fits.
         while passes < max_passes {
@@ -411,7 +540,7 @@ pub fn render_progressive(
             if t0.elapsed() + per_pass > budget {
                 break;
             }
-            let img = render_on_pool(scene, opts, passes, &progress, Some(&pilots)).0;
+            let img = render_on_pool(scene, opts, passes, &progress, Some(&prior)).0;
             for (a, b) in sum.pixels.iter_mut().zip(&img.pixels) {
                 *a += *b;
             }
@@ -471,10 +600,52 @@ fn add_stats(a: RenderStats, b: RenderStats) -> RenderStats {
     }
 }
 
-/// The pilot of adaptive MIS: per pixel, [`pilot_spp`] samples of their own
-/// randomization (a seed apart from the image's), the balance heuristic at
-/// the first bounce, recorded; their values are not used.
-fn pilot_phase(scene: &Scene, opts: &RenderOptions) -> (Vec<Pilot>, RenderStats) {
+/// A pixel's sample values' luminance: count, sum and sum of squares.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+struct Moments {
+    n: u64,
+    sum: f64,
+    sum_sq: f64,
+}
+
+impl Moments {
+    /// One sample value (a value that is not finite counts as 0, as in the
+    /// image).
+    #[inline]
+    fn add(&mut self, v: Rgb) {
+        self.n += 1;
+        if v.is_finite() {
+            let l = luminance(v);
+            self.sum += l;
+            self.sum_sq += l * l;
+        }
+    }
+
+    /// The unbiased sample variance (0 for fewer than 2 samples).
+    fn variance(&self) -> f64 {
+        if self.n < 2 {
+            return 0.0;
+        }
+        let n = self.n as f64;
+        ((self.sum_sq - self.sum * self.sum / n) / (n - 1.0)).max(0.0)
+    }
+}
+
+/// What pass 0's pilot decided, for every pass.
+#[derive(Debug, Clone, Default)]
+struct Prior {
+    /// Adaptive MIS: per pixel its pilot (empty otherwise).
+    pilots: Vec<Pilot>,
+    /// The variance allocation: per pixel its samples per pass.
+    counts: Option<Vec<u64>>,
+}
+
+/// The pilot: per pixel, [`pilot_spp`] samples of their own randomization
+/// (a seed apart from the image's); under adaptive MIS the balance
+/// heuristic at the first bounce, recorded, and under the variance
+/// allocation the values' moments ([`spp_counts`]). Their values are not
+/// in the image.
+fn pilot_phase(scene: &Scene, opts: &RenderOptions) -> (Prior, RenderStats) {
     let (w, h) = (scene.camera.width as usize, scene.camera.height as usize);
     let shading = shadings(scene, opts);
     let light = Light::Env(scene.environment.clone());
@@ -496,27 +667,43 @@ fn pilot_phase(scene: &Scene, opts: &RenderOptions) -> (Vec<Pilot>, RenderStats)
         batch.as_ref(),
     );
     let k = ctx.spp;
+    let adaptive = is_adaptive(opts.strategy);
+    let mode = if adaptive {
+        FirstBounce::Pilot
+    } else {
+        FirstBounce::Plain
+    };
     let mut pilots = vec![Pilot::default(); w * h];
+    let mut moments = vec![Moments::default(); w * h];
     if w == 0 {
-        return (pilots, RenderStats::default());
+        return (Prior::default(), RenderStats::default());
     }
     let stats = pilots
         .par_chunks_mut(w)
+        .zip(moments.par_chunks_mut(w))
         .enumerate()
-        .map(|(y, row)| {
+        .map(|(y, (row, mrow))| {
             let mut stats = RenderStats::default();
             if let Some(b) = ctx.batch {
                 let mut sums = vec![Rgb::ZERO; w];
-                stats = b.row(&ctx, y, &mut sums, &|_| FirstBounce::Pilot, Some(row));
+                let pilots = adaptive.then_some(row);
+                stats = b.row(&ctx, y, &mut sums, &|_| (k, mode), pilots, Some(mrow));
             } else {
-                for (x, p) in row.iter_mut().enumerate() {
-                    *p = ctx.pixel(x, y, 0..k, FirstBounce::Pilot, &mut stats).1;
+                for (x, (p, m)) in row.iter_mut().zip(mrow).enumerate() {
+                    (_, *p, *m) = ctx.pixel(x, y, k, mode, &mut stats);
                 }
             }
             stats
         })
         .reduce(RenderStats::default, add_stats);
-    (pilots, stats)
+    let counts = (opts.spp_allocation == SppAllocation::Variance).then(|| {
+        let var: Vec<f64> = moments.iter().map(Moments::variance).collect();
+        spp_counts(&var, w, h, opts.spp.max(1))
+    });
+    if !adaptive {
+        pilots = Vec::new();
+    }
+    (Prior { pilots, counts }, stats)
 }
 
 /// The allocation of pixel `(x, y)`: from the pilots of the pixels within
@@ -538,15 +725,15 @@ fn pooled_allocation(
     p.choose(mis.n_bsdf, mis.n_light)
 }
 
-/// One pass; for adaptive MIS also the per-pixel pilots (pass 0 draws them
-/// in its first [`pilot_spp`] samples; later passes take `prior`).
+/// One pass, and what its pilot decided (pass 0 runs the pilot where the
+/// render needs one; later passes take `prior`).
 fn render_on_pool(
     scene: &Scene,
     opts: &RenderOptions,
     pass: u64,
     progress: &(dyn Fn(u64) + Sync),
-    prior: Option<&[Pilot]>,
-) -> (Image, Vec<Pilot>) {
+    prior: Option<&Prior>,
+) -> (Image, Prior) {
     let (w, h) = (scene.camera.width as usize, scene.camera.height as usize);
     let shading = shadings(scene, opts);
     let light = Light::Env(scene.environment.clone());
@@ -562,30 +749,28 @@ fn render_on_pool(
     );
     let mut img = Image::new(w, h);
     if w == 0 || h == 0 {
-        return (img, Vec::new());
+        return (img, Prior::default());
     }
     let spp = ctx.spp;
-    let k = 1.0 / spp as f64;
-    let mis = match opts.strategy {
-        Strategy::Mis(mis) if mis.form == MisForm::Adaptive => mis,
-        _ => {
-            img.stats = render_rows(&ctx, &mut img.pixels, |_, _| (0..spp, FirstBounce::Plain));
-            for px in &mut img.pixels {
-                *px *= k;
-            }
-            return (img, Vec::new());
+    let (prior, pilot_stats) = match prior {
+        Some(p) => (p.clone(), RenderStats::default()),
+        None if needs_pilot(opts) => pilot_phase(scene, opts),
+        None => (Prior::default(), RenderStats::default()),
+    };
+    let count = |x: usize, y: usize| prior.counts.as_ref().map_or(spp, |c| c[y * w + x]);
+    let stats = match opts.strategy {
+        Strategy::Mis(mis) if mis.form == MisForm::Adaptive => {
+            render_rows(&ctx, &mut img.pixels, |x, y| {
+                let a = pooled_allocation(&prior.pilots, w, h, x, y, mis);
+                (count(x, y), FirstBounce::Allocated(a))
+            })
         }
+        _ => render_rows(&ctx, &mut img.pixels, |x, y| {
+            (count(x, y), FirstBounce::Plain)
+        }),
     };
-    let (pilots, pilot_stats) = match prior {
-        Some(p) => (p.to_vec(), RenderStats::default()),
-        None => pilot_phase(scene, opts),
-    };
-    let stats = render_rows(&ctx, &mut img.pixels, |x, y| {
-        let a = pooled_allocation(&pilots, w, h, x, y, mis);
-        (0..spp, FirstBounce::Allocated(a))
-    });
-    for px in &mut img.pixels {
-        *px *= k;
+    for (i, px) in img.pixels.iter_mut().enumerate() {
+        *px *= 1.0 / count(i % w, i / w) as f64;
     }
     // The pilot's rays are work done, but not camera rays of the image.
     img.stats = RenderStats {
@@ -593,15 +778,16 @@ fn render_on_pool(
         nonfinite: stats.nonfinite + pilot_stats.nonfinite,
         ..stats
     };
-    (img, pilots)
+    (img, prior)
 }
 
-/// Every pixel's samples `range` with first-bounce mode `mode`, as chosen
-/// per pixel, rows in parallel; stores each pixel's sum (not divided).
+/// Every pixel's samples `0..n` of the pass with first-bounce mode `mode`,
+/// `(n, mode) = plan(x, y)`, rows in parallel; stores each pixel's sum (not
+/// divided).
 fn render_rows(
     ctx: &Context<'_>,
     pixels: &mut [Rgb],
-    plan: impl Fn(usize, usize) -> (std::ops::Range<u64>, FirstBounce) + Sync,
+    plan: impl Fn(usize, usize) -> (u64, FirstBounce) + Sync,
 ) -> RenderStats {
     let w = ctx.width;
     pixels
@@ -609,12 +795,12 @@ fn render_rows(
         .enumerate()
         .map(|(y, row)| {
             if let Some(b) = ctx.batch {
-                return b.row(ctx, y, row, &|x| plan(x, y).1, None);
+                return b.row(ctx, y, row, &|x| plan(x, y), None, None);
             }
             let mut stats = RenderStats::default();
             for (x, px) in row.iter_mut().enumerate() {
-                let (range, mode) = plan(x, y);
-                *px = ctx.pixel(x, y, range, mode, &mut stats).0;
+                let (n, mode) = plan(x, y);
+                *px = ctx.pixel(x, y, n, mode, &mut stats).0;
             }
             stats
         })
@@ -673,42 +859,44 @@ impl Visibility for SceneVisibility<'_> {
 }
 
 impl Context<'_> {
-    /// Samples `range` of pixel `(x, y)`: their sum, and in
+    /// Pixel `(x, y)`'s `n` samples of the pass: their sum, in
     /// [`FirstBounce::Pilot`] mode the pilot statistics of their first
-    /// bounces.
+    /// bounces, and their values' moments.
     fn pixel(
         &self,
         x: usize,
         y: usize,
-        range: std::ops::Range<u64>,
+        n: u64,
         mode: FirstBounce,
         stats: &mut RenderStats,
-    ) -> (Rgb, Pilot) {
+    ) -> (Rgb, Pilot, Moments) {
         let pixel_seed = pixel_seed(self.seed, (y * self.width + x) as u64);
         let mut sum = Rgb::ZERO;
         let mut pilot = Pilot::default();
+        let mut moments = Moments::default();
         let mut pending = 0u64;
-        for i in range {
+        for i in 0..n {
             let ps = match self.sequence {
                 // A fresh stratification per pass.
                 Sequence::Stratified => PixelSample {
                     sequence: self.sequence,
                     seed: hash64(pixel_seed ^ hash64(self.pass)),
-                    n: self.spp,
+                    n,
                     index: i,
                 },
                 // The pixel's one sequence goes on.
                 Sequence::Sobol | Sequence::Independent => PixelSample {
                     sequence: self.sequence,
                     seed: pixel_seed,
-                    n: self.spp,
-                    index: self.pass * self.spp + i,
+                    n,
+                    index: self.pass * n + i,
                 },
             };
             let j = ps.pair(dims::CAMERA);
             let ray = self.scene.camera.ray(x as f64 + j.x, y as f64 + j.y);
             stats.camera_rays += 1;
             let v = self.radiance(ray, &ps, mode, &mut pilot, stats);
+            moments.add(v);
             if v.is_finite() {
                 sum += v;
             } else {
@@ -723,7 +911,7 @@ impl Context<'_> {
         if pending > 0 {
             (self.progress)(pending);
         }
-        (sum, pilot)
+        (sum, pilot, moments)
     }
 
     /// Radiance arriving along a camera ray.
@@ -864,5 +1052,76 @@ fn batch_loop<'a>(scene: &'a Scene, opts: &RenderOptions) -> Option<wavefront::B
             wavefront::Batch::new(scene, opts.strategy, opts.max_depth.max(1)).ok()
         }
         RenderLoop::Scalar => None,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn check(counts: &[u64], spp: u64) {
+        let total: u64 = counts.iter().sum();
+        assert_eq!(total, counts.len() as u64 * spp, "the total is w × h × spp");
+        let floor = (spp / 8).max(1);
+        assert!(counts.iter().all(|&n| n >= floor), "the floor {floor}");
+        assert!(counts.iter().all(|&n| n <= MAX_SPP_FACTOR * spp), "the cap");
+    }
+
+    #[test]
+    fn spp_counts_share_the_samples_out_by_standard_deviation() {
+        // Zero, negative or not-finite variances everywhere: spp each.
+        let (w, h) = (9, 7);
+        for v in [0.0, -1.0, f64::NAN, f64::INFINITY] {
+            assert_eq!(spp_counts(&vec![v; w * h], w, h, 16), vec![16; w * h]);
+        }
+        // Uniform variance: spp each (up to the rounding of the running sum).
+        let c = spp_counts(&vec![2.5; w * h], w, h, 16);
+        check(&c, 16);
+        assert!(c.iter().all(|&n| n.abs_diff(16) <= 1), "{c:?}");
+        // The left half 100 times the variance of the right half (pooled
+        // over 3 × 3 pixels): away from the border between them, 10 times
+        // the extra samples above the floor.
+        let (w, h) = (40, 10);
+        let var: Vec<f64> = (0..w * h)
+            .map(|i| if i % w < w / 2 { 100.0 } else { 1.0 })
+            .collect();
+        for spp in [1, 7, 64, 1000] {
+            let c = spp_counts(&var, w, h, spp);
+            check(&c, spp);
+            let floor = (spp / 8).max(1) as f64;
+            let (l, r) = (c[5 * w + 5] as f64 - floor, c[5 * w + 35] as f64 - floor);
+            if spp >= 64 {
+                assert!((l / r - 10.0).abs() < 0.2, "spp {spp}: {l} / {r}");
+            }
+        }
+    }
+
+    #[test]
+    fn spp_counts_cap_a_pixel_and_give_the_rest_to_the_others() {
+        // One noisy pixel among quiet ones: it and its 3 × 3 neighbours
+        // would take nearly everything, but stop at the cap.
+        let (w, h) = (50, 40);
+        let mut var = vec![1e-6; w * h];
+        var[20 * w + 25] = 1e6;
+        let spp = 16;
+        let c = spp_counts(&var, w, h, spp);
+        check(&c, spp);
+        assert_eq!(c[20 * w + 25], MAX_SPP_FACTOR * spp);
+        assert_eq!(c[19 * w + 24], MAX_SPP_FACTOR * spp);
+        // The rest share what the capped pixels leave (each ≥ the floor).
+        assert!(c[0] >= 2 && c[0] < spp, "{}", c[0]);
+    }
+
+    #[test]
+    fn moments_give_the_sample_variance_and_count_bad_values_as_zero() {
+        let mut m = Moments::default();
+        assert_eq!(m.variance(), 0.0);
+        for v in [1.0, 2.0, 3.0, 4.0] {
+            m.add(Rgb::splat(v));
+        }
+        assert!((m.variance() - 5.0 / 3.0).abs() < 1e-12, "{}", m.variance());
+        m.add(Rgb::splat(f64::NAN));
+        assert_eq!(m.n, 5);
+        assert!((m.sum - 10.0).abs() < 1e-12);
     }
 }

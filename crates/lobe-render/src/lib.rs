@@ -55,6 +55,6 @@ pub use envmap_io::{LoadError, LoadedEnvMap, load_envmap, load_envmap_checked};
 pub use geometry::{Hit, Ray};
 pub use integrator::{Image, RenderStats, fallbacks, render, strategy_for};
 pub use mesh::{Mesh, MeshError};
-pub use options::{RenderLoop, RenderOptions};
+pub use options::{RenderLoop, RenderOptions, SppAllocation};
 pub use output::{OutputError, ToneMap};
 pub use scene::{Object, Scene, SceneDesc, SceneError, Shape, load_scene, parse_scene, showcase};

@@ -25,6 +25,58 @@ pub struct RenderOptions {
     pub threads: Option<usize>,
     /// The batch loop (the default) or the scalar one, its reference.
     pub render_loop: RenderLoop,
+    /// How the samples are shared out among the pixels: `spp` each
+    /// (uniform, the default) or as a pilot's estimate of each pixel's noise
+    /// says ([`SppAllocation::Variance`]).
+    pub spp_allocation: SppAllocation,
+}
+
+/// How a render shares its `width × height × spp` samples out among the
+/// pixels.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub enum SppAllocation {
+    /// `spp` samples in every pixel.
+    #[default]
+    Uniform,
+    /// In proportion to each pixel's standard deviation as a pilot
+    /// estimates it (extra samples of their own randomization, not in the
+    /// image), with a floor of `spp / 8` (at least 1) per pixel: the
+    /// allocation that minimizes the image's mean squared error for a
+    /// given number of samples when each pixel's error is `σ / √n`. The
+    /// same total (`width × height × spp`) as `Uniform`; unbiased, since
+    /// the image's samples do not decide their own counts
+    /// ([`crate::integrator::spp_counts`]).
+    Variance,
+}
+
+impl SppAllocation {
+    pub const ALL: [SppAllocation; 2] = [SppAllocation::Uniform, SppAllocation::Variance];
+
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            SppAllocation::Uniform => "uniform",
+            SppAllocation::Variance => "variance",
+        }
+    }
+}
+
+impl std::fmt::Display for SppAllocation {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::str::FromStr for SppAllocation {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        SppAllocation::ALL
+            .into_iter()
+            .find(|a| a.name() == s)
+            .ok_or_else(|| {
+                format!("unknown spp allocation `{s}`, expected one of: uniform, variance")
+            })
+    }
 }
 
 /// Which loop renders: the batch (wavefront) loop on `lobe::batch`'s f32
@@ -76,6 +128,7 @@ impl Default for RenderOptions {
             max_depth: 1,
             threads: None,
             render_loop: RenderLoop::Batch,
+            spp_allocation: SppAllocation::Uniform,
         }
     }
 }

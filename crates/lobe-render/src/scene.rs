@@ -29,13 +29,14 @@
 //! seed = 1
 //! sequence = "sobol"  # sobol, stratified or independent
 //! max_depth = 1       # 1 = direct lighting
+//! spp_allocation = "uniform"  # uniform, or variance: as a pilot estimates each pixel's noise
 //! ```
 
 use crate::camera::{Camera, CameraError};
 use crate::envmap_io::load_envmap_checked;
 use crate::geometry::{Hit, Plane, Ray, Sphere};
 use crate::mesh::Mesh;
-use crate::options::{RenderLoop, RenderOptions};
+use crate::options::{RenderLoop, RenderOptions, SppAllocation};
 use glam::DVec3;
 use lobe::envmap::EnvMap;
 use lobe::estimator::Strategy;
@@ -333,6 +334,9 @@ pub struct RenderDesc {
     pub sequence: String,
     #[serde(default = "default_depth")]
     pub max_depth: u32,
+    /// `uniform` (the default) or `variance` ([`crate::options::SppAllocation`]).
+    #[serde(default = "default_spp_allocation")]
+    pub spp_allocation: String,
 }
 
 fn default_spp() -> u64 {
@@ -350,6 +354,9 @@ fn default_sequence() -> String {
 fn default_depth() -> u32 {
     1
 }
+fn default_spp_allocation() -> String {
+    "uniform".into()
+}
 
 impl Default for RenderDesc {
     fn default() -> Self {
@@ -359,6 +366,7 @@ impl Default for RenderDesc {
             seed: default_seed(),
             sequence: default_sequence(),
             max_depth: default_depth(),
+            spp_allocation: default_spp_allocation(),
         }
     }
 }
@@ -633,6 +641,11 @@ fn build(desc: &SceneDesc, base: &Path) -> FieldResult<Scene> {
         .parse()
         .map_err(|e: lobe::Error| (render_field("sequence"), e.to_string()))?;
 
+    let spp_allocation: SppAllocation = r
+        .spp_allocation
+        .parse()
+        .map_err(|e: String| (render_field("spp_allocation"), e))?;
+
     let mut scene = Scene::new(camera, map);
     scene.options = RenderOptions {
         spp: r.spp,
@@ -642,6 +655,7 @@ fn build(desc: &SceneDesc, base: &Path) -> FieldResult<Scene> {
         max_depth: r.max_depth,
         threads: None,
         render_loop: RenderLoop::Batch,
+        spp_allocation,
     };
     let mut meshes: HashMap<PathBuf, Arc<Mesh>> = HashMap::new();
     for (i, o) in desc.objects.iter().enumerate() {

@@ -7,7 +7,9 @@ use lobe::envmap::EnvMap;
 use lobe::estimator::{Heuristic, Strategy};
 use lobe::{BsdfStrategy, Material, MaterialDesc, Rgb};
 use lobe_render::integrator::RenderLoop;
-use lobe_render::{Camera, Image, Mesh, Object, RenderOptions, Scene, load_scene, render};
+use lobe_render::{
+    Camera, Image, Mesh, Object, RenderOptions, Scene, SppAllocation, load_scene, render,
+};
 use std::path::PathBuf;
 use std::sync::Arc;
 
@@ -24,6 +26,7 @@ fn opts(method: Strategy, spp: u64) -> RenderOptions {
         max_depth: 1,
         threads: None,
         render_loop: RenderLoop::Batch,
+        spp_allocation: SppAllocation::Uniform,
     }
 }
 
@@ -78,9 +81,25 @@ fn white_furnace_every_method() {
     let scene = furnace_scene(32, 24);
     let px = covered(&scene, 0);
     assert!(px.len() > 150, "{} covered pixels", px.len());
-    for method in Strategy::all() {
-        let img = render(&scene, &opts(method, 16), |_| {});
+    let allocations = Strategy::all().into_iter().flat_map(|m| {
+        // The variance allocation on the techniques whose pixels differ
+        // in noise (every pixel of the exact ones has none).
+        let variance = !matches!(m, Strategy::Bsdf(s) if s != BsdfStrategy::Uniform);
+        std::iter::once((m, SppAllocation::Uniform))
+            .chain(variance.then_some((m, SppAllocation::Variance)))
+    });
+    for (method, spp_allocation) in allocations {
+        let o = RenderOptions {
+            spp_allocation,
+            ..opts(method, 16)
+        };
+        let img = render(&scene, &o, |_| {});
         assert_eq!(img.stats.nonfinite, 0);
+        assert_eq!(
+            img.stats.camera_rays,
+            32 * 24 * 16,
+            "{method} {spp_allocation}"
+        );
         // The background is the environment, 1.
         assert_eq!(img.get(0, 0), Rgb::ONE, "{method}");
         // Cosine and brdf sampling of a Lambertian (and the strategies that
@@ -436,6 +455,79 @@ fn every_sequence_is_unbiased_and_qmc_has_less_error() {
     );
 }
 
+/// Issue 10: the variance allocation of samples. A shiny sphere reflecting
+/// a small bright sun, on a diffuse plane, with sky around them: the
+/// pixels' noise differs by orders of magnitude. At the same total number
+/// of samples the variance allocation is unbiased (against a reference of
+/// many samples, pixel by pixel over the covered pixels), has clearly less
+/// error than `spp` in every pixel (measured: the RMSEs of 8 seeds at 32
+/// spp add up to 0.24× uniform's; the test asks for 0.5×), and the batch
+/// loop agrees with the scalar loop for one seed.
+#[test]
+fn variance_allocation_is_unbiased_and_has_less_error() {
+    let ggx = Material::load(r#"{"type":"cook-torrance","alpha":0.05}"#).unwrap();
+    let camera = Camera::new(
+        DVec3::new(0.0, 1.0, 3.0),
+        DVec3::new(0.0, 0.6, 0.0),
+        DVec3::Y,
+        40.0,
+        32,
+        24,
+    )
+    .unwrap();
+    // The sun behind the camera, high: its reflection is on the sphere.
+    let scene = Scene::new(camera, EnvMap::sky(256, 128, 35.0, 180.0))
+        .with(Object::sphere(DVec3::new(0.0, 0.6, 0.0), 0.6, ggx).unwrap())
+        .with(Object::plane(DVec3::ZERO, DVec3::Y, lambert(0.5)).unwrap());
+    let mut px = covered(&scene, 0);
+    px.extend(covered(&scene, 1));
+    let mut r = opts(Strategy::mis(Heuristic::Balance), 4096);
+    r.seed = 99;
+    let reference = render(&scene, &r, |_| {});
+    let all: Vec<(usize, usize)> = (0..24).flat_map(|y| (0..32).map(move |x| (x, y))).collect();
+    // (mean difference, its standard error) over the covered pixels, and
+    // the RMSE over every pixel.
+    let err = |img: &Image| -> (f64, f64, f64) {
+        let d =
+            |&(x, y): &(usize, usize)| lobe::math::luminance(img.get(x, y) - reference.get(x, y));
+        let v: Vec<f64> = px.iter().map(d).collect();
+        let n = v.len() as f64;
+        let m = v.iter().sum::<f64>() / n;
+        let var = v.iter().map(|x| (x - m) * (x - m)).sum::<f64>() / (n - 1.0);
+        let rmse = (all.iter().map(|p| d(p) * d(p)).sum::<f64>() / all.len() as f64).sqrt();
+        (m, (var / n).sqrt(), rmse)
+    };
+    let (mut uniform, mut variance) = (0.0, 0.0);
+    for seed in 5..13 {
+        let mut o = opts(Strategy::MIS, 32);
+        o.seed = seed;
+        let (m, se, e_u) = err(&render(&scene, &o, |_| {}));
+        assert!(m.abs() < 4.5 * se, "uniform, seed {seed}: {m} ± {se}");
+        o.spp_allocation = SppAllocation::Variance;
+        let img = render(&scene, &o, |_| {});
+        assert_eq!(img.stats.camera_rays, 32 * 24 * 32);
+        let (m, se, e_v) = err(&img);
+        assert!(m.abs() < 4.5 * se, "variance, seed {seed}: {m} ± {se}");
+        eprintln!("seed {seed}: rmse uniform {e_u:.4}, variance {e_v:.4}");
+        uniform += e_u;
+        variance += e_v;
+    }
+    assert!(
+        variance < 0.5 * uniform,
+        "variance allocation {variance} vs uniform {uniform} (sum of 8 RMSEs)"
+    );
+    // Batch against scalar, one seed: the same allocation (the pilot's
+    // values agree to f32 rounding), the same image to f32 rounding.
+    let mut o = opts(Strategy::mis(Heuristic::Balance), 8);
+    o.spp_allocation = SppAllocation::Variance;
+    let mean = |img: &Image| mean_se(img, &px, lobe::math::luminance).0;
+    let batch = render(&scene, &o, |_| {});
+    o.render_loop = RenderLoop::Scalar;
+    let scalar = render(&scene, &o, |_| {});
+    let (a, b) = (mean(&batch), mean(&scalar));
+    assert!((a - b).abs() < 2e-4 * b, "batch {a} scalar {b}");
+}
+
 /// Issue 10's case in the renderer: a shiny GGX sphere (α = 0.05) under an
 /// even bright sky. The balance heuristic is several times worse than
 /// visible-normal sampling alone; adaptive MIS (`mis`) is not.
@@ -507,13 +599,22 @@ fn progressive_passes_are_reproducible() {
     use lobe::sequence::Sequence;
     use lobe_render::integrator::{render_pass, render_progressive};
     let (scene, _) = sphere_on_plane();
-    for (seq, strategy) in Sequence::ALL
+    for (seq, strategy, spp_allocation) in Sequence::ALL
         .into_iter()
-        .map(|q| (q, Strategy::mis(Heuristic::Balance)))
-        .chain([(Sequence::Sobol, Strategy::MIS)])
+        .map(|q| (q, Strategy::mis(Heuristic::Balance), SppAllocation::Uniform))
+        .chain([
+            (Sequence::Sobol, Strategy::MIS, SppAllocation::Uniform),
+            (Sequence::Sobol, Strategy::MIS, SppAllocation::Variance),
+            (
+                Sequence::Stratified,
+                Strategy::Light,
+                SppAllocation::Variance,
+            ),
+        ])
     {
         let mut o = opts(strategy, 8);
         o.sequence = seq;
+        o.spp_allocation = spp_allocation;
         o.max_depth = 3;
         let hour = std::time::Duration::from_secs(3600);
         let p = render_progressive(&scene, &o, hour, 3, |_| {});
@@ -562,9 +663,15 @@ fn the_same_image_for_any_thread_count() {
         // Direct lighting: the batch loop.
         (Strategy::MIS, 1),
         (Strategy::Bsdf(BsdfStrategy::Vndf), 1),
+        // Samples allocated by the pilot's variances (batch, then scalar).
+        (Strategy::mis(Heuristic::Balance), 1),
+        (Strategy::mis(Heuristic::Balance), 2),
     ] {
         let mut o = opts(method, 4);
         o.max_depth = depth;
+        if method == Strategy::mis(Heuristic::Balance) {
+            o.spp_allocation = SppAllocation::Variance;
+        }
         let one = render(
             &scene,
             &RenderOptions {
@@ -589,6 +696,7 @@ fn the_same_image_for_any_thread_count() {
         };
         assert_eq!(bits(&one), bits(&two), "{method}");
         assert_eq!(one.stats, two.stats);
+        assert_eq!(one.stats.camera_rays, 37 * 23 * 4);
         let mut o2 = o;
         o2.seed += 1;
         assert_ne!(
@@ -729,6 +837,17 @@ fn scene_files_load_and_their_errors_name_file_line_and_field() {
 
     let e = load_scene(&dir.join("none.toml")).unwrap_err().to_string();
     assert!(e.contains("none.toml"), "{e}");
+
+    std::fs::write(&bad, format!("{SCENE}spp_allocation = \"variance\"\n")).unwrap();
+    let s = load_scene(&bad).unwrap();
+    assert_eq!(s.options.spp_allocation, SppAllocation::Variance);
+    assert_eq!(scene.options.spp_allocation, SppAllocation::Uniform);
+    std::fs::write(&bad, format!("{SCENE}spp_allocation = \"even\"\n")).unwrap();
+    let e = load_scene(&bad).unwrap_err().to_string();
+    assert!(
+        e.contains("field render.spp_allocation: unknown spp allocation `even`, expected one of: uniform, variance"),
+        "{e}"
+    );
 }
 
 #[test]

@@ -5,7 +5,7 @@
 //! shadow rays traced for the whole block. See the parent module's doc
 //! ("Batch loop") for what it covers and how it is checked.
 
-use super::{Context, FirstBounce, RenderStats, dims, pixel_seed};
+use super::{Context, FirstBounce, Moments, RenderStats, dims, pixel_seed};
 use crate::lanes::{HitLanes, NO_HIT, RayLanes, Vec3Lanes, spawn_many};
 use crate::scene::{Scene, Shape};
 use glam::{DVec2, DVec3};
@@ -239,9 +239,9 @@ struct Lanes {
     miss_radiance: Vec<Rgb>,
     /// The block's film positions `(x, y)` in pixels.
     film: (Vec<f64>, Vec<f64>),
-    /// Independent or stratified numbers: each sample's pair seeds and
-    /// index.
-    each: Vec<(PixelSeeds, u64)>,
+    /// Independent or stratified numbers: each sample's pair seeds, index,
+    /// and its pixel's samples in the pass.
+    each: Vec<(PixelSeeds, u64, u64)>,
     /// Each sample's pixel column, plan, and value (the map's radiance
     /// where its camera ray escapes, else its estimate).
     px: Vec<f64>,
@@ -329,12 +329,13 @@ impl PixelSeeds {
 }
 
 impl Batch<'_> {
-    /// Samples `0..spp` of every pixel of row `y`, the pixel sums (not
-    /// divided) into `row`; `mode(x)` is pixel `x`'s first-bounce mode.
-    /// With `pilots` (adaptive MIS's pilot, every mode
+    /// Samples `0..n` of the pass of every pixel `x` of row `y`, `(n, mode)
+    /// = plan(x)` (its count and first-bounce mode), the pixel sums (not
+    /// divided) into `row`. With `pilots` (adaptive MIS's pilot, every mode
     /// [`FirstBounce::Pilot`]), each sample's draws are recorded in its
     /// pixel's [`Pilot`] as [`lobe::estimator::ShadingEstimator::estimate_pilot`]
-    /// records them.
+    /// records them; with `moments`, each sample's value in its pixel's
+    /// [`Moments`].
     ///
     /// The whole row runs at the block's SIMD level ([`SimdLevel::run`]):
     /// the glue between the batch calls is compiled with the level's
@@ -344,24 +345,31 @@ impl Batch<'_> {
         ctx: &Context<'_>,
         y: usize,
         row: &mut [Rgb],
-        mode: &(dyn Fn(usize) -> FirstBounce + Sync),
+        plan: &(dyn Fn(usize) -> (u64, FirstBounce) + Sync),
         pilots: Option<&mut [Pilot]>,
+        moments: Option<&mut [Moments]>,
     ) -> RenderStats {
         struct Row<'r, 'b, 'c> {
             batch: &'r Batch<'b>,
             ctx: &'r Context<'c>,
             y: usize,
             row: &'r mut [Rgb],
-            mode: &'r (dyn Fn(usize) -> FirstBounce + Sync),
+            plan: &'r (dyn Fn(usize) -> (u64, FirstBounce) + Sync),
             pilots: Option<&'r mut [Pilot]>,
+            moments: Option<&'r mut [Moments]>,
             stats: &'r mut RenderStats,
         }
         impl Step for Row<'_, '_, '_> {
             #[inline(always)]
             fn run(self) {
-                *self.stats =
-                    self.batch
-                        .row_at_level(self.ctx, self.y, self.row, self.mode, self.pilots);
+                *self.stats = self.batch.row_at_level(
+                    self.ctx,
+                    self.y,
+                    self.row,
+                    self.plan,
+                    self.pilots,
+                    self.moments,
+                );
             }
         }
         let mut stats = RenderStats::default();
@@ -370,8 +378,9 @@ impl Batch<'_> {
             ctx,
             y,
             row,
-            mode,
+            plan,
             pilots,
+            moments,
             stats: &mut stats,
         });
         stats
@@ -383,8 +392,9 @@ impl Batch<'_> {
         ctx: &Context<'_>,
         y: usize,
         row: &mut [Rgb],
-        mode: &(dyn Fn(usize) -> FirstBounce + Sync),
+        plan: &(dyn Fn(usize) -> (u64, FirstBounce) + Sync),
         mut pilots: Option<&mut [Pilot]>,
+        mut moments: Option<&mut [Moments]>,
     ) -> RenderStats {
         let mut stats = RenderStats::default();
         // The thread's buffers from its last row (every block writes what
@@ -396,11 +406,9 @@ impl Batch<'_> {
                 vec![Draw::default(); 2 * BLOCK],
             )
         });
-        let spp = ctx.spp;
-        let total = row.len() as u64 * spp;
-        let mut k = 0u64;
-        while k < total {
-            let end = (k + BLOCK as u64).min(total);
+        // The next sample: pixel `x`'s sample `i0` of `n` (its count).
+        let (mut x, mut i0) = (0usize, 0u64);
+        while x < row.len() {
             pts.clear();
             let sobol = ctx.sequence == Sequence::Sobol;
             // The block's samples, pixel by pixel: each one's column, plan
@@ -414,33 +422,45 @@ impl Batch<'_> {
             lanes.runs.clear();
             lanes.plans.clear();
             lanes.each.clear();
-            let mut f = k;
-            while f < end {
-                let (x, i0) = ((f / spp) as usize, f % spp);
-                let run = (spp - i0).min(end - f) as usize;
-                let seeds = pixel_seeds(ctx, x, y);
-                let plan = self.plan(mode(x));
-                lanes.px.extend(std::iter::repeat_n(x as f64, run));
-                lanes.runs.push((x, run));
-                lanes.plans.extend(std::iter::repeat_n(plan, run));
-                for i in i0..i0 + run as u64 {
-                    let index = match ctx.sequence {
-                        Sequence::Stratified => i,
-                        Sequence::Sobol | Sequence::Independent => ctx.pass * spp + i,
-                    };
+            let mut filled = 0usize;
+            while filled < BLOCK && x < row.len() {
+                // (A pixel's plan is asked again when its samples go on in
+                // the next block.)
+                let (n, mode) = plan(x);
+                let run = ((n - i0) as usize).min(BLOCK - filled);
+                if run > 0 {
+                    let seeds = pixel_seeds(ctx, x, y);
+                    let plan = self.plan(mode);
+                    lanes.px.extend(std::iter::repeat_n(x as f64, run));
+                    lanes.runs.push((x, run));
+                    lanes.plans.extend(std::iter::repeat_n(plan, run));
+                    for i in i0..i0 + run as u64 {
+                        let index = match ctx.sequence {
+                            Sequence::Stratified => i,
+                            Sequence::Sobol | Sequence::Independent => ctx.pass * n + i,
+                        };
+                        if sobol {
+                            debug_assert!(index <= u64::from(u32::MAX));
+                            lanes.pair_index.push(index as u32);
+                        } else {
+                            lanes.each.push((seeds, index, n));
+                        }
+                    }
                     if sobol {
-                        debug_assert!(index <= u64::from(u32::MAX));
-                        lanes.pair_index.push(index as u32);
-                    } else {
-                        lanes.each.push((seeds, index));
+                        for (v, s) in lanes.pair_seeds.iter_mut().zip(seeds.all()) {
+                            v.extend(std::iter::repeat_n(SobolKeys::new(s), run));
+                        }
                     }
+                    filled += run;
+                    i0 += run as u64;
                 }
-                if sobol {
-                    for (v, s) in lanes.pair_seeds.iter_mut().zip(seeds.all()) {
-                        v.extend(std::iter::repeat_n(SobolKeys::new(s), run));
-                    }
+                if i0 == n {
+                    x += 1;
+                    i0 = 0;
                 }
-                f += run as u64;
+            }
+            if filled == 0 {
+                continue;
             }
             // The camera pairs of every sample; the other pairs (below)
             // only for the samples that hit.
@@ -449,8 +469,8 @@ impl Batch<'_> {
             if sobol {
                 sobol_pairs(self.level, &lanes.pair_seeds[0], &lanes.pair_index, jx, jy);
             } else {
-                for ((&(seeds, index), x), y) in lanes.each.iter().zip(jx).zip(jy) {
-                    [*x, *y] = seeded_pair(ctx, &seeds, index, 0).to_array();
+                for ((&(seeds, index, n), x), y) in lanes.each.iter().zip(jx).zip(jy) {
+                    [*x, *y] = seeded_pair(ctx, &seeds, n, index, 0).to_array();
                 }
             }
             // The block's camera rays, traced together.
@@ -513,10 +533,14 @@ impl Batch<'_> {
                     }
                 }
                 row[x] = acc;
+                if let Some(mo) = moments.as_deref_mut() {
+                    for v in &lanes.value[m..m + run] {
+                        mo[x].add(*v);
+                    }
+                }
                 m += run;
             }
-            (ctx.progress)(end - k);
-            k = end;
+            (ctx.progress)(filled as u64);
         }
         ROW_BUFFERS.set(Some((lanes, pts, draws)));
         stats
@@ -588,8 +612,8 @@ impl Batch<'_> {
                 plan: lanes.plans[m],
                 u: [[0.0; 3]; 2],
             };
-            if let Some(&(seeds, index)) = lanes.each.get(m) {
-                self.assign_u(&mut pt, |p| seeded_pair(ctx, &seeds, index, p));
+            if let Some(&(seeds, index, n)) = lanes.each.get(m) {
+                self.assign_u(&mut pt, |p| seeded_pair(ctx, &seeds, n, index, p));
             }
             pts.push(pt);
         }
@@ -979,15 +1003,10 @@ impl Batch<'_> {
     }
 }
 
-/// Pair `p` of [`PixelSeeds::all`] for sample `index`, drawn alone
-/// (independent or stratified numbers).
-fn seeded_pair(ctx: &Context<'_>, seeds: &PixelSeeds, index: u64, p: usize) -> DVec2 {
-    DVec2::from_array(pair_point_seeded(
-        ctx.sequence,
-        seeds.all()[p],
-        ctx.spp,
-        index,
-    ))
+/// Pair `p` of [`PixelSeeds::all`] for sample `index` of a pixel with `n`
+/// samples in the pass, drawn alone (independent or stratified numbers).
+fn seeded_pair(ctx: &Context<'_>, seeds: &PixelSeeds, n: u64, index: u64, p: usize) -> DVec2 {
+    DVec2::from_array(pair_point_seeded(ctx.sequence, seeds.all()[p], n, index))
 }
 
 /// The pair seeds of pixel `(x, y)` in `ctx`'s pass.
