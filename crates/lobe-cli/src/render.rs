@@ -52,9 +52,10 @@ pub struct RenderArgs {
     pub sequence: Option<String>,
     /// How the width × height × spp samples are shared out among the
     /// pixels: uniform (spp each, the default) or variance (in proportion
-    /// to each pixel's noise as a pilot of spp/8, at most 8, extra samples
+    /// to each pixel's noise as a pilot of spp/8 (2 to 8) extra samples
     /// per pixel estimates it; at least spp/8 and at most 64 × spp per
-    /// pixel) (overrides the scene's render.spp_allocation)
+    /// pixel; the same total; NAME.spp.png shows the counts) (overrides the
+    /// scene's render.spp_allocation)
     #[arg(long, value_name = "ALLOCATION")]
     pub spp_allocation: Option<String>,
     /// Render whole passes of --spp samples per pixel until SECONDS have
@@ -255,6 +256,9 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             exposure: args.exposure,
         },
     )?;
+    // Where the samples went, when the variance allocation placed them.
+    let spp_png = crate::common::with_ext(&base, "spp.png");
+    let wrote_spp = image.write_spp_png(&spp_png)?;
     let samples = image.stats.camera_rays as f64;
     let passes = image.stats.passes.max(1);
     let spp = if budget.is_some() {
@@ -266,14 +270,27 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     } else {
         format!("{} spp", opts.spp)
     };
-    let spp = match opts.spp_allocation {
-        SppAllocation::Uniform => spp,
-        SppAllocation::Variance => format!("{spp} on average, allocated by variance"),
+    let spp = match (&image.spp, opts.spp_allocation) {
+        (Some(c), SppAllocation::Variance) => format!(
+            "{spp} on average, allocated by variance: {} to {} per pixel{}",
+            c.iter().min().unwrap_or(&0),
+            c.iter().max().unwrap_or(&0),
+            if budget.is_some() { " per pass" } else { "" }
+        ),
+        _ => spp,
+    };
+    let written = if wrote_spp {
+        format!(
+            "{}, {} and {} (samples per pixel)",
+            exr.display(),
+            png.display(),
+            spp_png.display()
+        )
+    } else {
+        format!("{} and {}", exr.display(), png.display())
     };
     println!(
-        "wrote {} and {} ({w}x{h}, {spp}, {}, {}, max_depth {}): {:.2} s, {:.2} M samples/s, {:.2} M rays/s",
-        exr.display(),
-        png.display(),
+        "wrote {written} ({w}x{h}, {spp}, {}, {}, max_depth {}): {:.2} s, {:.2} M samples/s, {:.2} M rays/s",
         opts.sequence,
         opts.strategy,
         opts.max_depth,

@@ -78,8 +78,9 @@
 //!
 //! With [`SppAllocation::Uniform`] (the default) every pixel gets `spp`
 //! samples per pass. With [`SppAllocation::Variance`] a pilot (before pass
-//! 0: [`pilot_spp`] samples per pixel of their own randomization, not in
-//! the image; adaptive MIS's pilot when the strategy is `mis`) estimates
+//! 0: [`pilot_spp`] samples per pixel, at least 2, of their own
+//! randomization, not in the image; adaptive MIS's pilot when the strategy
+//! is `mis`) estimates
 //! each pixel's variance, pooled over the 3 × 3 pixels around it, and
 //! [`spp_counts`] shares the pass's `width × height × spp` samples out in
 //! proportion to the standard deviations, at least `spp / 8` (and 1) per
@@ -241,6 +242,9 @@ pub struct Image {
     /// Row-major, `pixels[y * width + x]`.
     pub pixels: Vec<Rgb>,
     pub stats: RenderStats,
+    /// Under [`SppAllocation::Variance`], each pixel's samples per pass
+    /// (row-major; [`spp_counts`]); `None` when every pixel took `spp`.
+    pub spp: Option<Vec<u64>>,
 }
 
 impl Image {
@@ -252,6 +256,7 @@ impl Image {
             height,
             pixels: vec![Rgb::ZERO; width * height],
             stats: RenderStats::default(),
+            spp: None,
         }
     }
 
@@ -651,7 +656,11 @@ fn pilot_phase(scene: &Scene, opts: &RenderOptions) -> (Prior, RenderStats) {
     let light = Light::Env(scene.environment.clone());
     let pilot_opts = RenderOptions {
         seed: hash64(opts.seed ^ 0x7069_6c6f_7470_6978),
-        spp: pilot_spp(opts.spp.max(1)),
+        spp: match opts.spp_allocation {
+            // (A variance needs two samples.)
+            SppAllocation::Variance => pilot_spp(opts.spp.max(1)).max(2),
+            SppAllocation::Uniform => pilot_spp(opts.spp.max(1)),
+        },
         ..*opts
     };
     // On the batch loop where it renders the scene: the same draws,
@@ -772,6 +781,7 @@ fn render_on_pool(
     for (i, px) in img.pixels.iter_mut().enumerate() {
         *px *= 1.0 / count(i % w, i / w) as f64;
     }
+    img.spp.clone_from(&prior.counts);
     // The pilot's rays are work done, but not camera rays of the image.
     img.stats = RenderStats {
         rays: stats.rays + pilot_stats.rays,

@@ -130,6 +130,60 @@ impl Image {
             .map_err(|e| err(e.to_string()))
     }
 
+    /// The samples per pixel of a variance-allocated render
+    /// ([`Image::spp`]) as an 8-bit sRGB picture, `RGB RGB ...`: black for
+    /// the fewest, through purple and orange to pale yellow for the most,
+    /// on a logarithmic scale; `None` for a render that gave every pixel
+    /// the same count.
+    #[must_use]
+    pub fn spp_srgb8(&self) -> Option<Vec<u8>> {
+        let counts = self.spp.as_ref()?;
+        let lo = (*counts.iter().min()? as f64).max(1.0).ln();
+        let hi = (*counts.iter().max()? as f64).max(1.0).ln();
+        // (A colour ramp like matplotlib's "magma", by a few stops.)
+        const STOPS: [[f64; 3]; 5] = [
+            [0.0, 0.0, 0.02],
+            [0.32, 0.07, 0.48],
+            [0.72, 0.21, 0.47],
+            [0.98, 0.53, 0.38],
+            [0.99, 0.99, 0.75],
+        ];
+        Some(
+            counts
+                .iter()
+                .flat_map(|&n| {
+                    let t = if hi > lo {
+                        ((n as f64).max(1.0).ln() - lo) / (hi - lo)
+                    } else {
+                        1.0
+                    };
+                    let x = t.clamp(0.0, 1.0) * (STOPS.len() - 1) as f64;
+                    let k = (x as usize).min(STOPS.len() - 2);
+                    let f = x - k as f64;
+                    let (a, b) = (STOPS[k], STOPS[k + 1]);
+                    [0, 1, 2].map(|c| ((a[c] + (b[c] - a[c]) * f) * 255.0).round() as u8)
+                })
+                .collect(),
+        )
+    }
+
+    /// Write [`Image::spp_srgb8`] as a PNG; `Ok(false)` (nothing written)
+    /// for a render without per-pixel counts.
+    pub fn write_spp_png(&self, path: &Path) -> Result<bool, OutputError> {
+        let err = |message: String| OutputError {
+            path: path.to_path_buf(),
+            message,
+        };
+        let Some(bytes) = self.spp_srgb8() else {
+            return Ok(false);
+        };
+        let img = image::RgbImage::from_raw(self.width as u32, self.height as u32, bytes)
+            .ok_or_else(|| err("the count buffer does not match the size".into()))?;
+        img.save_with_format(path, image::ImageFormat::Png)
+            .map_err(|e| err(e.to_string()))?;
+        Ok(true)
+    }
+
     /// Write the image tone-mapped by `tone` as an 8-bit sRGB PNG.
     pub fn write_png(&self, path: &Path, tone: &ToneMap) -> Result<(), OutputError> {
         let err = |message: String| OutputError {

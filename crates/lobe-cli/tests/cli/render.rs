@@ -102,6 +102,55 @@ fn writes_exr_and_png() {
     assert_eq!(e.matches("the scalar loop renders this").count(), 1, "{e}");
     assert!(e.contains("one-sample MIS"), "{e}");
     assert!(!note(&["--strategy", "mis-one", "--loop", "scalar"]).contains("scalar loop"));
+
+    // The variance allocation: the counts' range in the summary and a
+    // picture of them beside the image (none without it: `scene.spp.png`
+    // was not written above); a bad name is a one-line error.
+    assert!(!d.join("scene.spp.png").exists());
+    let o = lobe(
+        &[
+            "render",
+            "scene.toml",
+            "--spp",
+            "16",
+            "--spp-allocation",
+            "variance",
+            "--out",
+            "v",
+        ],
+        Some(&d),
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        stdout.contains("16 spp on average, allocated by variance: ")
+            && stdout.contains("v.spp.png (samples per pixel)"),
+        "{stdout}"
+    );
+    let counts = image::open(d.join("v.spp.png")).unwrap().to_rgb8();
+    assert_eq!(counts.dimensions(), (20, 14));
+    // The fewest samples black, the most pale yellow.
+    let lum = |p: &image::Rgb<u8>| p.0.iter().map(|&c| u32::from(c)).sum::<u32>();
+    assert_eq!(counts.pixels().map(lum).min(), Some(5));
+    assert_eq!(counts.pixels().map(lum).max(), Some(252 + 252 + 191));
+    let o = lobe(
+        &[
+            "render",
+            "scene.toml",
+            "--spp-allocation",
+            "even",
+            "--out",
+            "e",
+        ],
+        Some(&d),
+    );
+    let e = one_line_error(&o);
+    assert!(
+        e.contains(
+            "--spp-allocation: unknown spp allocation `even`, expected one of: uniform, variance"
+        ),
+        "{e}"
+    );
 }
 
 #[test]
