@@ -193,13 +193,16 @@ def render(
     *,
     max_depth: int | None = None,
     threads: int | None = None,
+    spp_allocation: str | None = None,
 ) -> np.ndarray:
     """Render a scene (a TOML file path, or a dict of the same tables:
     ``camera``, ``environment``, ``object``, ``render``; see ``lobe render
     --help``) and return the linear image, an (H, W, 3) float32 array, row 0
     at the top. ``spp``, ``strategy`` (``mis``, ``light``, a BSDF strategy,
-    ...), ``seed`` and ``max_depth`` override the scene's ``[render]`` table;
-    the image does not depend on ``threads``. Relative paths in a dict are
+    ...), ``seed``, ``max_depth`` and ``spp_allocation`` (``uniform``: ``spp``
+    in every pixel; ``variance``: the same total shared out in proportion to
+    each pixel's noise, as a pilot estimates it) override the scene's
+    ``[render]`` table; the image does not depend on ``threads``. Relative paths in a dict are
     taken from the current directory. The scene is in world space (y up);
     each object's material is evaluated in its local shading frame (+z the
     surface normal, wo toward the camera, wi toward the light, f without the
@@ -224,7 +227,7 @@ def render(
                 text = f.read()
         except OSError as e:
             raise ValueError(f"scene {path}: cannot read it: {e}") from e
-    return _lobe._render(text, path, spp, strategy, seed, max_depth, threads)
+    return _lobe._render(text, path, spp, strategy, seed, max_depth, threads, spp_allocation)
 
 
 from . import chi2  # noqa: E402

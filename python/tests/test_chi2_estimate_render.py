@@ -128,6 +128,16 @@ def test_render_a_tiny_scene():
         lobe.render({"camera": {"width": 0}})
     with pytest.raises(ValueError, match="cannot read"):
         lobe.render("/nonexistent/scene.toml")
+    # Samples allocated by each pixel's noise: the same shape, finite, the
+    # same for any thread count; the scene's [render] table can ask too.
+    v = lobe.render(scene, spp=16, seed=1, spp_allocation="variance")
+    assert v.shape == (6, 8, 3) and np.all(np.isfinite(v))
+    assert np.array_equal(v, lobe.render(scene, spp=16, seed=1, spp_allocation="variance", threads=1))
+    assert not np.array_equal(v, lobe.render(scene, spp=16, seed=1))
+    in_table = lobe.render({**scene, "render": {"spp_allocation": "variance"}}, spp=16, seed=1)
+    assert np.array_equal(v, in_table)
+    with pytest.raises(ValueError, match="spp_allocation: unknown spp allocation `even`"):
+        lobe.render(scene, spp_allocation="even")
 
 
 def test_the_lecture_example_runs():

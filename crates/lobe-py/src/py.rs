@@ -810,7 +810,7 @@ fn _estimate_json(
 /// Render a scene (TOML text as if read from `path`) to an (H, W, 3)
 /// float32 linear image.
 #[pyfunction]
-#[pyo3(signature = (text, path, spp, strategy, seed, max_depth, threads))]
+#[pyo3(signature = (text, path, spp, strategy, seed, max_depth, threads, spp_allocation))]
 #[allow(clippy::too_many_arguments)]
 fn _render<'py>(
     py: Python<'py>,
@@ -821,6 +821,7 @@ fn _render<'py>(
     seed: Option<u64>,
     max_depth: Option<u32>,
     threads: Option<usize>,
+    spp_allocation: Option<&str>,
 ) -> PyResult<Bound<'py, PyAny>> {
     let mut scene =
         lobe_render::parse_scene(text, std::path::Path::new(path)).map_err(value_error)?;
@@ -847,6 +848,11 @@ fn _render<'py>(
     }
     if threads == Some(0) {
         return Err(value_error("threads: at least 1"));
+    }
+    if let Some(a) = spp_allocation {
+        opts.spp_allocation = a
+            .parse()
+            .map_err(|e| value_error(format!("spp_allocation: {e}")))?;
     }
     opts.threads = threads;
     scene.options = opts;
