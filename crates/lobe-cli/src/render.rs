@@ -29,7 +29,10 @@ use std::time::Instant;
                   8 bits). Every pixel has its own randomization of the sample pattern (--sequence: \
                   Owen-scrambled Sobol by default, in its own dimensions for the pixel position, each \
                   technique's samples and each bounce), so the image is the same for any --threads. \
-                  --time renders whole passes until the time is up.",
+                  --time renders whole passes until the time is up. --spp-allocation variance \
+                  shares the samples out among the pixels by their noise, as a pilot estimates it \
+                  (the same total; NAME.spp.png shows where they went): the fastest way to a clean \
+                  image where a few pixels (a highlight, an edge) hold most of the noise.",
     after_help = "Example:\n  lobe render examples/scene.toml --spp 16 --strategy mis-power --out preview",
     after_long_help = SCENE_HELP
 )]
