@@ -272,4 +272,21 @@ fn huge_spp_is_accepted_or_refused_clearly() {
     assert!(!out.status.success());
     let e = String::from_utf8_lossy(&out.stderr);
     assert!(e.contains("--spp") && e.contains("too large"), "{e}");
+    // Sobol's 2^32 points per pixel: the variance allocation can give a
+    // pixel 64 × spp, so 2^26 + 1 spp is refused, and says why.
+    let e = one_line_error(&lobe(
+        &[
+            "render",
+            s,
+            "--spp",
+            "67108865",
+            "--spp-allocation",
+            "variance",
+        ],
+        None,
+    ));
+    assert!(
+        e.contains("--spp 67108865: the sobol sequence has 2^32 points per pixel (the variance allocation gives a pixel up to 64 × spp)"),
+        "{e}"
+    );
 }
