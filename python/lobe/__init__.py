@@ -199,9 +199,10 @@ def render(
     ``camera``, ``environment``, ``object``, ``render``; see ``lobe render
     --help``) and return the linear image, an (H, W, 3) float32 array, row 0
     at the top. ``spp``, ``strategy`` (``mis``, ``light``, a BSDF strategy,
-    ...), ``seed``, ``max_depth`` and ``spp_allocation`` (``uniform``: ``spp``
-    in every pixel; ``variance``: the same total shared out in proportion to
-    each pixel's noise, as a pilot estimates it) override the scene's
+    ...), ``seed``, ``max_depth`` and ``spp_allocation`` (``variance``, the
+    default: the ``width × height × spp`` samples shared out in proportion to
+    each pixel's noise, as a pilot estimates it; ``uniform``: ``spp`` in every
+    pixel) override the scene's
     ``[render]`` table; the image does not depend on ``threads``. Relative paths in a dict are
     taken from the current directory. The scene is in world space (y up);
     each object's material is evaluated in its local shading frame (+z the

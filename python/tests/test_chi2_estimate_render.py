@@ -128,14 +128,16 @@ def test_render_a_tiny_scene():
         lobe.render({"camera": {"width": 0}})
     with pytest.raises(ValueError, match="cannot read"):
         lobe.render("/nonexistent/scene.toml")
-    # Samples allocated by each pixel's noise: the same shape, finite, the
-    # same for any thread count; the scene's [render] table can ask too.
+    # Samples allocated by each pixel's noise (the default): the same shape,
+    # finite, the same for any thread count; uniform spp differs; the
+    # scene's [render] table can ask too.
     v = lobe.render(scene, spp=16, seed=1, spp_allocation="variance")
     assert v.shape == (6, 8, 3) and np.all(np.isfinite(v))
-    assert np.array_equal(v, lobe.render(scene, spp=16, seed=1, spp_allocation="variance", threads=1))
-    assert not np.array_equal(v, lobe.render(scene, spp=16, seed=1))
-    in_table = lobe.render({**scene, "render": {"spp_allocation": "variance"}}, spp=16, seed=1)
-    assert np.array_equal(v, in_table)
+    assert np.array_equal(v, lobe.render(scene, spp=16, seed=1, threads=1))
+    u = lobe.render(scene, spp=16, seed=1, spp_allocation="uniform")
+    assert np.all(np.isfinite(u)) and not np.array_equal(v, u)
+    in_table = lobe.render({**scene, "render": {"spp_allocation": "uniform"}}, spp=16, seed=1)
+    assert np.array_equal(u, in_table)
     with pytest.raises(ValueError, match="spp_allocation: unknown spp allocation `even`"):
         lobe.render(scene, spp_allocation="even")
 

@@ -29,10 +29,11 @@ use std::time::Instant;
                   8 bits). Every pixel has its own randomization of the sample pattern (--sequence: \
                   Owen-scrambled Sobol by default, in its own dimensions for the pixel position, each \
                   technique's samples and each bounce), so the image is the same for any --threads. \
-                  --time renders whole passes until the time is up. --spp-allocation variance \
-                  shares the samples out among the pixels by their noise, as a pilot estimates it \
-                  (the same total; NAME.spp.png shows where they went): the fastest way to a clean \
-                  image where a few pixels (a highlight, an edge) hold most of the noise.",
+                  --time renders whole passes until the time is up. The samples are shared out \
+                  among the pixels by their noise, as a pilot estimates it (--spp-allocation \
+                  variance, the default; the same total; NAME.spp.png shows where they went): the \
+                  fastest way to a clean image where a few pixels (a highlight, an edge) hold most \
+                  of the noise; --spp-allocation uniform gives every pixel --spp.",
     after_help = "Example:\n  lobe render examples/scene.toml --spp 16 --strategy mis-power --out preview",
     after_long_help = SCENE_HELP
 )]
@@ -54,10 +55,10 @@ pub struct RenderArgs {
     #[arg(long)]
     pub sequence: Option<String>,
     /// How the width × height × spp samples are shared out among the
-    /// pixels: uniform (spp each, the default) or variance (in proportion
-    /// to each pixel's noise as a pilot of spp/8 (2 to 8) extra samples
-    /// per pixel estimates it; at least spp/8 and at most 64 × spp per
-    /// pixel; the same total; NAME.spp.png shows the counts) (overrides the
+    /// pixels: variance (the default: in proportion to each pixel's noise
+    /// as a pilot of spp/8 (2 to 8) extra samples per pixel estimates it;
+    /// at least spp/8 and at most 64 × spp per pixel; the same total;
+    /// NAME.spp.png shows the counts) or uniform (spp each) (overrides the
     /// scene's render.spp_allocation)
     #[arg(long, value_name = "ALLOCATION")]
     pub spp_allocation: Option<String>,
@@ -120,7 +121,7 @@ Scene file (TOML; unknown keys are errors; paths are relative to the scene file)
   seed = 1
   sequence = \"sobol\"   # sobol (default), stratified or independent
   max_depth = 1        # 1 = direct lighting; more adds bounces
-  spp_allocation = \"uniform\"  # uniform (default) or variance
+  spp_allocation = \"variance\"  # variance (default) or uniform
 
 Materials take the keys of `lobe eval --help`.
 

@@ -76,8 +76,8 @@
 //!
 //! # Samples per pixel
 //!
-//! With [`SppAllocation::Uniform`] (the default) every pixel gets `spp`
-//! samples per pass. With [`SppAllocation::Variance`] a pilot (before pass
+//! With [`SppAllocation::Uniform`] every pixel gets `spp` samples per pass.
+//! With [`SppAllocation::Variance`] (the default) a pilot (before pass
 //! 0: [`pilot_spp`] samples per pixel, at least 2, of their own
 //! randomization, not in the image; adaptive MIS's pilot when the strategy
 //! is `mis`) estimates

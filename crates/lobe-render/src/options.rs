@@ -25,9 +25,9 @@ pub struct RenderOptions {
     pub threads: Option<usize>,
     /// The batch loop (the default) or the scalar one, its reference.
     pub render_loop: RenderLoop,
-    /// How the samples are shared out among the pixels: `spp` each
-    /// (uniform, the default) or as a pilot's estimate of each pixel's noise
-    /// says ([`SppAllocation::Variance`]).
+    /// How the samples are shared out among the pixels: as a pilot's
+    /// estimate of each pixel's noise says ([`SppAllocation::Variance`], the
+    /// default) or `spp` each (uniform).
     pub spp_allocation: SppAllocation,
 }
 
@@ -36,7 +36,6 @@ pub struct RenderOptions {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 pub enum SppAllocation {
     /// `spp` samples in every pixel.
-    #[default]
     Uniform,
     /// In proportion to each pixel's standard deviation as a pilot
     /// estimates it (extra samples of their own randomization, not in the
@@ -45,7 +44,8 @@ pub enum SppAllocation {
     /// given number of samples when each pixel's error is `σ / √n`. The
     /// same total (`width × height × spp`) as `Uniform`; unbiased, since
     /// the image's samples do not decide their own counts
-    /// ([`crate::integrator::spp_counts`]).
+    /// ([`crate::integrator::spp_counts`]). The default.
+    #[default]
     Variance,
 }
 
@@ -128,7 +128,7 @@ impl Default for RenderOptions {
             max_depth: 1,
             threads: None,
             render_loop: RenderLoop::Batch,
-            spp_allocation: SppAllocation::Uniform,
+            spp_allocation: SppAllocation::Variance,
         }
     }
 }

@@ -29,7 +29,7 @@
 //! seed = 1
 //! sequence = "sobol"  # sobol, stratified or independent
 //! max_depth = 1       # 1 = direct lighting
-//! spp_allocation = "uniform"  # uniform, or variance: as a pilot estimates each pixel's noise
+//! spp_allocation = "variance"  # variance (as a pilot estimates each pixel's noise) or uniform
 //! ```
 
 use crate::camera::{Camera, CameraError};
@@ -334,7 +334,7 @@ pub struct RenderDesc {
     pub sequence: String,
     #[serde(default = "default_depth")]
     pub max_depth: u32,
-    /// `uniform` (the default) or `variance` ([`crate::options::SppAllocation`]).
+    /// `variance` (the default) or `uniform` ([`crate::options::SppAllocation`]).
     #[serde(default = "default_spp_allocation")]
     pub spp_allocation: String,
 }
@@ -355,7 +355,7 @@ fn default_depth() -> u32 {
     1
 }
 fn default_spp_allocation() -> String {
-    "uniform".into()
+    "variance".into()
 }
 
 impl Default for RenderDesc {

@@ -838,10 +838,10 @@ fn scene_files_load_and_their_errors_name_file_line_and_field() {
     let e = load_scene(&dir.join("none.toml")).unwrap_err().to_string();
     assert!(e.contains("none.toml"), "{e}");
 
-    std::fs::write(&bad, format!("{SCENE}spp_allocation = \"variance\"\n")).unwrap();
+    std::fs::write(&bad, format!("{SCENE}spp_allocation = \"uniform\"\n")).unwrap();
     let s = load_scene(&bad).unwrap();
-    assert_eq!(s.options.spp_allocation, SppAllocation::Variance);
-    assert_eq!(scene.options.spp_allocation, SppAllocation::Uniform);
+    assert_eq!(s.options.spp_allocation, SppAllocation::Uniform);
+    assert_eq!(scene.options.spp_allocation, SppAllocation::Variance);
     std::fs::write(&bad, format!("{SCENE}spp_allocation = \"even\"\n")).unwrap();
     let e = load_scene(&bad).unwrap_err().to_string();
     assert!(

@@ -103,10 +103,27 @@ fn writes_exr_and_png() {
     assert!(e.contains("one-sample MIS"), "{e}");
     assert!(!note(&["--strategy", "mis-one", "--loop", "scalar"]).contains("scalar loop"));
 
-    // The variance allocation: the counts' range in the summary and a
-    // picture of them beside the image (none without it: `scene.spp.png`
-    // was not written above); a bad name is a one-line error.
-    assert!(!d.join("scene.spp.png").exists());
+    // The variance allocation (the default: `scene.spp.png` was written
+    // above): the counts' range in the summary and a picture of them beside
+    // the image; none with --spp-allocation uniform; a bad name is a
+    // one-line error.
+    assert!(d.join("scene.spp.png").exists());
+    let o = lobe(
+        &[
+            "render",
+            "scene.toml",
+            "--spp",
+            "2",
+            "--spp-allocation",
+            "uniform",
+            "--out",
+            "u",
+        ],
+        Some(&d),
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("(20x14, 2 spp, sobol"));
+    assert!(d.join("u.png").exists() && !d.join("u.spp.png").exists());
     let o = lobe(
         &[
             "render",
