@@ -793,12 +793,12 @@ fn render_on_pool(
     let count = |x: usize, y: usize| prior.counts.as_ref().map_or(spp, |c| c[y * w + x]);
     let stats = match opts.strategy {
         Strategy::Mis(mis) if mis.form == MisForm::Adaptive => {
-            render_rows(&ctx, &mut img.pixels, |x, y| {
+            render_rows(&ctx, &mut img.pixels, count, |x, y| {
                 let a = pooled_allocation(&prior.pilots, w, h, x, y, mis);
                 (count(x, y), FirstBounce::Allocated(a))
             })
         }
-        _ => render_rows(&ctx, &mut img.pixels, |x, y| {
+        _ => render_rows(&ctx, &mut img.pixels, count, |x, y| {
             (count(x, y), FirstBounce::Plain)
         }),
     };
@@ -816,18 +816,28 @@ fn render_on_pool(
 }
 
 /// Every pixel's samples `0..n` of the pass with first-bounce mode `mode`,
-/// `(n, mode) = plan(x, y)`, rows in parallel; stores each pixel's sum (not
-/// divided).
+/// `(n, mode) = plan(x, y)` (`n = count(x, y)`, the cheaper call), rows in
+/// parallel; stores each pixel's sum (not divided).
 fn render_rows(
     ctx: &Context<'_>,
     pixels: &mut [Rgb],
+    count: impl Fn(usize, usize) -> u64,
     plan: impl Fn(usize, usize) -> (u64, FirstBounce) + Sync,
 ) -> RenderStats {
     let w = ctx.width;
-    pixels
-        .par_chunks_mut(w)
+    // The rows handed out to the threads the costliest first (by their
+    // samples), so that no thread is left with a long row at the end while
+    // the others wait; each row's pixels are the same whichever thread
+    // takes it, and the stats are sums.
+    let mut rows: Vec<(u64, usize, &mut [Rgb])> = pixels
+        .chunks_mut(w)
         .enumerate()
-        .map(|(y, row)| {
+        .map(|(y, row)| ((0..w).map(|x| count(x, y)).sum(), y, row))
+        .collect();
+    rows.sort_by_key(|&(cost, y, _)| (std::cmp::Reverse(cost), y));
+    rows.into_iter()
+        .par_bridge()
+        .map(|(_, y, row)| {
             if let Some(b) = ctx.batch {
                 return b.row(ctx, y, row, &|x| plan(x, y), None, None);
             }
