@@ -253,16 +253,29 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     }
     let exr = crate::common::with_ext(&base, "exr");
     let png = crate::common::with_ext(&base, "png");
-    image.write_exr(&exr)?;
-    image.write_png(
-        &png,
-        &lobe_render::ToneMap {
-            exposure: args.exposure,
-        },
-    )?;
     // Where the samples went, when the variance allocation placed them.
     let spp_png = crate::common::with_ext(&base, "spp.png");
-    let wrote_spp = image.write_spp_png(&spp_png)?;
+    // The three files written at once (each one encodes on its own thread).
+    let (exr_written, png_written, spp_written) = std::thread::scope(|s| {
+        let p = s.spawn(|| {
+            image.write_png(
+                &png,
+                &lobe_render::ToneMap {
+                    exposure: args.exposure,
+                },
+            )
+        });
+        let q = s.spawn(|| image.write_spp_png(&spp_png));
+        let e = image.write_exr(&exr);
+        (
+            e,
+            p.join().expect("the PNG writer does not panic"),
+            q.join().expect("the spp PNG writer does not panic"),
+        )
+    });
+    exr_written?;
+    png_written?;
+    let wrote_spp = spp_written?;
     let samples = image.stats.camera_rays as f64;
     let passes = image.stats.passes.max(1);
     let spp = if budget.is_some() {

@@ -366,6 +366,33 @@ impl TexelBuffer {
         self.texels[j * self.width + i] = Texel { rgb };
     }
 
+    /// Set channel `c` (0 red, 1 green, 2 blue) of the run of texels
+    /// starting at `(i0, j)`: `values[k]` to texel `(i0 + k, j)` (a
+    /// decoder's line of one channel, as [`TexelBuffer::set`] sets texels).
+    ///
+    /// # Panics
+    /// If the run leaves row `j` or the buffer, or `c > 2`.
+    #[inline]
+    pub fn set_channel_run(
+        &mut self,
+        i0: usize,
+        j: usize,
+        c: usize,
+        values: impl ExactSizeIterator<Item = f32>,
+    ) {
+        let n = values.len();
+        assert!(
+            c < 3 && j < self.height && i0.checked_add(n).is_some_and(|e| e <= self.width),
+            "TexelBuffer::set_channel_run: channel {c}, {n} texels from ({i0}, {j}) outside {}×{}",
+            self.width,
+            self.height
+        );
+        let start = j * self.width + i0;
+        for (t, v) in self.texels[start..start + n].iter_mut().zip(values) {
+            t.rgb[c] = v;
+        }
+    }
+
     /// `(width, height)`.
     #[must_use]
     pub fn size(&self) -> (usize, usize) {
@@ -530,10 +557,19 @@ impl EnvMap {
         // `f32::MAX`): the same texels without a round trip through `f64`.
         // A count of the texels to clamp first, in a loop without branches
         // (vectorized), then the clamping only if there are any.
-        let bad = |c: f32| !(c >= 0.0 && c.is_finite());
+        // `!(c >= 0.0 && c.is_finite())` on the bits: negative (but −0),
+        // infinite or NaN, an integer comparison that vectorizes.
+        let bad = |c: f32| {
+            let b = c.to_bits();
+            b > 0x7f7f_ffff && b != 0x8000_0000
+        };
         let clamped: usize = texels
-            .iter()
-            .map(|t| usize::from(bad(t.rgb[0]) | bad(t.rgb[1]) | bad(t.rgb[2])))
+            .chunks(1 << 16)
+            .map(|c| {
+                c.iter()
+                    .map(|t| u32::from(bad(t.rgb[0]) | bad(t.rgb[1]) | bad(t.rgb[2])))
+                    .sum::<u32>() as usize
+            })
             .sum();
         if clamped > 0 {
             for t in &mut texels {
@@ -1235,6 +1271,12 @@ mod tests {
             .map(|k| match k % 97 {
                 0 => [-1.0, f32::NAN, 2.0],
                 1 => [f32::INFINITY, 1.0, 0.5],
+                2 => [-0.0, f32::NEG_INFINITY, 1.0],
+                3 => [-f32::NAN, 0.0, 0.0],
+                // −0 is not clamped; the largest finite and the smallest
+                // subnormal are kept, a negative subnormal is not.
+                4 => [-0.0, -0.0, -0.0],
+                5 => [f32::MAX, 1e-45, -1e-45],
                 _ => [k as f32 * 0.37, (k % 13) as f32, 1e-3 * k as f32],
             })
             .collect();
@@ -1244,7 +1286,8 @@ mod tests {
             .collect();
         let a = EnvMap::from_rgb32f(32, 16, &rgb, 1.5, 20.0).unwrap();
         let b = EnvMap::new(32, 16, wide, 1.5, 20.0).unwrap();
-        assert_eq!(a.1, 12);
+        assert_eq!(a.1, 30);
+        assert_eq!(b.1, 30);
         assert_eq!(a, b);
         // Filled texel by texel, in any order, as a decoder fills it.
         let mut buf = TexelBuffer::new(32, 16);
