@@ -57,7 +57,7 @@ pub struct RenderArgs {
     /// How the width × height × spp samples are shared out among the
     /// pixels: variance (the default: in proportion to each pixel's noise
     /// as a pilot of spp/8 (2 to 8) extra samples per pixel estimates it;
-    /// at least spp/8 and at most 64 × spp per pixel; the same total;
+    /// at least spp/16 and at most 64 × spp per pixel; the same total;
     /// NAME.spp.png shows the counts) or uniform (spp each) (overrides the
     /// scene's render.spp_allocation)
     #[arg(long, value_name = "ALLOCATION")]

@@ -39,7 +39,7 @@ pub enum SppAllocation {
     Uniform,
     /// In proportion to each pixel's standard deviation as a pilot
     /// estimates it (extra samples of their own randomization, not in the
-    /// image), with a floor of `spp / 8` (at least 1) per pixel: the
+    /// image), with a floor of `spp / 16` (at least 1) per pixel: the
     /// allocation that minimizes the image's mean squared error for a
     /// given number of samples when each pixel's error is `σ / √n`. The
     /// same total (`width × height × spp`) as `Uniform`; unbiased, since
