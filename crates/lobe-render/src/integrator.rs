@@ -580,7 +580,7 @@ pub fn render_progressive(
             if t0.elapsed() + per_pass > budget {
                 break;
             }
-            let img = render_on_pool(scene, opts, passes, &progress, Some(&prior)).0;
+            let img = render_on_pool(scene, opts, passes, &progress, prior.as_ref()).0;
             for (a, b) in sum.pixels.iter_mut().zip(&img.pixels) {
                 *a += *b;
             }
@@ -769,15 +769,16 @@ fn pooled_allocation(
     p.choose(mis.n_bsdf, mis.n_light)
 }
 
-/// One pass, and what its pilot decided (pass 0 runs the pilot where the
-/// render needs one; later passes take `prior`).
+/// One pass, and what its pilot decided when it ran one (pass 0 runs the
+/// pilot where the render needs one and returns it; later passes borrow
+/// it as `prior`).
 fn render_on_pool(
     scene: &Scene,
     opts: &RenderOptions,
     pass: u64,
     progress: &(dyn Fn(u64) + Sync),
     prior: Option<&Prior>,
-) -> (Image, Prior) {
+) -> (Image, Option<Prior>) {
     let (w, h) = (scene.camera.width as usize, scene.camera.height as usize);
     let shading = shadings(scene, opts);
     let light = Light::Env(scene.environment.clone());
@@ -793,13 +794,15 @@ fn render_on_pool(
     );
     let mut img = Image::new(w, h);
     if w == 0 || h == 0 {
-        return (img, Prior::default());
+        return (img, None);
     }
     let spp = ctx.spp;
-    let (prior, pilot_stats) = match prior {
-        Some(p) => (p.clone(), RenderStats::default()),
-        None if needs_pilot(opts) => pilot_phase(scene, opts),
-        None => (Prior::default(), RenderStats::default()),
+    let own = (prior.is_none() && needs_pilot(opts)).then(|| pilot_phase(scene, opts));
+    let none = Prior::default();
+    let (prior, pilot_stats) = match (&own, prior) {
+        (Some((p, stats)), _) => (p, *stats),
+        (None, Some(p)) => (p, RenderStats::default()),
+        (None, None) => (&none, RenderStats::default()),
     };
     let count = |x: usize, y: usize| prior.counts.as_ref().map_or(spp, |c| c[y * w + x]);
     let stats = match opts.strategy {
@@ -823,7 +826,7 @@ fn render_on_pool(
         nonfinite: stats.nonfinite + pilot_stats.nonfinite,
         ..stats
     };
-    (img, prior)
+    (img, own.map(|(p, _)| p))
 }
 
 /// Every pixel's samples `0..n` of the pass with first-bounce mode `mode`,
