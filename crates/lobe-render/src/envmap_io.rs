@@ -424,8 +424,9 @@ mod tests {
 
     /// The line reader gives the pixel reader's texels, bit for bit, for
     /// scanline and tiled files, four compressions and every sample type,
-    /// with other channels beside R, G and B, lines stored bottom-up; it
-    /// leaves files of more than one layer to the pixel reader.
+    /// with other channels beside R, G and B, lines stored bottom-up, and
+    /// the full-resolution level of a mip map; it leaves files of more than
+    /// one layer to the pixel reader.
     #[test]
     fn the_line_reader_reads_what_the_pixel_reader_reads() {
         use exr::prelude::*;
@@ -491,6 +492,50 @@ mod tests {
                 }
             }
         }
+        // A mip-mapped file (tiled): the full-resolution level, the
+        // smaller ones different (each level's values offset by its index).
+        let levels = exr::meta::mip_map_levels(exr::math::RoundingMode::Down, Vec2(w, h))
+            .collect::<Vec<_>>();
+        let mip = |name: &str, c: usize| {
+            let data = levels
+                .iter()
+                .map(|(l, size)| {
+                    FlatSamples::F32(
+                        (0..size.area())
+                            .map(|k| value(c, k) as f32 + 100.0 * *l as f32)
+                            .collect(),
+                    )
+                })
+                .collect();
+            AnyChannel::new(
+                name,
+                Levels::Mip {
+                    rounding_mode: exr::math::RoundingMode::Down,
+                    level_data: data,
+                },
+            )
+        };
+        let layer = Layer::new(
+            (w, h),
+            LayerAttributes::named("mip"),
+            Encoding {
+                compression: Compression::ZIP16,
+                blocks: Blocks::Tiles(Vec2(8, 8)),
+                line_order: LineOrder::Increasing,
+            },
+            AnyChannels::sort(SmallVec::from_vec(vec![
+                mip("R", 0),
+                mip("G", 1),
+                mip("B", 2),
+            ])),
+        );
+        let p = tmp("mip.exr");
+        Image::from_layer(layer).write().to_file(&p).unwrap();
+        let lines = read_exr_rgb_lines(&p).unwrap().expect("one flat layer");
+        assert_eq!(lines.size(), (w, h));
+        assert_eq!(lines, read_exr_rgb_pixels(&p).unwrap());
+        let (m, _) = load_envmap(&p, 1.0, 0.0).unwrap();
+        assert_eq!(m.texel(1, 0).x, 7.0);
         // Two layers: the pixel reader's.
         let layer = |name: &str| {
             Layer::new(
