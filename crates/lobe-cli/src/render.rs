@@ -287,14 +287,15 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     } else {
         format!("{} spp", opts.spp)
     };
-    let spp = match (&image.spp, opts.spp_allocation) {
-        (Some(c), SppAllocation::Variance) => format!(
+    // (Per-pixel counts exist only under the variance allocation.)
+    let spp = match &image.spp {
+        Some(c) => format!(
             "{spp} on average, allocated by variance: {} to {} per pixel{}",
             c.iter().min().unwrap_or(&0),
             c.iter().max().unwrap_or(&0),
             if budget.is_some() { " per pass" } else { "" }
         ),
-        _ => spp,
+        None => spp,
     };
     let written = if wrote_spp {
         format!(

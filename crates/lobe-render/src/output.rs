@@ -170,29 +170,27 @@ impl Image {
     /// Write [`Image::spp_srgb8`] as a PNG; `Ok(false)` (nothing written)
     /// for a render without per-pixel counts.
     pub fn write_spp_png(&self, path: &Path) -> Result<bool, OutputError> {
-        let err = |message: String| OutputError {
-            path: path.to_path_buf(),
-            message,
-        };
         let Some(bytes) = self.spp_srgb8() else {
             return Ok(false);
         };
-        let img = image::RgbImage::from_raw(self.width as u32, self.height as u32, bytes)
-            .ok_or_else(|| err("the count buffer does not match the size".into()))?;
-        img.save_with_format(path, image::ImageFormat::Png)
-            .map_err(|e| err(e.to_string()))?;
+        self.write_srgb8_png(path, bytes, "count")?;
         Ok(true)
     }
 
     /// Write the image tone-mapped by `tone` as an 8-bit sRGB PNG.
     pub fn write_png(&self, path: &Path, tone: &ToneMap) -> Result<(), OutputError> {
+        self.write_srgb8_png(path, self.to_srgb8(tone), "pixel")
+    }
+
+    /// Write `bytes` (8-bit sRGB, `RGB RGB ...`, the image's size) as a PNG;
+    /// `what` names the buffer in the error if its size is wrong.
+    fn write_srgb8_png(&self, path: &Path, bytes: Vec<u8>, what: &str) -> Result<(), OutputError> {
         let err = |message: String| OutputError {
             path: path.to_path_buf(),
             message,
         };
-        let img =
-            image::RgbImage::from_raw(self.width as u32, self.height as u32, self.to_srgb8(tone))
-                .ok_or_else(|| err("the pixel buffer does not match the size".into()))?;
+        let img = image::RgbImage::from_raw(self.width as u32, self.height as u32, bytes)
+            .ok_or_else(|| err(format!("the {what} buffer does not match the size")))?;
         img.save_with_format(path, image::ImageFormat::Png)
             .map_err(|e| err(e.to_string()))
     }
