@@ -158,38 +158,35 @@ fn read_exr_rgb_lines(path: &Path) -> Result<Option<TexelBuffer>, exr::error::Er
                         continue;
                     };
                     // Native-endian samples, converted as the pixel reader
-                    // converts them.
+                    // converts them (one loop per type, of a constant width).
+                    let first = (x0, y0 + k, rgb);
                     match c.sample_type {
-                        SampleType::F16 => texels.set_channel_run(
-                            x0,
-                            y0 + k,
-                            rgb,
-                            samples
-                                .chunks_exact(2)
-                                .map(|s| f16::from_ne_bytes([s[0], s[1]]).to_f32()),
-                        ),
-                        SampleType::F32 => texels.set_channel_run(
-                            x0,
-                            y0 + k,
-                            rgb,
-                            samples
-                                .chunks_exact(4)
-                                .map(|s| f32::from_ne_bytes([s[0], s[1], s[2], s[3]])),
-                        ),
-                        SampleType::U32 => texels.set_channel_run(
-                            x0,
-                            y0 + k,
-                            rgb,
-                            samples
-                                .chunks_exact(4)
-                                .map(|s| u32::from_ne_bytes([s[0], s[1], s[2], s[3]]) as f32),
-                        ),
+                        SampleType::F16 => put(&mut texels, first, samples, |s: &[u8; 2]| {
+                            f16::from_ne_bytes(*s).to_f32()
+                        }),
+                        SampleType::F32 => put(&mut texels, first, samples, |s: &[u8; 4]| {
+                            f32::from_ne_bytes(*s)
+                        }),
+                        SampleType::U32 => put(&mut texels, first, samples, |s: &[u8; 4]| {
+                            u32::from_ne_bytes(*s) as f32
+                        }),
                     }
                 }
             }
             Ok(())
         })?;
     Ok(Some(texels))
+}
+
+/// Channel `c` of the texels from `(x0, y)` on: `samples`, `N` bytes each,
+/// converted by `convert`.
+fn put<const N: usize>(
+    texels: &mut TexelBuffer,
+    (x0, y, c): (usize, usize, usize),
+    samples: &[u8],
+    convert: impl Fn(&[u8; N]) -> f32,
+) {
+    texels.set_channel_run(x0, y, c, samples.as_chunks::<N>().0.iter().map(convert));
 }
 
 /// [`read_exr_rgb`] through `exr`'s pixel reader: any layout it reads.
