@@ -189,15 +189,17 @@ struct Point {
 }
 
 /// Per draw (two per sample) of a block.
-#[derive(Debug, Clone, Copy, Default)]
+#[derive(Debug, Clone, Copy)]
 struct Draw {
+    /// What the draw is (its sample's plan's slot).
+    slot: Slot,
     /// A BSDF draw: `wi` local; a light draw: the world direction.
     dir: DVec3,
     /// The light draw's local `wi`.
     wi: DVec3,
-    /// The map at the draw's direction: a light draw's texel, an escaping
-    /// BSDF draw's lookup.
-    light: Option<EnvLookup>,
+    /// The map at the draw's direction (read only when `ok`): a light
+    /// draw's texel, an escaping BSDF draw's lookup.
+    light: EnvLookup,
     /// BSDF draw: the weight `f cos / p`; light draw: `f`.
     f: Rgb,
     /// BSDF draw: its pdf; light draw: the BSDF strategy's pdf at `wi`.
@@ -205,18 +207,28 @@ struct Draw {
     ok: bool,
 }
 
+impl Default for Draw {
+    fn default() -> Self {
+        Draw {
+            slot: Slot::Unused,
+            dir: DVec3::ZERO,
+            wi: DVec3::ZERO,
+            light: EnvLookup::default(),
+            f: Rgb::ZERO,
+            pdf: 0.0,
+            ok: false,
+        }
+    }
+}
+
 /// Reusable structure-of-arrays buffers of one row.
 struct Lanes {
     a: [Vec<f32>; 6],
     out: [Vec<f32>; 10],
     valid: Vec<u8>,
-    /// (bucket, draw index) of every BSDF or light draw, the bucket
-    /// `2 · object + (1 for a light draw)`, grouped by bucket (a stable
-    /// counting sort, through `sorted` and the per-bucket `starts`): in
-    /// each bucket the draws in draw order.
-    keys: Vec<u64>,
-    sorted: Vec<u64>,
-    starts: Vec<usize>,
+    /// The draw indices of every BSDF or light draw, by bucket `2 · object
+    /// + (1 for a light draw)`: in each bucket the draws in draw order.
+    buckets: Vec<Vec<u32>>,
     /// The block's Sobol pairs: per sample, the scramble keys of its
     /// [`PAIRS`] pairs, its index, and the points.
     pair_seeds: [Vec<SobolKeys>; PAIRS],
@@ -272,9 +284,7 @@ impl Lanes {
             a: std::array::from_fn(|_| v()),
             out: std::array::from_fn(|_| v()),
             valid: vec![0; 2 * BLOCK],
-            keys: Vec::with_capacity(2 * BLOCK),
-            sorted: Vec::with_capacity(2 * BLOCK),
-            starts: Vec::new(),
+            buckets: Vec::new(),
             pair_seeds: std::array::from_fn(|_| Vec::with_capacity(BLOCK)),
             pair_index: Vec::with_capacity(BLOCK),
             pair_x: std::array::from_fn(|_| vec![0.0; BLOCK]),
@@ -683,23 +693,29 @@ impl Batch<'_> {
     ) {
         // Light draws first: their directions, by sampling the map for the
         // whole block (`EnvMap::sample_lookup_many`).
-        lanes.keys.clear();
+        // A draw's bucket: its object, then BSDF 0 / light 1.
+        let buckets = 2 * self.samplers.len();
+        lanes.buckets.resize_with(buckets, Vec::new);
+        for b in &mut lanes.buckets {
+            b.clear();
+        }
+        let bucket = |obj: u32, light: bool| 2 * obj as usize + usize::from(light);
         lanes.light_u.clear();
         lanes.draw_index.clear();
-        // A draw's key: its bucket (object, then BSDF 0 / light 1) above
-        // its draw index.
-        let key = |obj: u32, light: bool, di: usize| {
-            ((2 * u64::from(obj) + u64::from(light)) << 32) | di as u64
-        };
-        for (i, pt) in pts.iter().enumerate() {
-            for s in 0..2 {
+        let draws = &mut draws[..2 * pts.len()];
+        for (i, (pt, pair)) in pts.iter().zip(draws.chunks_exact_mut(2)).enumerate() {
+            for (s, d) in pair.iter_mut().enumerate() {
                 // Every other field of a draw is written before it is read
                 // (a light draw that gets no direction stays not `ok`).
-                draws[2 * i + s].ok = false;
-                match pt.plan.slots[s] {
+                let slot = pt.plan.slots[s];
+                d.slot = slot;
+                d.ok = false;
+                match slot {
                     Slot::Unused => {}
-                    Slot::Bsdf => lanes.keys.push(key(pt.obj, false, 2 * i + s)),
-                    slot @ (Slot::Light | Slot::LightCompensated) => {
+                    Slot::Bsdf => {
+                        lanes.buckets[bucket(pt.obj, false)].push((2 * i + s) as u32);
+                    }
+                    Slot::Light | Slot::LightCompensated => {
                         let compensated = slot == Slot::LightCompensated;
                         lanes
                             .light_u
@@ -725,37 +741,13 @@ impl Batch<'_> {
             let d = &mut draws[di];
             d.dir = dir;
             d.wi = wi;
-            d.light = Some(l);
-            lanes.keys.push(key(pt.obj, true, di));
+            d.light = l;
+            lanes.buckets[bucket(pt.obj, true)].push(di as u32);
         }
-        // Grouped by bucket (a stable counting sort), each bucket's draws in
-        // draw order, so each batch call's lanes are in draw order.
-        let buckets = 2 * self.samplers.len();
-        lanes.starts.clear();
-        lanes.starts.resize(buckets + 1, 0);
-        for &key in &lanes.keys {
-            lanes.starts[(key >> 32) as usize + 1] += 1;
-        }
-        for b in 0..buckets {
-            lanes.starts[b + 1] += lanes.starts[b];
-        }
-        lanes.sorted.clear();
-        lanes.sorted.resize(lanes.keys.len(), 0);
-        // Each bucket's start as its cursor, which ends at the next
-        // bucket's start; then shifted back.
-        for &key in &lanes.keys {
-            let b = (key >> 32) as usize;
-            lanes.sorted[lanes.starts[b]] = key;
-            lanes.starts[b] += 1;
-        }
-        lanes.starts.copy_within(0..buckets, 1);
-        lanes.starts[0] = 0;
-        std::mem::swap(&mut lanes.keys, &mut lanes.sorted);
         // One batch call per object and kind of draw.
         for b in 0..buckets {
-            let (g, e) = (lanes.starts[b], lanes.starts[b + 1]);
-            if g < e {
-                self.batch_group(b / 2, b % 2 == 0, g..e, pts, draws, lanes);
+            if !lanes.buckets[b].is_empty() {
+                self.batch_group(b, pts, draws, lanes);
             }
         }
         // The shadow rays of the block, traced together: the BSDF draws'
@@ -769,23 +761,24 @@ impl Batch<'_> {
         lanes.shadow_dir.resize(most);
         lanes.shadow_draw.resize(most, 0);
         let mut r = 0;
-        for (i, pt) in pts.iter().enumerate() {
-            for s in 0..2 {
-                let di = 2 * i + s;
-                let d = &mut draws[di];
-                let dir = match pt.plan.slots[s] {
-                    Slot::Bsdf if d.ok => {
+        for (i, (pt, pair)) in pts.iter().zip(draws.chunks_exact_mut(2)).enumerate() {
+            for (s, d) in pair.iter_mut().enumerate() {
+                if !d.ok {
+                    continue;
+                }
+                let dir = match d.slot {
+                    Slot::Bsdf => {
                         // The world direction, kept for the lookup.
                         d.dir = pt.frame.to_world(d.dir).normalize();
                         d.dir
                     }
-                    Slot::Light | Slot::LightCompensated if d.ok && d.f != Rgb::ZERO => d.dir,
+                    Slot::Light | Slot::LightCompensated if d.f != Rgb::ZERO => d.dir,
                     _ => continue,
                 };
                 lanes.shadow_p.set(r, pt.p);
                 lanes.shadow_ng.set(r, pt.ng);
                 lanes.shadow_dir.set(r, dir);
-                lanes.shadow_draw[r] = di;
+                lanes.shadow_draw[r] = 2 * i + s;
                 r += 1;
             }
         }
@@ -793,7 +786,7 @@ impl Batch<'_> {
         lanes.shadow_ng.truncate(r);
         lanes.shadow_dir.truncate(r);
         lanes.shadow_draw.truncate(r);
-        stats.rays += lanes.shadow_draw.len() as u64;
+        stats.rays += r as u64;
         spawn_many(
             self.level,
             &lanes.shadow_p,
@@ -810,7 +803,7 @@ impl Batch<'_> {
             let d = &mut draws[di];
             if blocked {
                 d.ok = false;
-            } else if pts[di / 2].plan.slots[di % 2] == Slot::Bsdf {
+            } else if d.slot == Slot::Bsdf {
                 lanes.bsdf_dirs.push(d.dir);
                 lanes.draw_index.push(di);
             }
@@ -820,32 +813,31 @@ impl Batch<'_> {
         self.env
             .lookup_many(&lanes.bsdf_dirs, &mut lanes.bsdf_env[..n]);
         for (&di, &l) in lanes.draw_index.iter().zip(&lanes.bsdf_env[..n]) {
-            draws[di].light = Some(l);
+            draws[di].light = l;
         }
-        // Shadow rays and the estimates, in sample order.
-        for (i, pt) in pts.iter().enumerate() {
+        // The estimates, in sample order.
+        for (pt, pair) in pts.iter().zip(draws.chunks_exact(2)) {
             let mut sum = Rgb::ZERO;
             let mut n = 0.0;
-            let x = lanes.px[pt.m as usize] as usize;
-            let mut pilot = pilots.as_deref_mut().map(|p| &mut p[x]);
+            let m = pt.m as usize;
+            let mut pilot = pilots.as_deref_mut().map(|p| &mut p[lanes.px[m] as usize]);
             if let Some(p) = pilot.as_deref_mut() {
                 p.samples += 1;
             }
-            for s in 0..2 {
-                let slot = pt.plan.slots[s];
-                if slot == Slot::Unused {
+            for d in pair {
+                if d.slot == Slot::Unused {
                     continue;
                 }
                 n += 1.0;
-                let d = &draws[2 * i + s];
                 if !d.ok {
                     continue;
                 }
-                match slot {
+                // (Unoccluded: a blocked draw is not `ok`; a BSDF draw that
+                // is `ok` escapes and was looked up.)
+                let l = d.light;
+                match d.slot {
                     Slot::Unused => {}
                     Slot::Bsdf => {
-                        // Unoccluded (above), looked up.
-                        let l = d.light.expect("a BSDF draw that escapes");
                         let v = d.f * l.radiance;
                         if let Some(p) = pilot.as_deref_mut() {
                             let q = d.pdf + l.pdf_compensated;
@@ -857,18 +849,15 @@ impl Batch<'_> {
                         };
                     }
                     Slot::Light | Slot::LightCompensated => {
-                        let compensated = slot == Slot::LightCompensated;
-                        let l = d.light.expect("a light draw");
                         if d.f == Rgb::ZERO {
                             continue;
                         }
-                        // (Unoccluded: a blocked draw is not `ok`.)
                         let v = d.f * l.radiance * d.wi.z;
                         if let Some(p) = pilot.as_deref_mut() {
                             let q = d.pdf + l.pdf_compensated;
                             p.record(luminance(v), d.pdf, l.pdf_compensated, l.pdf, q);
                         }
-                        let p = if compensated {
+                        let p = if d.slot == Slot::LightCompensated {
                             l.pdf_compensated
                         } else {
                             l.pdf
@@ -880,32 +869,26 @@ impl Batch<'_> {
                     }
                 }
             }
-            lanes.value[pt.m as usize] = match pt.plan.mis {
+            lanes.value[m] = match pt.plan.mis {
                 None if n > 1.0 => sum / n,
                 _ => sum,
             };
         }
     }
 
-    /// The draws `keys[range]`, all of object `obj` and of one kind, in one
-    /// batch call: BSDF draws (`bsdf`) sampled, light draws evaluated.
+    /// The draws of bucket `b` (`lanes.buckets[b]`, all of object `b / 2`
+    /// and of one kind) in one batch call: BSDF draws (`b` even) sampled,
+    /// light draws evaluated.
     #[inline(always)]
-    fn batch_group(
-        &self,
-        obj: usize,
-        bsdf: bool,
-        range: std::ops::Range<usize>,
-        pts: &[Point],
-        draws: &mut [Draw],
-        lanes: &mut Lanes,
-    ) {
-        let sampler = &self.samplers[obj];
+    fn batch_group(&self, b: usize, pts: &[Point], draws: &mut [Draw], lanes: &mut Lanes) {
+        let (sampler, bsdf) = (&self.samplers[b / 2], b % 2 == 0);
         // One lane per draw of the bucket (never empty).
-        let m = range.len();
-        for (k, &key) in lanes.keys[range.clone()].iter().enumerate() {
-            let di = (key & 0xffff_ffff) as usize;
+        let keys = &lanes.buckets[b];
+        let m = keys.len();
+        for (k, &di) in keys.iter().enumerate() {
+            let di = di as usize;
             let (pt, s) = (&pts[di / 2], di % 2);
-            debug_assert_eq!(pt.plan.slots[s] == Slot::Bsdf, bsdf);
+            debug_assert_eq!(draws[di].slot == Slot::Bsdf, bsdf);
             let a = &mut lanes.a;
             a[0][k] = pt.wo.x as f32;
             a[1][k] = pt.wo.y as f32;
@@ -978,9 +961,9 @@ impl Batch<'_> {
                 )
                 .expect("equal lengths");
         }
-        for (k, &key) in lanes.keys[range].iter().enumerate() {
-            let di = (key & 0xffff_ffff) as usize;
-            debug_assert_eq!(pts[di / 2].plan.slots[di % 2] == Slot::Bsdf, bsdf);
+        for (k, &di) in keys.iter().enumerate() {
+            let di = di as usize;
+            debug_assert_eq!(draws[di].slot == Slot::Bsdf, bsdf);
             let o = &lanes.out;
             let d = &mut draws[di];
             let rgb = |c: usize| {
