@@ -61,6 +61,10 @@ impl Distribution1D {
             cdf.push(acc);
         }
         let n = cdf.len() - 1;
+        assert!(
+            u32::try_from(n).is_ok(),
+            "Distribution1D: more than 2^32 - 1 bins"
+        );
         if acc > 0.0 {
             for c in &mut cdf {
                 *c /= acc;
@@ -100,7 +104,9 @@ impl Distribution1D {
     #[inline]
     fn bin(&self, u: f64) -> usize {
         let n = self.len();
-        let k = ((u * n as f64) as usize).min(n - 1);
+        // (Through `u32`, which `n` fits: shorter conversions than from
+        // and to `usize`, the same bin.)
+        let k = ((u * f64::from(n as u32)) as u32 as usize).min(n - 1);
         let lo = self.guide[k] as usize;
         let hi = match self.guide.get(k + 1) {
             Some(&g) => g as usize,
@@ -127,6 +133,7 @@ impl Distribution1D {
 
     /// Probability of bin `i`.
     #[must_use]
+    #[inline]
     pub fn prob(&self, i: usize) -> f64 {
         if self.total > 0.0 {
             self.cdf[i + 1] - self.cdf[i]
@@ -137,6 +144,7 @@ impl Distribution1D {
 
     /// A bin and the position of `u` inside it, rescaled to [0, 1).
     #[must_use]
+    #[inline]
     pub fn sample(&self, u: f64) -> Option<(usize, f64)> {
         if self.total <= 0.0 {
             return None;
@@ -200,6 +208,43 @@ fn prefetch<T>(v: &T) {
     }
     #[cfg(not(target_arch = "x86_64"))]
     let _ = v;
+}
+
+/// [`EnvMap::sample_lookup_many`]'s work, run at a SIMD level: per chunk
+/// of draws, the rows drawn, then the columns, the texels' cache lines
+/// asked for, then each draw finished.
+struct SampleLookups<'a> {
+    map: &'a EnvMap,
+    draws: &'a [(bool, DVec2)],
+    out: &'a mut [Option<(DVec3, EnvLookup)>],
+}
+
+impl Step for SampleLookups<'_> {
+    #[inline(always)]
+    fn run(self) {
+        let SampleLookups { map, draws, out } = self;
+        for (dc, oc) in draws.chunks(LOOKUP_CHUNK).zip(out.chunks_mut(LOOKUP_CHUNK)) {
+            let mut rows = [None::<(usize, f64)>; LOOKUP_CHUNK];
+            for (r, &(comp, u)) in rows.iter_mut().zip(dc) {
+                *r = map.sampler(comp).rows.sample(u.x);
+            }
+            let mut cols = [None::<(usize, f64)>; LOOKUP_CHUNK];
+            for ((c, r), &(comp, u)) in cols.iter_mut().zip(&rows).zip(dc) {
+                *c = r.and_then(|(j, _)| map.sampler(comp).cols[j].sample(u.y));
+            }
+            for (r, c) in rows.iter().zip(&cols) {
+                if let (Some((j, _)), Some((i, _))) = (r, c) {
+                    prefetch(&map.texels[j * map.width + i]);
+                }
+            }
+            for (k, o) in oc.iter_mut().enumerate() {
+                *o = match (rows[k], cols[k]) {
+                    (Some(r), Some(c)) => map.finish_sample(dc[k].0, r, c),
+                    _ => None,
+                };
+            }
+        }
+    }
 }
 
 /// The texels `j · width + i` of up to [`LOOKUP_CHUNK`] directions, as
@@ -872,7 +917,7 @@ impl EnvMap {
         self.texel_lookup(j * self.width + i)
     }
 
-    #[inline]
+    #[inline(always)]
     fn texel_lookup(&self, k: usize) -> EnvLookup {
         let texel = self.texels[k];
         let lum = texel.lum();
@@ -928,27 +973,13 @@ impl EnvMap {
         out: &mut [Option<(DVec3, EnvLookup)>],
     ) {
         assert_eq!(draws.len(), out.len(), "sample_lookup_many: lengths differ");
-        for (dc, oc) in draws.chunks(LOOKUP_CHUNK).zip(out.chunks_mut(LOOKUP_CHUNK)) {
-            let mut rows = [None::<(usize, f64)>; LOOKUP_CHUNK];
-            for (r, &(comp, u)) in rows.iter_mut().zip(dc) {
-                *r = self.sampler(comp).rows.sample(u.x);
-            }
-            let mut cols = [None::<(usize, f64)>; LOOKUP_CHUNK];
-            for ((c, r), &(comp, u)) in cols.iter_mut().zip(&rows).zip(dc) {
-                *c = r.and_then(|(j, _)| self.sampler(comp).cols[j].sample(u.y));
-            }
-            for (r, c) in rows.iter().zip(&cols) {
-                if let (Some((j, _)), Some((i, _))) = (r, c) {
-                    prefetch(&self.texels[j * self.width + i]);
-                }
-            }
-            for (k, o) in oc.iter_mut().enumerate() {
-                *o = match (rows[k], cols[k]) {
-                    (Some(r), Some(c)) => self.finish_sample(dc[k].0, r, c),
-                    _ => None,
-                };
-            }
-        }
+        // Compiled for the CPU's widest level (the same arithmetic, so the
+        // same bits at every level).
+        SimdLevel::best().run(SampleLookups {
+            map: self,
+            draws,
+            out,
+        });
     }
 
     /// [`EnvMap::lookup`] of many directions: `out[k] = self.lookup(dirs[k])`,
@@ -1014,7 +1045,7 @@ impl EnvMap {
     /// and cosine are Taylor polynomials exact to f64 rounding for
     /// `δ < 2π/256` (the terms left out are below 1e-18 of the result);
     /// narrower maps call `sin_cos`.
-    #[inline]
+    #[inline(always)]
     fn column_sin_cos(&self, i: usize, rv: f64) -> (f64, f64) {
         let w = self.width as f64;
         if self.width < 256 {
@@ -1032,7 +1063,7 @@ impl EnvMap {
     }
 
     /// The direction and lookup of a draw in texel `(i, j)` at `(ru, rv)`.
-    #[inline]
+    #[inline(always)]
     fn finish_sample(
         &self,
         compensated: bool,
