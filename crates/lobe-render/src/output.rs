@@ -116,18 +116,32 @@ impl Image {
             .collect()
     }
 
-    /// Write the linear image as OpenEXR (RGB, 32-bit float).
+    /// Write the linear image as OpenEXR (RGB, 32-bit float, `exr`'s
+    /// default encoding), on the calling thread: a small image's blocks
+    /// compressed in parallel cost more (a thread pool started per file)
+    /// than they save, and the file's bytes stay the same from run to run.
     pub fn write_exr(&self, path: &Path) -> Result<(), OutputError> {
+        use exr::prelude::{Image as ExrImage, SpecificChannels, WritableImage};
         let err = |message: String| OutputError {
             path: path.to_path_buf(),
             message,
         };
-        let img =
-            image::Rgb32FImage::from_raw(self.width as u32, self.height as u32, self.to_rgb32f())
-                .ok_or_else(|| err("the pixel buffer does not match the size".into()))?;
-        image::DynamicImage::ImageRgb32F(img)
-            .save_with_format(path, image::ImageFormat::OpenExr)
-            .map_err(|e| err(e.to_string()))
+        let rgb = self.to_rgb32f();
+        if rgb.len() != 3 * self.width * self.height {
+            return Err(err("the pixel buffer does not match the size".into()));
+        }
+        let w = self.width;
+        ExrImage::from_channels(
+            (self.width, self.height),
+            SpecificChannels::rgb(|p: exr::math::Vec2<usize>| {
+                let k = 3 * (p.y() * w + p.x());
+                (rgb[k], rgb[k + 1], rgb[k + 2])
+            }),
+        )
+        .write()
+        .non_parallel()
+        .to_file(path)
+        .map_err(|e| err(e.to_string()))
     }
 
     /// The samples per pixel of a variance-allocated render
