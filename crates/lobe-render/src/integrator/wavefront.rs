@@ -591,17 +591,20 @@ impl Batch<'_> {
         lanes.draw_index.clear();
         lanes.value.clear();
         lanes.value.resize(n, Rgb::ZERO);
+        // (Slices borrowed once, see `Vec3Lanes::view`.)
         let h = &lanes.hits;
+        let (obj, hp, hng, hns) = (&h.obj[..n], h.p.view(n), h.ng.view(n), h.ns.view(n));
+        let (dirs, plans) = (lanes.rays.dir.view(n), &lanes.plans[..n]);
         for m in 0..n {
-            let dir = lanes.rays.dir.get(m);
-            if h.obj[m] == NO_HIT {
+            let dir = dirs.get(m);
+            if obj[m] == NO_HIT {
                 lanes.bsdf_dirs.push(dir);
                 lanes.draw_index.push(m);
                 continue;
             }
             // The scalar loop's normals (see `Context::radiance`).
             let wo_world = -dir;
-            let (hng, hns) = (h.ng.get(m), h.ns.get(m));
+            let (hng, hns) = (hng.get(m), hns.get(m));
             let ng = if hng.dot(wo_world) < 0.0 { -hng } else { hng };
             let mut ns = if hns.dot(ng) < 0.0 { -hns } else { hns };
             if ns.dot(wo_world) <= 0.0 {
@@ -614,12 +617,12 @@ impl Batch<'_> {
             }
             let mut pt = Point {
                 m: m as u32,
-                obj: h.obj[m],
-                p: h.p.get(m),
+                obj: obj[m],
+                p: hp.get(m),
                 ng,
                 frame,
                 wo,
-                plan: lanes.plans[m],
+                plan: plans[m],
                 u: [[0.0; 3]; 2],
             };
             if let Some(&(seeds, index, n)) = lanes.each.get(m) {
@@ -761,6 +764,14 @@ impl Batch<'_> {
         lanes.shadow_dir.resize(most);
         lanes.shadow_draw.resize(most, 0);
         let mut r = 0;
+        let (mut sp, mut sng) = (
+            lanes.shadow_p.view_mut(most),
+            lanes.shadow_ng.view_mut(most),
+        );
+        let (mut sdir, sdraw) = (
+            lanes.shadow_dir.view_mut(most),
+            &mut lanes.shadow_draw[..most],
+        );
         for (i, (pt, pair)) in pts.iter().zip(draws.chunks_exact_mut(2)).enumerate() {
             for (s, d) in pair.iter_mut().enumerate() {
                 if !d.ok {
@@ -775,10 +786,10 @@ impl Batch<'_> {
                     Slot::Light | Slot::LightCompensated if d.f != Rgb::ZERO => d.dir,
                     _ => continue,
                 };
-                lanes.shadow_p.set(r, pt.p);
-                lanes.shadow_ng.set(r, pt.ng);
-                lanes.shadow_dir.set(r, dir);
-                lanes.shadow_draw[r] = 2 * i + s;
+                sp.set(r, pt.p);
+                sng.set(r, pt.ng);
+                sdir.set(r, dir);
+                sdraw[r] = 2 * i + s;
                 r += 1;
             }
         }
@@ -816,11 +827,12 @@ impl Batch<'_> {
             draws[di].light = l;
         }
         // The estimates, in sample order.
+        let (px, value) = (&lanes.px[..], &mut lanes.value[..]);
         for (pt, pair) in pts.iter().zip(draws.chunks_exact(2)) {
             let mut sum = Rgb::ZERO;
             let mut n = 0.0;
             let m = pt.m as usize;
-            let mut pilot = pilots.as_deref_mut().map(|p| &mut p[lanes.px[m] as usize]);
+            let mut pilot = pilots.as_deref_mut().map(|p| &mut p[px[m] as usize]);
             if let Some(p) = pilot.as_deref_mut() {
                 p.samples += 1;
             }
@@ -869,7 +881,7 @@ impl Batch<'_> {
                     }
                 }
             }
-            lanes.value[m] = match pt.plan.mis {
+            value[m] = match pt.plan.mis {
                 None if n > 1.0 => sum / n,
                 _ => sum,
             };
@@ -885,23 +897,27 @@ impl Batch<'_> {
         // One lane per draw of the bucket (never empty).
         let keys = &lanes.buckets[b];
         let m = keys.len();
-        for (k, &di) in keys.iter().enumerate() {
-            let di = di as usize;
-            let (pt, s) = (&pts[di / 2], di % 2);
-            debug_assert_eq!(draws[di].slot == Slot::Bsdf, bsdf);
-            let a = &mut lanes.a;
-            a[0][k] = pt.wo.x as f32;
-            a[1][k] = pt.wo.y as f32;
-            a[2][k] = pt.wo.z as f32;
-            if bsdf {
-                a[3][k] = pt.u[s][1] as f32;
-                a[4][k] = pt.u[s][2] as f32;
-                a[5][k] = pt.u[s][0] as f32;
-            } else {
-                let wi = draws[di].wi;
-                a[3][k] = wi.x as f32;
-                a[4][k] = wi.y as f32;
-                a[5][k] = wi.z as f32;
+        {
+            let [a0, a1, a2, a3, a4, a5] = &mut lanes.a;
+            let (a0, a1, a2) = (&mut a0[..m], &mut a1[..m], &mut a2[..m]);
+            let (a3, a4, a5) = (&mut a3[..m], &mut a4[..m], &mut a5[..m]);
+            for (k, &di) in keys.iter().enumerate() {
+                let di = di as usize;
+                let (pt, s) = (&pts[di / 2], di % 2);
+                debug_assert_eq!(draws[di].slot == Slot::Bsdf, bsdf);
+                a0[k] = pt.wo.x as f32;
+                a1[k] = pt.wo.y as f32;
+                a2[k] = pt.wo.z as f32;
+                if bsdf {
+                    a3[k] = pt.u[s][1] as f32;
+                    a4[k] = pt.u[s][2] as f32;
+                    a5[k] = pt.u[s][0] as f32;
+                } else {
+                    let wi = draws[di].wi;
+                    a3[k] = wi.x as f32;
+                    a4[k] = wi.y as f32;
+                    a5[k] = wi.z as f32;
+                }
             }
         }
         let [a0, a1, a2, a3, a4, a5] = &lanes.a;
@@ -961,10 +977,11 @@ impl Batch<'_> {
                 )
                 .expect("equal lengths");
         }
+        let o: [&[f32]; 10] = std::array::from_fn(|c| &lanes.out[c][..m]);
+        let valid = &lanes.valid[..m];
         for (k, &di) in keys.iter().enumerate() {
             let di = di as usize;
             debug_assert_eq!(draws[di].slot == Slot::Bsdf, bsdf);
-            let o = &lanes.out;
             let d = &mut draws[di];
             let rgb = |c: usize| {
                 Rgb::new(
@@ -974,7 +991,7 @@ impl Batch<'_> {
                 )
             };
             if bsdf {
-                d.ok = lanes.valid[k] == 1;
+                d.ok = valid[k] == 1;
                 d.dir = DVec3::new(f64::from(o[0][k]), f64::from(o[1][k]), f64::from(o[2][k]));
                 d.f = rgb(7);
             } else {
