@@ -65,6 +65,31 @@ impl Sphere {
     #[inline]
     #[must_use]
     pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<Hit> {
+        let t = self.nearest_t(ray, t_max)?;
+        let n = (ray.at(t) - self.center) / self.radius;
+        let n = n.try_normalize()?;
+        Some(Hit {
+            t,
+            p: self.center + n * self.radius,
+            ng: n,
+            ns: n,
+        })
+    }
+
+    /// Whether the sphere blocks `ray` before `t_max`: a root `t` in
+    /// `(0, t_max)`, as [`Sphere::intersect`] finds it, without the normal
+    /// at the hit (which a shadow ray does not need; where it cannot be
+    /// normalized, a point within rounding of the centre of a sphere far
+    /// smaller than its distance, `intersect` has no hit and this blocks).
+    #[inline]
+    #[must_use]
+    pub fn blocks(&self, ray: &Ray, t_max: f64) -> bool {
+        self.nearest_t(ray, t_max).is_some()
+    }
+
+    /// The nearest root `t` of the ray's equation in `(0, t_max)`.
+    #[inline]
+    fn nearest_t(&self, ray: &Ray, t_max: f64) -> Option<f64> {
         let oc = ray.origin - self.center;
         let b = oc.dot(ray.dir);
         // The discriminant from the distance of the center to the line,
@@ -89,17 +114,7 @@ impl Sphere {
         } else {
             return None;
         };
-        if t >= t_max || !t.is_finite() {
-            return None;
-        }
-        let n = (ray.at(t) - self.center) / self.radius;
-        let n = n.try_normalize()?;
-        Some(Hit {
-            t,
-            p: self.center + n * self.radius,
-            ng: n,
-            ns: n,
-        })
+        (t < t_max && t.is_finite()).then_some(t)
     }
 }
 

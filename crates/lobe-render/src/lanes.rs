@@ -265,12 +265,13 @@ const CHUNK: usize = 8;
 /// A sphere's hits of the rays `start..start + m` (`m ≤ CHUNK`, its rays
 /// count): per lane `t` (infinite when none) and the unit normal
 /// (unspecified when none), as [`Sphere::intersect`] with `t_max = ∞`
-/// finds them. The steps that only a hit needs (the root, then the
+/// finds them; without `NORMALS`, `t` alone as [`Sphere::blocks`] finds it
+/// (the normals zero). The steps that only a hit needs (the root, then the
 /// normal) are skipped for a chunk where no lane gets that far, as the
 /// scalar test returns early. Inlined into each caller's loop over the
 /// chunks, so that it is compiled for the caller's SIMD level.
 #[inline(always)]
-fn sphere_chunk(
+fn sphere_chunk<const NORMALS: bool>(
     s: &Sphere,
     rays: &RayLanes,
     start: usize,
@@ -325,7 +326,7 @@ fn sphere_chunk(
             any |= (l < m) & ok;
         }
     }
-    if any {
+    if NORMALS && any {
         // The normal at `o + t d`, normalized as `try_normalize`: a
         // hit only where that succeeds.
         for l in 0..CHUNK {
@@ -449,7 +450,7 @@ impl Step for SphereBlocks<'_> {
         let n = rays.len();
         for start in (0..n).step_by(CHUNK) {
             let m = (n - start).min(CHUNK);
-            let (t, _) = sphere_chunk(s, rays, start, m);
+            let (t, _) = sphere_chunk::<false>(s, rays, start, m);
             for (b, &t) in out[start..start + m].iter_mut().zip(&t) {
                 *b |= t < f64::INFINITY;
             }
@@ -480,7 +481,7 @@ impl Step for SphereHits<'_> {
         let n = rays.len();
         for start in (0..n).step_by(CHUNK) {
             let m = (n - start).min(CHUNK);
-            let (tc, nv) = sphere_chunk(s, rays, start, m);
+            let (tc, nv) = sphere_chunk::<true>(s, rays, start, m);
             let e = start + m;
             let (t, obj) = (&mut out.t[start..e], &mut out.obj[start..e]);
             let (px, py, pz) = (

@@ -139,7 +139,7 @@ impl Object {
     #[must_use]
     pub fn occluded(&self, ray: &Ray, t_max: f64) -> bool {
         match &self.shape {
-            Shape::Sphere(s) => s.intersect(ray, t_max).is_some(),
+            Shape::Sphere(s) => s.blocks(ray, t_max),
             Shape::Plane(p) => p.intersect(ray, t_max).is_some(),
             Shape::Mesh(m) => m.occluded(ray, t_max),
         }
