@@ -53,6 +53,20 @@ impl Distribution1D {
     /// of them needed).
     #[must_use]
     pub fn from_weights(weights: impl ExactSizeIterator<Item = f64>) -> Self {
+        let steps = Self::steps(weights.len());
+        Self::with_steps(weights, &steps)
+    }
+
+    /// `k / n` for `k = 0..n`: the points of the guide table of `n` bins,
+    /// the same for every distribution of `n` bins (a map's rows share
+    /// them: one division per column instead of one per texel).
+    fn steps(n: usize) -> Vec<f64> {
+        (0..n).map(|k| k as f64 / n as f64).collect()
+    }
+
+    /// [`Distribution1D::from_weights`] with the guide table's points,
+    /// [`Distribution1D::steps`] of the number of weights.
+    fn with_steps(weights: impl ExactSizeIterator<Item = f64>, steps: &[f64]) -> Self {
         let mut cdf = Vec::with_capacity(weights.len() + 1);
         let mut acc = 0.0;
         cdf.push(0.0);
@@ -71,12 +85,12 @@ impl Distribution1D {
             }
             *cdf.last_mut().expect("non-empty") = 1.0;
         }
+        debug_assert_eq!(steps.len(), n, "Distribution1D: one step per bin");
         let mut guide = Vec::with_capacity(n);
         let mut i = 0usize;
         // `upper[i]` = `cdf[i + 1]` for the bins before the last.
         let upper = &cdf[1..n.max(1)];
-        for k in 0..n {
-            let u = k as f64 / n as f64;
+        for &u in steps {
             while i < upper.len() && upper[i] <= u {
                 i += 1;
             }
@@ -388,10 +402,23 @@ impl TexelBuffer {
         let n = width
             .checked_mul(height)
             .expect("TexelBuffer: width × height overflows");
+        let black = Texel { rgb: [0.0; 3] };
+        // Written on rayon's threads when there are: the first touch of
+        // each page of a large map (a page fault each, 2048 for 1024 × 512)
+        // shared out.
+        #[cfg(feature = "parallel")]
+        let texels = {
+            use rayon::prelude::*;
+            let mut t = Vec::with_capacity(n);
+            t.par_extend(rayon::iter::repeat_n(black, n));
+            t
+        };
+        #[cfg(not(feature = "parallel"))]
+        let texels = vec![black; n];
         TexelBuffer {
             width,
             height,
-            texels: vec![Texel { rgb: [0.0; 3] }; n],
+            texels,
         }
     }
 
@@ -461,12 +488,14 @@ struct TexelSampler {
 impl TexelSampler {
     fn new(width: usize, height: usize, shift: Option<f64>, texels: &[Texel]) -> Self {
         let dphi = 2.0 * PI / width as f64;
+        let steps = Distribution1D::steps(width);
         let row = |j: usize| {
             let omega = dphi * EnvMap::band(height, j);
-            Distribution1D::from_weights(
+            Distribution1D::with_steps(
                 texels[j * width..(j + 1) * width]
                     .iter()
                     .map(|t| Self::weight_of(shift, t.lum()) * omega),
+                &steps,
             )
         };
         // Each row's distribution is its own computation: the same numbers
@@ -608,14 +637,20 @@ impl EnvMap {
             let b = c.to_bits();
             b > 0x7f7f_ffff && b != 0x8000_0000
         };
-        let clamped: usize = texels
-            .chunks(1 << 16)
-            .map(|c| {
-                c.iter()
-                    .map(|t| u32::from(bad(t.rgb[0]) | bad(t.rgb[1]) | bad(t.rgb[2])))
-                    .sum::<u32>() as usize
-            })
-            .sum();
+        // (Chunks on rayon's threads when there are: a sum of integers, the
+        // same in any order.)
+        let count = |c: &[Texel]| {
+            c.iter()
+                .map(|t| u32::from(bad(t.rgb[0]) | bad(t.rgb[1]) | bad(t.rgb[2])))
+                .sum::<u32>() as usize
+        };
+        #[cfg(feature = "parallel")]
+        let clamped: usize = {
+            use rayon::prelude::*;
+            texels.par_chunks(1 << 16).map(count).sum()
+        };
+        #[cfg(not(feature = "parallel"))]
+        let clamped: usize = texels.chunks(1 << 16).map(count).sum();
         if clamped > 0 {
             for t in &mut texels {
                 t.rgb = t.rgb.map(|c| if bad(c) { 0.0 } else { c });
