@@ -67,46 +67,122 @@ impl Distribution1D {
     /// [`Distribution1D::from_weights`] with the guide table's points,
     /// [`Distribution1D::steps`] of the number of weights.
     fn with_steps(weights: impl ExactSizeIterator<Item = f64>, steps: &[f64]) -> Self {
-        let mut cdf = Vec::with_capacity(weights.len() + 1);
-        let mut acc = 0.0;
-        cdf.push(0.0);
-        for w in weights {
-            acc += w.max(0.0);
-            cdf.push(acc);
-        }
-        let n = cdf.len() - 1;
+        let n = weights.len();
+        let (mut cdf, mut guide) = (vec![0.0; n + 1], vec![0u32; n]);
+        let total = Self::build(weights, steps, &mut cdf, &mut guide);
+        Distribution1D { cdf, total, guide }
+    }
+
+    /// Write the tables of the distribution of `weights` (`n` of them)
+    /// into `cdf` (`n + 1` entries) and `guide` (`n`, the guide table of
+    /// the points `steps`, [`Distribution1D::steps`] of `n`), and return
+    /// the weights' sum.
+    fn build(
+        weights: impl ExactSizeIterator<Item = f64>,
+        steps: &[f64],
+        cdf: &mut [f64],
+        guide: &mut [u32],
+    ) -> f64 {
+        let n = weights.len();
         assert!(
             u32::try_from(n).is_ok(),
             "Distribution1D: more than 2^32 - 1 bins"
         );
+        assert!(
+            cdf.len() == n + 1 && guide.len() == n && steps.len() == n,
+            "Distribution1D: tables of the wrong size"
+        );
+        let mut acc = 0.0;
+        cdf[0] = 0.0;
+        for (c, w) in cdf[1..].iter_mut().zip(weights) {
+            acc += w.max(0.0);
+            *c = acc;
+        }
         if acc > 0.0 {
-            for c in &mut cdf {
+            for c in cdf.iter_mut() {
                 *c /= acc;
             }
-            *cdf.last_mut().expect("non-empty") = 1.0;
+            cdf[n] = 1.0;
         }
-        debug_assert_eq!(steps.len(), n, "Distribution1D: one step per bin");
-        let mut guide = Vec::with_capacity(n);
         let mut i = 0usize;
         // `upper[i]` = `cdf[i + 1]` for the bins before the last.
         let upper = &cdf[1..n.max(1)];
-        for &u in steps {
+        for (g, &u) in guide.iter_mut().zip(steps) {
             while i < upper.len() && upper[i] <= u {
                 i += 1;
             }
-            guide.push(i as u32);
+            *g = i as u32;
         }
-        Distribution1D {
-            cdf,
-            total: acc,
-            guide,
+        acc
+    }
+
+    /// The tables, borrowed.
+    #[inline]
+    fn tables(&self) -> Tables<'_> {
+        Tables {
+            cdf: &self.cdf,
+            total: self.total,
+            guide: &self.guide,
         }
+    }
+
+    /// [`Tables::bin`] (for the tests).
+    #[cfg(test)]
+    fn bin(&self, u: f64) -> usize {
+        self.tables().bin(u)
     }
 
     /// The bin of `u` by binary search (the reference for the guide table).
     #[cfg(test)]
     fn bin_by_search(&self, u: f64) -> usize {
         self.cdf.partition_point(|&c| c <= u).clamp(1, self.len()) - 1
+    }
+
+    #[must_use]
+    pub fn total(&self) -> f64 {
+        self.total
+    }
+
+    #[must_use]
+    pub fn len(&self) -> usize {
+        self.cdf.len() - 1
+    }
+
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Probability of bin `i`.
+    #[must_use]
+    #[inline]
+    pub fn prob(&self, i: usize) -> f64 {
+        self.tables().prob(i)
+    }
+
+    /// A bin and the position of `u` inside it, rescaled to [0, 1).
+    #[must_use]
+    #[inline]
+    pub fn sample(&self, u: f64) -> Option<(usize, f64)> {
+        self.tables().sample(u)
+    }
+}
+
+/// The tables of a [`Distribution1D`], borrowed: its own, or one row's of a
+/// map's [`Columns`] (all rows' tables in two buffers).
+#[derive(Debug, Clone, Copy)]
+struct Tables<'a> {
+    /// `cdf[i]` = probability of bins `0..i`; `cdf[n] = 1`.
+    cdf: &'a [f64],
+    total: f64,
+    /// `guide[k]`: the bin of `u = k/n`.
+    guide: &'a [u32],
+}
+
+impl Tables<'_> {
+    #[inline]
+    fn len(&self) -> usize {
+        self.cdf.len() - 1
     }
 
     /// The bin of `u ∈ [0, 1)`: the one with `cdf[i] ≤ u < cdf[i + 1]`
@@ -130,25 +206,8 @@ impl Distribution1D {
         lo + self.cdf[lo + 1..=hi].partition_point(|&c| c <= u)
     }
 
-    #[must_use]
-    pub fn total(&self) -> f64 {
-        self.total
-    }
-
-    #[must_use]
-    pub fn len(&self) -> usize {
-        self.cdf.len() - 1
-    }
-
-    #[must_use]
-    pub fn is_empty(&self) -> bool {
-        self.len() == 0
-    }
-
-    /// Probability of bin `i`.
-    #[must_use]
     #[inline]
-    pub fn prob(&self, i: usize) -> f64 {
+    fn prob(&self, i: usize) -> f64 {
         if self.total > 0.0 {
             self.cdf[i + 1] - self.cdf[i]
         } else {
@@ -156,10 +215,8 @@ impl Distribution1D {
         }
     }
 
-    /// A bin and the position of `u` inside it, rescaled to [0, 1).
-    #[must_use]
     #[inline]
-    pub fn sample(&self, u: f64) -> Option<(usize, f64)> {
+    fn sample(&self, u: f64) -> Option<(usize, f64)> {
         if self.total <= 0.0 {
             return None;
         }
@@ -244,7 +301,7 @@ impl Step for SampleLookups<'_> {
             }
             let mut cols = [None::<(usize, f64)>; LOOKUP_CHUNK];
             for ((c, r), &(comp, u)) in cols.iter_mut().zip(&rows).zip(dc) {
-                *c = r.and_then(|(j, _)| map.sampler(comp).cols[j].sample(u.y));
+                *c = r.and_then(|(j, _)| map.sampler(comp).cols.row(j).sample(u.y));
             }
             for (r, c) in rows.iter().zip(&cols) {
                 if let (Some((j, _)), Some((i, _))) = (r, c) {
@@ -480,40 +537,86 @@ struct TexelSampler {
     /// `max(0, lum − m)`.
     shift: Option<f64>,
     rows: Distribution1D,
-    cols: Vec<Distribution1D>,
+    cols: Columns,
     /// Σ weight·Ω over the texels.
     norm: f64,
+}
+
+/// The conditional distributions of a map's rows over their `width`
+/// columns, each one a [`Distribution1D`]'s tables, all of them in two
+/// buffers (row `j`'s CDF at `cdf[j (width + 1)..]`, its guide table at
+/// `guide[j width..]`): two allocations instead of two per row, which the
+/// threads that build the rows fill in place.
+#[derive(Debug, Clone, PartialEq)]
+struct Columns {
+    width: usize,
+    cdf: Vec<f64>,
+    guide: Vec<u32>,
+    /// Each row's sum of weights.
+    totals: Vec<f64>,
+}
+
+impl Columns {
+    /// Row `j`'s distribution.
+    #[inline]
+    fn row(&self, j: usize) -> Tables<'_> {
+        let w = self.width;
+        Tables {
+            cdf: &self.cdf[j * (w + 1)..(j + 1) * (w + 1)],
+            total: self.totals[j],
+            guide: &self.guide[j * w..(j + 1) * w],
+        }
+    }
 }
 
 impl TexelSampler {
     fn new(width: usize, height: usize, shift: Option<f64>, texels: &[Texel]) -> Self {
         let dphi = 2.0 * PI / width as f64;
         let steps = Distribution1D::steps(width);
-        let row = |j: usize| {
+        // (Zeros from the allocator: pages that the rows' threads touch
+        // first.)
+        let mut cdf = vec![0.0; height * (width + 1)];
+        let mut guide = vec![0u32; height * width];
+        let row = |(j, (c, g)): (usize, (&mut [f64], &mut [u32]))| {
             let omega = dphi * EnvMap::band(height, j);
-            Distribution1D::with_steps(
+            Distribution1D::build(
                 texels[j * width..(j + 1) * width]
                     .iter()
                     .map(|t| Self::weight_of(shift, t.lum()) * omega),
                 &steps,
+                c,
+                g,
             )
         };
         // Each row's distribution is its own computation: the same numbers
         // in parallel or not.
         #[cfg(feature = "parallel")]
-        let cols: Vec<Distribution1D> = {
+        let totals: Vec<f64> = {
             use rayon::prelude::*;
-            (0..height).into_par_iter().map(row).collect()
+            cdf.par_chunks_mut(width + 1)
+                .zip(guide.par_chunks_mut(width))
+                .enumerate()
+                .map(row)
+                .collect()
         };
         #[cfg(not(feature = "parallel"))]
-        let cols: Vec<Distribution1D> = (0..height).map(row).collect();
-        let row_weights: Vec<f64> = cols.iter().map(Distribution1D::total).collect();
-        let rows = Distribution1D::new(&row_weights);
+        let totals: Vec<f64> = cdf
+            .chunks_mut(width + 1)
+            .zip(guide.chunks_mut(width))
+            .enumerate()
+            .map(row)
+            .collect();
+        let rows = Distribution1D::new(&totals);
         let norm = rows.total();
         TexelSampler {
             shift,
             rows,
-            cols,
+            cols: Columns {
+                width,
+                cdf,
+                guide,
+                totals,
+            },
             norm,
         }
     }
@@ -920,7 +1023,7 @@ impl EnvMap {
 
     fn sample_with(&self, t: &TexelSampler, u: DVec2) -> Option<(DVec3, f64)> {
         let (j, ru) = t.rows.sample(u.x)?;
-        let (i, rv) = t.cols[j].sample(u.y)?;
+        let (i, rv) = t.cols.row(j).sample(u.y)?;
         // Uniform in solid angle inside the texel: uniform in cos θ and φ.
         let t0 = PI * j as f64 / self.height as f64;
         let t1 = PI * (j + 1) as f64 / self.height as f64;
@@ -982,7 +1085,7 @@ impl EnvMap {
     pub fn sample_lookup(&self, compensated: bool, u: DVec2) -> Option<(DVec3, EnvLookup)> {
         let t = self.sampler(compensated);
         let (j, ru) = t.rows.sample(u.x)?;
-        let (i, rv) = t.cols[j].sample(u.y)?;
+        let (i, rv) = t.cols.row(j).sample(u.y)?;
         self.finish_sample(compensated, (j, ru), (i, rv))
     }
 
