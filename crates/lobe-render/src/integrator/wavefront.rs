@@ -893,7 +893,7 @@ impl Batch<'_> {
     /// light draws evaluated.
     #[inline(always)]
     fn batch_group(&self, b: usize, pts: &[Point], draws: &mut [Draw], lanes: &mut Lanes) {
-        let (sampler, bsdf) = (&self.samplers[b / 2], b % 2 == 0);
+        let (sampler, bsdf) = (&self.samplers[b / 2], b.is_multiple_of(2));
         // One lane per draw of the bucket (never empty).
         let keys = &lanes.buckets[b];
         let m = keys.len();
