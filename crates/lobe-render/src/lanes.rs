@@ -579,6 +579,47 @@ pub fn spawn_many(
     level.run(Spawn(p, ng, dir, out));
 }
 
+/// `a.max(b)` of two absolute values (no `-0`), as `f64::max` gives it,
+/// NaN included, but as a comparison and a select, which the compiler
+/// vectorizes (`f64::max`'s NaN rule kept the loop scalar).
+#[inline(always)]
+fn max_of_abs(a: f64, b: f64) -> f64 {
+    if b > a || a.is_nan() { b } else { a }
+}
+
+/// The origins of [`spawn_many`]'s rays. The outputs are parameters of
+/// their own, so that the compiler knows they do not overlap the inputs
+/// (`&mut` parameters are `noalias`) and vectorizes the loop without
+/// run-time overlap checks (it left the loop scalar inline in
+/// [`Spawn::run`]).
+#[inline(always)]
+fn spawn_lanes(
+    (px, py, pz): (&[f64], &[f64], &[f64]),
+    (gx, gy, gz): (&[f64], &[f64], &[f64]),
+    (dx, dy, dz): (&[f64], &[f64], &[f64]),
+    ox: &mut [f64],
+    oy: &mut [f64],
+    oz: &mut [f64],
+) {
+    let n = ox.len();
+    let (oy, oz) = (&mut oy[..n], &mut oz[..n]);
+    let (px, py, pz) = (&px[..n], &py[..n], &pz[..n]);
+    let (gx, gy, gz) = (&gx[..n], &gy[..n], &gz[..n]);
+    let (dx, dy, dz) = (&dx[..n], &dy[..n], &dz[..n]);
+    for i in 0..n {
+        let m = max_of_abs(px[i].abs(), max_of_abs(py[i].abs(), pz[i].abs()));
+        let eps = RAY_EPSILON * (1.0 + m);
+        let side = if dot(dx[i], dy[i], dz[i], gx[i], gy[i], gz[i]) >= 0.0 {
+            eps
+        } else {
+            -eps
+        };
+        ox[i] = px[i] + gx[i] * side;
+        oy[i] = py[i] + gy[i] * side;
+        oz[i] = pz[i] + gz[i] * side;
+    }
+}
+
 /// [`spawn_many`]'s loop.
 struct Spawn<'a>(
     &'a Vec3Lanes,
@@ -593,22 +634,15 @@ impl Step for Spawn<'_> {
         let Spawn(p, ng, dir, out) = self;
         let n = p.len();
         let (o, od) = (&mut out.origin, &mut out.dir);
-        let (ox, oy, oz) = (&mut o.x[..n], &mut o.y[..n], &mut o.z[..n]);
-        let (px, py, pz) = (&p.x[..n], &p.y[..n], &p.z[..n]);
-        let (gx, gy, gz) = (&ng.x[..n], &ng.y[..n], &ng.z[..n]);
         let (dx, dy, dz) = (&dir.x[..n], &dir.y[..n], &dir.z[..n]);
-        for i in 0..n {
-            let m = px[i].abs().max(py[i].abs().max(pz[i].abs()));
-            let eps = RAY_EPSILON * (1.0 + m);
-            let side = if dot(dx[i], dy[i], dz[i], gx[i], gy[i], gz[i]) >= 0.0 {
-                eps
-            } else {
-                -eps
-            };
-            ox[i] = px[i] + gx[i] * side;
-            oy[i] = py[i] + gy[i] * side;
-            oz[i] = pz[i] + gz[i] * side;
-        }
+        spawn_lanes(
+            (&p.x[..n], &p.y[..n], &p.z[..n]),
+            (&ng.x[..n], &ng.y[..n], &ng.z[..n]),
+            (dx, dy, dz),
+            &mut o.x[..n],
+            &mut o.y[..n],
+            &mut o.z[..n],
+        );
         od.x[..n].copy_from_slice(dx);
         od.y[..n].copy_from_slice(dy);
         od.z[..n].copy_from_slice(dz);
