@@ -253,6 +253,39 @@ impl Aabb {
 mod tests {
     use super::*;
 
+    /// A shadow ray's test finds what the hit does: random rays from
+    /// outside, inside and on the sphere, any `t_max`.
+    #[test]
+    fn sphere_blocks_where_it_is_hit() {
+        use rand::{RngExt, SeedableRng};
+        let mut rng = rand_pcg::Pcg64::seed_from_u64(11);
+        let s = Sphere {
+            center: DVec3::new(0.3, -0.2, 1.0),
+            radius: 0.9,
+        };
+        let mut hits = 0;
+        for k in 0..20_000 {
+            let mut v = || DVec3::new(rng.random(), rng.random(), rng.random()) * 2.0 - 1.0;
+            let origin = match k % 3 {
+                0 => s.center + v() * 4.0,
+                1 => s.center + v() * 0.5,
+                _ => s.center + v().normalize() * s.radius,
+            };
+            let dir = v().normalize();
+            let t_max = if k % 4 == 0 {
+                f64::INFINITY
+            } else {
+                rng.random::<f64>() * 5.0
+            };
+            let ray = Ray { origin, dir };
+            let hit = s.intersect(&ray, t_max).is_some();
+            assert_eq!(s.blocks(&ray, t_max), hit, "{ray:?} t_max {t_max}");
+            hits += usize::from(hit);
+        }
+        // Both outcomes, many times.
+        assert!(hits > 3000 && hits < 17_000, "{hits}");
+    }
+
     #[test]
     fn sphere_hits_from_outside_and_inside() {
         let s = Sphere {

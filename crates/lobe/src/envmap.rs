@@ -1279,6 +1279,47 @@ impl EnvMap {
 
 #[cfg(test)]
 mod tests {
+    /// A sampler's rows, built in place in its two shared buffers
+    /// ([`Columns`]), are the distributions [`Distribution1D::from_weights`]
+    /// builds alone, bit for bit, and sample alike (a sun in a sky, a
+    /// black row).
+    #[test]
+    fn columns_are_the_rows_distributions() {
+        let (w, h) = (64usize, 16usize);
+        let rgb: Vec<Rgb> = (0..w * h)
+            .map(|k| {
+                let (i, j) = (k % w, k / w);
+                if j == 5 {
+                    Rgb::ZERO
+                } else if (i, j) == (40, 9) {
+                    Rgb::splat(5e4)
+                } else {
+                    Rgb::new(0.2 + (i as f64 * 0.37).sin().abs(), 0.5, 1.0 + j as f64)
+                }
+            })
+            .collect();
+        let m = EnvMap::new(w, h, rgb, 1.0, 0.0).unwrap().0;
+        for t in [&m.plain, &m.compensated] {
+            let dphi = 2.0 * PI / w as f64;
+            for j in 0..h {
+                let omega = dphi * EnvMap::band(h, j);
+                let alone = Distribution1D::from_weights(
+                    m.texels[j * w..(j + 1) * w]
+                        .iter()
+                        .map(|x| TexelSampler::weight_of(t.shift, x.lum()) * omega),
+                );
+                let row = t.cols.row(j);
+                assert_eq!(row.cdf, &alone.cdf[..], "row {j}");
+                assert_eq!(row.guide, &alone.guide[..], "row {j}");
+                assert_eq!(row.total.to_bits(), alone.total().to_bits(), "row {j}");
+                for k in 0..200 {
+                    let u = k as f64 / 200.0 + 1e-3;
+                    assert_eq!(row.sample(u), alone.sample(u), "row {j} u {u}");
+                }
+            }
+        }
+    }
+
     /// The column's sine and cosine from the table and the polynomials
     /// are `sin_cos`'s within 4e-15 (both round the angle, whose unit in
     /// the last place is up to 8.9e-16).
