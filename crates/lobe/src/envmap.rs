@@ -294,24 +294,33 @@ impl Step for SampleLookups<'_> {
     #[inline(always)]
     fn run(self) {
         let SampleLookups { map, draws, out } = self;
+        // (A chunk's rows and columns as plain arrays, `NONE` where the
+        // draw has none: no `Option`s to write and test.)
+        const NONE: u32 = u32::MAX;
         for (dc, oc) in draws.chunks(LOOKUP_CHUNK).zip(out.chunks_mut(LOOKUP_CHUNK)) {
-            let mut rows = [None::<(usize, f64)>; LOOKUP_CHUNK];
-            for (r, &(comp, u)) in rows.iter_mut().zip(dc) {
-                *r = map.sampler(comp).rows.sample(u.x);
+            let n = dc.len();
+            let (mut rj, mut ru) = ([NONE; LOOKUP_CHUNK], [0.0; LOOKUP_CHUNK]);
+            for ((j, r), &(comp, u)) in rj.iter_mut().zip(&mut ru).zip(dc) {
+                if let Some((jj, rr)) = map.sampler(comp).rows.sample(u.x) {
+                    (*j, *r) = (jj as u32, rr);
+                }
             }
-            let mut cols = [None::<(usize, f64)>; LOOKUP_CHUNK];
-            for ((c, r), &(comp, u)) in cols.iter_mut().zip(&rows).zip(dc) {
-                *c = r.and_then(|(j, _)| map.sampler(comp).cols.row(j).sample(u.y));
-            }
-            for (r, c) in rows.iter().zip(&cols) {
-                if let (Some((j, _)), Some((i, _))) = (r, c) {
+            let (mut ci, mut rv) = ([NONE; LOOKUP_CHUNK], [0.0; LOOKUP_CHUNK]);
+            for (k, &(comp, u)) in dc.iter().enumerate() {
+                if rj[k] == NONE {
+                    continue;
+                }
+                let j = rj[k] as usize;
+                if let Some((i, r)) = map.sampler(comp).cols.row(j).sample(u.y) {
+                    (ci[k], rv[k]) = (i as u32, r);
                     prefetch(&map.texels[j * map.width + i]);
                 }
             }
-            for (k, o) in oc.iter_mut().enumerate() {
-                *o = match (rows[k], cols[k]) {
-                    (Some(r), Some(c)) => map.finish_sample(dc[k].0, r, c),
-                    _ => None,
+            for (k, o) in oc[..n].iter_mut().enumerate() {
+                *o = if ci[k] == NONE {
+                    None
+                } else {
+                    map.finish_sample(dc[k].0, (rj[k] as usize, ru[k]), (ci[k] as usize, rv[k]))
                 };
             }
         }
