@@ -4,6 +4,7 @@
 //! `lobe: error: <message>` on stderr and exit code 1 (clap's own usage
 //! errors exit 2).
 
+mod alloc;
 mod bench;
 mod common;
 mod compare;
@@ -21,6 +22,9 @@ mod tabulate;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
+
+#[global_allocator]
+static ALLOCATOR: alloc::Allocator = alloc::Allocator;
 
 #[derive(Parser, Debug)]
 #[command(

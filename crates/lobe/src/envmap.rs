@@ -103,6 +103,10 @@ impl Distribution1D {
                 *c /= acc;
             }
             cdf[n] = 1.0;
+        } else {
+            // No bin can be drawn: the guide stays as it was given (zeros),
+            // as the tables of a map's black row stay ([`TexelSampler::new`]).
+            return acc;
         }
         let mut i = 0usize;
         // `upper[i]` = `cdf[i + 1]` for the bins before the last.
@@ -588,14 +592,16 @@ impl TexelSampler {
         let mut guide = vec![0u32; height * width];
         let row = |(j, (c, g)): (usize, (&mut [f64], &mut [u32]))| {
             let omega = dphi * EnvMap::band(height, j);
-            Distribution1D::build(
-                texels[j * width..(j + 1) * width]
-                    .iter()
-                    .map(|t| Self::weight_of(shift, t.lum()) * omega),
-                &steps,
-                c,
-                g,
-            )
+            let texels = &texels[j * width..(j + 1) * width];
+            let weight = |t: &Texel| Self::weight_of(shift, t.lum()) * omega;
+            // A row of weight 0 (most of a compensated sampler's rows
+            // under a sky with a sun) leaves its tables as allocated, the
+            // zeros `Distribution1D::build` would leave too: pages of them
+            // that are never touched cost neither a fault nor a clearing.
+            if !texels.iter().any(|t| weight(t) > 0.0) {
+                return 0.0;
+            }
+            Distribution1D::build(texels.iter().map(weight), &steps, c, g)
         };
         // Each row's distribution is its own computation: the same numbers
         // in parallel or not.
