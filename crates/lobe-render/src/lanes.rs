@@ -308,7 +308,12 @@ fn sphere_chunk<const NORMALS: bool>(
         );
         disc[l] = r2 - dot(px, py, pz, px, py, pz);
         cc[l] = dot(ocx, ocy, ocz, ocx, ocy, ocz) - r2;
-        any |= (l < m) & (disc[l] >= 0.0);
+        // A ray that starts outside (or on) the sphere and does not go
+        // toward its centre (`c ≥ 0`, `b ≥ 0`: both roots ≤ 0 below, so no
+        // hit) needs no roots: a shadow ray leaving the sphere it starts
+        // on, which is every shadow ray's test against its own sphere.
+        let away = (b[l] >= 0.0) & (cc[l] >= 0.0);
+        any |= (l < m) & (disc[l] >= 0.0) & !away;
     }
     if any {
         // Roots of t² + 2bt + c: q = −(b + sign(b) √disc), t = q and c / q.
@@ -774,6 +779,60 @@ mod tests {
                 assert!(n_hit > 1000 && n_hit < rays.len() - 500, "{n_hit} hits");
             }
         }
+    }
+
+    /// Shadow rays leaving the sphere they start on, in runs of whole
+    /// chunks (which skip the roots: every lane starts outside and goes
+    /// away), and rays from outside along a tangent (`b = ±0`), against
+    /// the scalar tests.
+    #[test]
+    fn rays_leaving_a_sphere_are_the_scalar_ones_bit_for_bit() {
+        let scene = scene(false);
+        let mut rng = Pcg64::seed_from_u64(11);
+        let mut rays = Vec::new();
+        for o in &scene.objects {
+            let Shape::Sphere(s) = &o.shape else {
+                continue;
+            };
+            for _ in 0..64 {
+                let n = unit(&mut rng);
+                let mut d = unit(&mut rng);
+                if d.dot(n) < 0.0 {
+                    d = -d;
+                }
+                rays.push(spawn_ray(s.center + n * s.radius, n, d));
+            }
+            for (e, f) in [
+                (DVec3::X, DVec3::Y),
+                (DVec3::Y, DVec3::Z),
+                (DVec3::Z, DVec3::X),
+            ] {
+                for k in [1.0, 1.5, 3.0] {
+                    let origin = s.center + e * (s.radius * k);
+                    rays.push(Ray { origin, dir: f });
+                    rays.push(Ray { origin, dir: -f });
+                }
+            }
+        }
+        let lanes = lanes_of(&rays);
+        let (mut hits, mut blocked) = (HitLanes::default(), Vec::new());
+        let mut n_blocked = 0;
+        for level in levels() {
+            scene.intersect_many(level, &lanes, &mut hits);
+            scene.occluded_many(level, &lanes, &mut blocked);
+            for (i, r) in rays.iter().enumerate() {
+                assert_eq!(blocked[i], scene.occluded(r), "{level:?} ray {i} {r:?}");
+                n_blocked += usize::from(blocked[i]);
+                let want = scene.intersect(r, f64::INFINITY);
+                assert_eq!(
+                    want.map(|(h, k)| (k as u32, h.t.to_bits())),
+                    (hits.obj[i] != NO_HIT).then(|| (hits.obj[i], hits.t[i].to_bits())),
+                    "{level:?} ray {i} {r:?}"
+                );
+            }
+        }
+        // Some are blocked by another sphere (two touch, one is inside one).
+        assert!(n_blocked > 0);
     }
 
     #[test]
