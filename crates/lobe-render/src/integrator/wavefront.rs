@@ -495,19 +495,20 @@ impl Batch<'_> {
             lanes.film.1.extend(jy.iter().map(|&j| yf + j));
             self.camera_points(ctx, y, &mut pts, &mut lanes, &mut stats);
             if sobol {
-                // The shading pairs of the samples that hit, compacted.
-                for v in &mut lanes.hit_seeds {
-                    v.clear();
+                // The shading pairs of the samples that hit, compacted: a
+                // gather per array, written by index (no `push`es).
+                let n = pts.len();
+                lanes.hit_index.resize(n, 0);
+                for (h, pt) in lanes.hit_index.iter_mut().zip(&pts) {
+                    *h = lanes.pair_index[pt.m as usize];
                 }
-                lanes.hit_index.clear();
-                for pt in &pts {
-                    let m = pt.m as usize;
-                    lanes.hit_index.push(lanes.pair_index[m]);
-                    for p in self.shading_pairs() {
-                        lanes.hit_seeds[p].push(lanes.pair_seeds[p][m]);
+                for p in self.shading_pairs() {
+                    let (dst, src) = (&mut lanes.hit_seeds[p], &lanes.pair_seeds[p]);
+                    dst.resize(n, SobolKeys::default());
+                    for (d, pt) in dst.iter_mut().zip(&pts) {
+                        *d = src[pt.m as usize];
                     }
                 }
-                let n = lanes.hit_index.len();
                 for p in self.shading_pairs() {
                     sobol_pairs(
                         self.level,
