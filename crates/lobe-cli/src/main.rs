@@ -24,7 +24,7 @@ use clap::{Parser, Subcommand};
 use std::process::ExitCode;
 
 #[global_allocator]
-static ALLOCATOR: alloc::Allocator = alloc::Allocator;
+static ALLOCATOR: alloc::Allocator = alloc::Allocator::new();
 
 #[derive(Parser, Debug)]
 #[command(
@@ -57,6 +57,9 @@ enum Command {
 }
 
 fn main() -> ExitCode {
+    // Huge pages for `render`'s large blocks only (see `alloc`), decided
+    // before any large block exists.
+    ALLOCATOR.use_huge_pages(std::env::args_os().nth(1).is_some_and(|a| a == "render"));
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Demo(args) => demo::run(&args),
