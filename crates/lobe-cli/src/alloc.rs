@@ -58,7 +58,11 @@ impl Allocator {
     /// the first call decides, if no large block was allocated before it;
     /// later calls change nothing. Returns whether they are on.
     pub fn use_huge_pages(&self, on: bool) -> bool {
-        let want = if on { ON } else { OFF };
+        self.decide(if on { ON } else { OFF })
+    }
+
+    /// Set the switch to `want` if it is still unset; whether it is on.
+    fn decide(&self, want: u8) -> bool {
         let _ = self
             .state
             .compare_exchange(UNSET, want, Ordering::AcqRel, Ordering::Acquire);
@@ -76,12 +80,7 @@ impl Allocator {
         match self.state.load(Ordering::Acquire) {
             ON => true,
             OFF => false,
-            _ => {
-                let _ =
-                    self.state
-                        .compare_exchange(UNSET, OFF, Ordering::AcqRel, Ordering::Acquire);
-                self.state.load(Ordering::Acquire) == ON
-            }
+            _ => self.decide(OFF),
         }
     }
 }

@@ -420,31 +420,15 @@ pub fn spp_counts(variance: &[f64], w: usize, h: usize, spp: u64) -> Vec<u64> {
         if v.is_finite() && v > 0.0 { v } else { 0.0 }
     };
     // Pooled over the (2r + 1)² pixels around each one (fewer at the
-    // edges): box sums along the rows, then down the columns.
-    let r = VARIANCE_POOL_RADIUS;
-    let mut across = vec![(0.0, 0.0); p];
-    for y in 0..h {
-        for x in 0..w {
-            let (mut s, mut k) = (0.0, 0.0);
-            for xx in x.saturating_sub(r)..(x + r + 1).min(w) {
-                s += var(y * w + xx);
-                k += 1.0;
-            }
-            across[y * w + x] = (s, k);
-        }
-    }
-    let mut sigma = vec![0.0; p];
-    for y in 0..h {
-        for x in 0..w {
-            let (mut s, mut k) = (0.0, 0.0);
-            for yy in y.saturating_sub(r)..(y + r + 1).min(h) {
-                let (a, b) = across[yy * w + x];
-                s += a;
-                k += b;
-            }
-            sigma[y * w + x] = (s / k).sqrt();
-        }
-    }
+    // edges): the variances' sum and count.
+    let cells: Vec<(f64, f64)> = (0..p).map(|i| (var(i), 1.0)).collect();
+    let sigma: Vec<f64> = box_pool(&cells, w, h, VARIANCE_POOL_RADIUS, |a, b| {
+        a.0 += b.0;
+        a.1 += b.1;
+    })
+    .into_iter()
+    .map(|(s, k)| (s / k).sqrt())
+    .collect();
     let total = p as u64 * spp;
     // (A sum that overflows: uniform too.)
     let s: f64 = sigma.iter().sum();
@@ -755,24 +739,39 @@ fn pilot_phase(scene: &Scene, opts: &RenderOptions) -> (Prior, RenderStats) {
 /// down the columns (14 merges a pixel instead of 49, for a render that
 /// asks each pixel's allocation in every block it spans).
 fn pooled_allocations(pilots: &[Pilot], w: usize, h: usize, mis: Mis) -> Vec<Allocation> {
-    let r = PILOT_RADIUS;
-    let mut across = vec![Pilot::default(); w * h];
+    box_pool(pilots, w, h, PILOT_RADIUS, Pilot::merge)
+        .iter()
+        .map(|p| p.choose(mis.n_bsdf, mis.n_light))
+        .collect()
+}
+
+/// Each cell of a `w × h` grid (row by row) pooled with the cells of the
+/// `(2r + 1)²` box around it (fewer at the edges) by `merge`, starting
+/// from `T::default()`: along the rows first, then down the columns (`2(2r
+/// + 1)` merges a cell instead of `(2r + 1)²`), each in increasing order.
+fn box_pool<T: Clone + Default>(
+    cells: &[T],
+    w: usize,
+    h: usize,
+    r: usize,
+    merge: impl Fn(&mut T, &T),
+) -> Vec<T> {
+    let mut across = vec![T::default(); w * h];
     for y in 0..h {
         for x in 0..w {
             let p = &mut across[y * w + x];
             for xx in x.saturating_sub(r)..(x + r + 1).min(w) {
-                p.merge(&pilots[y * w + xx]);
+                merge(p, &cells[y * w + xx]);
             }
         }
     }
-    let mut out = Vec::with_capacity(w * h);
+    let mut out = vec![T::default(); w * h];
     for y in 0..h {
         for x in 0..w {
-            let mut p = Pilot::default();
+            let p = &mut out[y * w + x];
             for yy in y.saturating_sub(r)..(y + r + 1).min(h) {
-                p.merge(&across[yy * w + x]);
+                merge(p, &across[yy * w + x]);
             }
-            out.push(p.choose(mis.n_bsdf, mis.n_light));
         }
     }
     out
