@@ -105,39 +105,86 @@ fn read_exr_rgb(path: &Path) -> Result<TexelBuffer, String> {
 /// [`read_exr_rgb`] of a file of one flat layer whose R, G and B channels
 /// have a sample per pixel (most maps): the decoded blocks' lines copied a
 /// channel at a time, without a call per pixel (a 1024 × 512 map decodes
-/// in a third of the time); `None` for any other file.
+/// in a third of the time); `None` for any other file. The rows are read
+/// in bands on rayon's threads, each band by a reader of its own, which
+/// also decompresses its blocks (`exr` reads an uncompressed file's blocks
+/// one after the other on one thread, and starts a thread pool of its own
+/// to decompress):
+/// every texel comes from the same bytes of the file whatever the number
+/// of bands.
 fn read_exr_rgb_lines(path: &Path) -> Result<Option<TexelBuffer>, exr::error::Error> {
+    use rayon::prelude::*;
+    let open = || -> Result<_, exr::error::Error> {
+        let file = std::io::BufReader::new(std::fs::File::open(path)?);
+        exr::block::read(file, false)
+    };
+    let reader = open()?;
+    let [header] = reader.headers() else {
+        return Ok(None);
+    };
+    let (size, deep) = (header.layer_size, header.deep);
+    let list = header.channels.list.clone();
+    let find = |name: &str| list.iter().position(|c| c.name == *name);
+    let (Some(r), Some(g), Some(b)) = (find("R"), find("G"), find("B")) else {
+        return Ok(None);
+    };
+    if deep
+        || list.iter().any(|c| c.sampling != exr::math::Vec2(1, 1))
+        || size.area() > MAX_EXR_TEXELS
+    {
+        return Ok(None);
+    }
+    // Bands of whole blocks (a block's rows in one band): about two per
+    // thread, for balance.
+    let block_rows = header.max_block_pixel_size().height().max(1);
+    let blocks = size.height().div_ceil(block_rows).max(1);
+    let per_band = blocks.div_ceil((2 * rayon::current_num_threads()).clamp(1, blocks));
+    let mut texels = TexelBuffer::new(size.width(), size.height());
+    let rgb = [r, g, b];
+    let mut first = Some(reader);
+    let bands: Vec<_> = texels
+        .bands(per_band * block_rows)
+        .map(|band| (band, first.take()))
+        .collect();
+    bands.into_par_iter().try_for_each(|(band, reader)| {
+        let reader = match reader {
+            Some(r) => r,
+            None => open()?,
+        };
+        read_band(reader, band, &list, rgb)
+    })?;
+    Ok(Some(texels))
+}
+
+/// The blocks of [`read_exr_rgb_lines`]'s file whose rows are `band`'s,
+/// decoded into it (the channels `rgb` of `list` by index).
+fn read_band<R: std::io::Read + std::io::Seek + Send>(
+    reader: exr::block::reader::Reader<R>,
+    mut band: lobe::envmap::TexelBand<'_>,
+    list: &[exr::meta::attribute::ChannelDescription],
+    rgb: [usize; 3],
+) -> Result<(), exr::error::Error> {
     use exr::block::BlockIndex;
     use exr::block::chunk::TileCoordinates;
     use exr::block::reader::ChunksReader;
     use exr::meta::MetaData;
     use exr::meta::attribute::SampleType;
     use exr::prelude::*;
-    let file = std::io::BufReader::new(std::fs::File::open(path)?);
-    let reader = exr::block::read(file, false)?;
-    let [header] = reader.headers() else {
-        return Ok(None);
-    };
-    let (size, deep) = (header.layer_size, header.deep);
-    let list = header.channels.list.clone();
-    // Each channel's bytes per sample; R, G and B by index.
+    let rows = band.rows();
+    // Each channel's bytes per sample.
     let bytes = |t: SampleType| match t {
         SampleType::F16 => 2,
         SampleType::F32 | SampleType::U32 => 4,
     };
-    let find = |name: &str| list.iter().position(|c| c.name == *name);
-    let (Some(r), Some(g), Some(b)) = (find("R"), find("G"), find("B")) else {
-        return Ok(None);
+    // The full-resolution level's blocks that start in the band.
+    let mine = |_: &MetaData, _: TileCoordinates, i: BlockIndex| {
+        i.level == Vec2(0, 0) && rows.contains(&i.pixel_position.y())
     };
-    if deep || list.iter().any(|c| c.sampling != Vec2(1, 1)) || size.area() > MAX_EXR_TEXELS {
-        return Ok(None);
-    }
-    let mut texels = TexelBuffer::new(size.width(), size.height());
-    // The full-resolution level's blocks only.
-    let full = |_: &MetaData, _: TileCoordinates, i: BlockIndex| i.level == Vec2(0, 0);
+    // (Decompressed on the band's thread: the bands are the parallelism,
+    // without a thread pool of `exr`'s own per band.)
     reader
-        .filter_chunks(false, full)?
-        .decompress_parallel(false, |_, block| {
+        .filter_chunks(false, mine)?
+        .decompress_sequential(false, |_, block| {
             let (x0, y0) = (
                 block.index.pixel_position.x(),
                 block.index.pixel_position.y(),
@@ -145,7 +192,7 @@ fn read_exr_rgb_lines(path: &Path) -> Result<Option<TexelBuffer>, exr::error::Er
             let (w, h) = (block.index.pixel_size.x(), block.index.pixel_size.y());
             // A line of the block: each channel's `w` samples in turn.
             let line: usize = list.iter().map(|c| w * bytes(c.sample_type)).sum();
-            if block.data.len() != line * h || x0 + w > size.width() || y0 + h > size.height() {
+            if block.data.len() != line * h || y0 + h > rows.end || x0 + w > band.width() {
                 return Err(exr::error::Error::Invalid("block size".into()));
             }
             for (k, data) in block.data.chunks_exact(line).enumerate() {
@@ -154,39 +201,38 @@ fn read_exr_rgb_lines(path: &Path) -> Result<Option<TexelBuffer>, exr::error::Er
                     let n = w * bytes(c.sample_type);
                     let samples = &data[at..at + n];
                     at += n;
-                    let Some(rgb) = [r, g, b].iter().position(|&i| i == ci) else {
+                    let Some(ch) = rgb.iter().position(|&i| i == ci) else {
                         continue;
                     };
                     // Native-endian samples, converted as the pixel reader
                     // converts them (one loop per type, of a constant width).
-                    let first = (x0, y0 + k, rgb);
+                    let first = (x0, y0 + k, ch);
                     match c.sample_type {
-                        SampleType::F16 => put(&mut texels, first, samples, |s: &[u8; 2]| {
+                        SampleType::F16 => put(&mut band, first, samples, |s: &[u8; 2]| {
                             f16::from_ne_bytes(*s).to_f32()
                         }),
-                        SampleType::F32 => put(&mut texels, first, samples, |s: &[u8; 4]| {
+                        SampleType::F32 => put(&mut band, first, samples, |s: &[u8; 4]| {
                             f32::from_ne_bytes(*s)
                         }),
-                        SampleType::U32 => put(&mut texels, first, samples, |s: &[u8; 4]| {
+                        SampleType::U32 => put(&mut band, first, samples, |s: &[u8; 4]| {
                             u32::from_ne_bytes(*s) as f32
                         }),
                     }
                 }
             }
             Ok(())
-        })?;
-    Ok(Some(texels))
+        })
 }
 
 /// Channel `c` of the texels from `(x0, y)` on: `samples`, `N` bytes each,
 /// converted by `convert`.
 fn put<const N: usize>(
-    texels: &mut TexelBuffer,
+    band: &mut lobe::envmap::TexelBand<'_>,
     (x0, y, c): (usize, usize, usize),
     samples: &[u8],
     convert: impl Fn(&[u8; N]) -> f32,
 ) {
-    texels.set_channel_run(x0, y, c, samples.as_chunks::<N>().0.iter().map(convert));
+    band.set_channel_run(x0, y, c, samples.as_chunks::<N>().0.iter().map(convert));
 }
 
 /// [`read_exr_rgb`] through `exr`'s pixel reader: any layout it reads.

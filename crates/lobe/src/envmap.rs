@@ -522,23 +522,90 @@ impl TexelBuffer {
         c: usize,
         values: impl ExactSizeIterator<Item = f32>,
     ) {
-        let n = values.len();
-        assert!(
-            c < 3 && j < self.height && i0.checked_add(n).is_some_and(|e| e <= self.width),
-            "TexelBuffer::set_channel_run: channel {c}, {n} texels from ({i0}, {j}) outside {}×{}",
-            self.width,
-            self.height
-        );
-        let start = j * self.width + i0;
-        for (t, v) in self.texels[start..start + n].iter_mut().zip(values) {
-            t.rgb[c] = v;
+        TexelBand {
+            width: self.width,
+            first_row: 0,
+            rows: self.height,
+            texels: &mut self.texels,
         }
+        .set_channel_run(i0, j, c, values);
+    }
+
+    /// The buffer cut into bands of `rows` rows each from the top (the last
+    /// one shorter when `rows` does not divide the height), each one borrowed
+    /// on its own: a decoder's threads can set a band each
+    /// ([`TexelBand::set_channel_run`]). None for a buffer without texels.
+    ///
+    /// # Panics
+    /// If `rows` is 0.
+    pub fn bands(&mut self, rows: usize) -> impl Iterator<Item = TexelBand<'_>> {
+        assert!(rows > 0, "TexelBuffer::bands: bands of 0 rows");
+        let width = self.width;
+        // (`max(1)`: a buffer of width 0 has no texels, so no chunk.)
+        self.texels
+            .chunks_mut(rows.saturating_mul(width).max(1))
+            .enumerate()
+            .map(move |(k, texels)| TexelBand {
+                width,
+                first_row: k * rows,
+                rows: texels.len() / width,
+                texels,
+            })
     }
 
     /// `(width, height)`.
     #[must_use]
     pub fn size(&self) -> (usize, usize) {
         (self.width, self.height)
+    }
+}
+
+/// Rows of a [`TexelBuffer`], borrowed to be set ([`TexelBuffer::bands`]).
+#[derive(Debug)]
+pub struct TexelBand<'a> {
+    width: usize,
+    first_row: usize,
+    rows: usize,
+    texels: &'a mut [Texel],
+}
+
+impl TexelBand<'_> {
+    /// The buffer's rows the band holds.
+    #[must_use]
+    pub fn rows(&self) -> std::ops::Range<usize> {
+        self.first_row..self.first_row + self.rows
+    }
+
+    /// The buffer's width in texels.
+    #[must_use]
+    pub fn width(&self) -> usize {
+        self.width
+    }
+
+    /// [`TexelBuffer::set_channel_run`] on a row of the band (`j` counted
+    /// from the top of the buffer, as there).
+    ///
+    /// # Panics
+    /// If the run leaves row `j` or the band, or `c > 2`.
+    #[inline]
+    pub fn set_channel_run(
+        &mut self,
+        i0: usize,
+        j: usize,
+        c: usize,
+        values: impl ExactSizeIterator<Item = f32>,
+    ) {
+        let n = values.len();
+        assert!(
+            c < 3 && self.rows().contains(&j) && i0.checked_add(n).is_some_and(|e| e <= self.width),
+            "TexelBand::set_channel_run: channel {c}, {n} texels from ({i0}, {j}) outside rows {:?} of width {}",
+            self.rows(),
+            self.width
+        );
+        let start = (j - self.first_row) * self.width + i0;
+        for (t, v) in self.texels[start..start + n].iter_mut().zip(values) {
+            t.rgb[c] = v;
+        }
     }
 }
 
@@ -1519,6 +1586,20 @@ mod tests {
         assert_eq!(buf.size(), (32, 16));
         for k in (0..rgb.len()).rev() {
             buf.set(k % 32, k / 32, rgb[k]);
+        }
+        assert_eq!(EnvMap::from_texel_buffer(buf, 1.5, 20.0).unwrap(), a);
+        // Filled a channel run at a time in bands of 5 rows (the last of 1),
+        // in any order of the bands, as a decoder's threads fill it.
+        let mut buf = TexelBuffer::new(32, 16);
+        let mut bands: Vec<TexelBand<'_>> = buf.bands(5).collect();
+        let rows: Vec<_> = bands.iter().map(TexelBand::rows).collect();
+        assert_eq!(rows, [0..5, 5..10, 10..15, 15..16]);
+        for band in bands.iter_mut().rev() {
+            for j in band.rows() {
+                for c in 0..3 {
+                    band.set_channel_run(0, j, c, rgb[j * 32..(j + 1) * 32].iter().map(|t| t[c]));
+                }
+            }
         }
         assert_eq!(EnvMap::from_texel_buffer(buf, 1.5, 20.0).unwrap(), a);
         let short = TexelBuffer::new(32, 15);
