@@ -131,6 +131,8 @@ impl Image {
             return Err(err("the pixel buffer does not match the size".into()));
         }
         let w = self.width;
+        let mut out =
+            std::io::BufWriter::new(create_replacing(path).map_err(|e| err(e.to_string()))?);
         ExrImage::from_channels(
             (self.width, self.height),
             SpecificChannels::rgb(|p: exr::math::Vec2<usize>| {
@@ -140,8 +142,9 @@ impl Image {
         )
         .write()
         .non_parallel()
-        .to_file(path)
-        .map_err(|e| err(e.to_string()))
+        .to_buffered(&mut out)
+        .map_err(|e| err(e.to_string()))?;
+        std::io::Write::flush(&mut out).map_err(|e| err(e.to_string()))
     }
 
     /// The samples per pixel of a variance-allocated render
@@ -203,16 +206,112 @@ impl Image {
             path: path.to_path_buf(),
             message,
         };
-        let img = image::RgbImage::from_raw(self.width as u32, self.height as u32, bytes)
-            .ok_or_else(|| err(format!("the {what} buffer does not match the size")))?;
-        img.save_with_format(path, image::ImageFormat::Png)
-            .map_err(|e| err(e.to_string()))
+        use image::ImageEncoder;
+        if bytes.len() != 3 * self.width * self.height {
+            return Err(err(format!("the {what} buffer does not match the size")));
+        }
+        let mut out =
+            std::io::BufWriter::new(create_replacing(path).map_err(|e| err(e.to_string()))?);
+        image::codecs::png::PngEncoder::new(&mut out)
+            .write_image(
+                &bytes,
+                self.width as u32,
+                self.height as u32,
+                image::ExtendedColorType::Rgb8,
+            )
+            .map_err(|e| err(e.to_string()))?;
+        std::io::Write::flush(&mut out).map_err(|e| err(e.to_string()))
+    }
+}
+
+/// A new, empty file at `path` to write. A regular file already there, the
+/// only link to its data and writable, is removed first instead of being
+/// truncated: on Linux's ext4, truncating a file that was written moments
+/// ago (the previous render's output) waits until the kernel has written
+/// its old data to the disk (half a millisecond to several), while the
+/// blocks of a removed file are freed in the background. Anything else (a
+/// symbolic link, a file with other hard links, a file this process cannot
+/// write) is opened as [`std::fs::File::create`] opens it, and fails or
+/// not as it does.
+fn create_replacing(path: &Path) -> std::io::Result<std::fs::File> {
+    if let Ok(m) = std::fs::symlink_metadata(path)
+        && m.file_type().is_file()
+        && only_link(&m)
+        && std::fs::OpenOptions::new().write(true).open(path).is_ok()
+    {
+        // (Another process may remove it first: create below either way.)
+        let _ = std::fs::remove_file(path);
+    }
+    std::fs::File::create(path)
+}
+
+/// Whether `m`'s file has a single hard link (always so where links cannot
+/// be counted).
+fn only_link(m: &std::fs::Metadata) -> bool {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt;
+        m.nlink() == 1
+    }
+    #[cfg(not(unix))]
+    {
+        let _ = m;
+        true
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A render written over an earlier file, over a symbolic link and over
+    /// a file with a second hard link: the file gets the new bytes, the
+    /// link is written through (and stays a link), the other hard link sees
+    /// the new bytes too (its data was rewritten in place).
+    #[test]
+    fn outputs_replace_files_and_write_through_links() {
+        let d = std::env::temp_dir().join(format!("lobe-output-test-{}", std::process::id()));
+        std::fs::create_dir_all(&d).unwrap();
+        let mut img = Image::new(4, 3);
+        img.pixels[5] = lobe::Rgb::new(0.5, 1.0, 2.0);
+        let fresh = d.join("fresh.png");
+        img.write_png(&fresh, &ToneMap::default()).unwrap();
+        let want = std::fs::read(&fresh).unwrap();
+        // Over a longer file.
+        let old = d.join("old.png");
+        std::fs::write(&old, vec![7u8; 10 * want.len()]).unwrap();
+        img.write_png(&old, &ToneMap::default()).unwrap();
+        assert_eq!(std::fs::read(&old).unwrap(), want);
+        #[cfg(unix)]
+        {
+            let target = d.join("target.png");
+            std::fs::write(&target, b"old").unwrap();
+            let link = d.join("link.png");
+            let _ = std::fs::remove_file(&link);
+            std::os::unix::fs::symlink(&target, &link).unwrap();
+            img.write_png(&link, &ToneMap::default()).unwrap();
+            assert!(
+                std::fs::symlink_metadata(&link)
+                    .unwrap()
+                    .file_type()
+                    .is_symlink()
+            );
+            assert_eq!(std::fs::read(&target).unwrap(), want);
+            let other = d.join("other.png");
+            let _ = std::fs::remove_file(&other);
+            std::fs::hard_link(&old, &other).unwrap();
+            std::fs::write(&old, b"x").unwrap();
+            img.write_png(&old, &ToneMap::default()).unwrap();
+            assert_eq!(std::fs::read(&other).unwrap(), want);
+        }
+        // The EXR: over an earlier file, read back.
+        let exr = d.join("img.exr");
+        std::fs::write(&exr, vec![1u8; 100_000]).unwrap();
+        img.write_exr(&exr).unwrap();
+        let back = crate::load_envmap(&exr, 1.0, 0.0).unwrap().0;
+        assert_eq!(back.texel(1, 1), lobe::Rgb::new(0.5, 1.0, 2.0));
+        std::fs::remove_dir_all(&d).unwrap();
+    }
 
     #[test]
     fn tone_curve() {
