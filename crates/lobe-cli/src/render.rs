@@ -156,6 +156,16 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         Some(s) => Some(s.parse().map_err(|m| anyhow!("--strategy: {m}"))?),
         None => None,
     };
+    // `--threads` for all of the command's work, the map's loading too:
+    // rayon's global pool, which the render then runs on (a pool of the
+    // same size, see `RenderOptions::threads`).
+    if let Some(n) = args.threads {
+        // (Fails only if the pool exists already; the render then starts a
+        // pool of its own, of `n` threads.)
+        let _ = rayon::ThreadPoolBuilder::new()
+            .num_threads(n as usize)
+            .build_global();
+    }
     let mut scene = load_scene(&args.scene)?;
     let mut opts = scene.options;
     if let Some(n) = args.spp {
@@ -255,24 +265,18 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let png = crate::common::with_ext(&base, "png");
     // Where the samples went, when the variance allocation placed them.
     let spp_png = crate::common::with_ext(&base, "spp.png");
-    // The three files written at once (each one encodes on its own thread).
-    let (exr_written, png_written, spp_written) = std::thread::scope(|s| {
-        let p = s.spawn(|| {
+    // The three files written at once on the pool's threads.
+    let (png_written, (spp_written, exr_written)) = rayon::join(
+        || {
             image.write_png(
                 &png,
                 &lobe_render::ToneMap {
                     exposure: args.exposure,
                 },
             )
-        });
-        let q = s.spawn(|| image.write_spp_png(&spp_png));
-        let e = image.write_exr(&exr);
-        (
-            e,
-            p.join().expect("the PNG writer does not panic"),
-            q.join().expect("the spp PNG writer does not panic"),
-        )
-    });
+        },
+        || rayon::join(|| image.write_spp_png(&spp_png), || image.write_exr(&exr)),
+    );
     exr_written?;
     png_written?;
     let wrote_spp = spp_written?;

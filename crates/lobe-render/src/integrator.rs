@@ -527,8 +527,11 @@ pub const MAX_PILOT_SPP: u64 = 8;
 /// allocation (7 × 7 pixels).
 pub const PILOT_RADIUS: usize = 3;
 
+/// `f` on a pool of `opts.threads` threads: the current pool (rayon's
+/// global one outside of any) when it has that many, else a new one.
 fn on_pool<T: Send>(opts: &RenderOptions, f: impl FnOnce() -> T + Send) -> T {
     if let Some(n) = opts.threads
+        && n != rayon::current_num_threads()
         && let Ok(pool) = rayon::ThreadPoolBuilder::new().num_threads(n).build()
     {
         return pool.install(f);

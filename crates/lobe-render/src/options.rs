@@ -21,7 +21,8 @@ pub struct RenderOptions {
     pub sequence: Sequence,
     /// 1 = direct lighting; more adds bounces. At least 1.
     pub max_depth: u32,
-    /// Threads of a local pool; `None` runs on rayon's current pool.
+    /// Threads to render on: rayon's current pool when it has that many,
+    /// else a local pool of that many; `None` runs on rayon's current pool.
     pub threads: Option<usize>,
     /// The batch loop (the default) or the scalar one, its reference.
     pub render_loop: RenderLoop,
