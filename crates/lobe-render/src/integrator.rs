@@ -420,15 +420,17 @@ pub fn spp_counts(variance: &[f64], w: usize, h: usize, spp: u64) -> Vec<u64> {
         if v.is_finite() && v > 0.0 { v } else { 0.0 }
     };
     // Pooled over the (2r + 1)² pixels around each one (fewer at the
-    // edges): the variances' sum and count.
-    let cells: Vec<(f64, f64)> = (0..p).map(|i| (var(i), 1.0)).collect();
-    let sigma: Vec<f64> = box_pool(&cells, w, h, VARIANCE_POOL_RADIUS, |a, b| {
-        a.0 += b.0;
-        a.1 += b.1;
-    })
-    .into_iter()
-    .map(|(s, k)| (s / k).sqrt())
-    .collect();
+    // edges): the variances' sum over their count.
+    let r = VARIANCE_POOL_RADIUS;
+    let span = |c: usize, n: usize| (c + r + 1).min(n) - c.saturating_sub(r);
+    let sigma: Vec<f64> = box_pool(
+        w,
+        h,
+        r,
+        var,
+        |a, b| *a += b,
+        |i, s| (s / (span(i % w, w) * span(i / w, h)) as f64).sqrt(),
+    );
     let total = p as u64 * spp;
     // (A sum that overflows: uniform too.)
     let s: f64 = sigma.iter().sum();
@@ -742,42 +744,54 @@ fn pilot_phase(scene: &Scene, opts: &RenderOptions) -> (Prior, RenderStats) {
 /// down the columns (14 merges a pixel instead of 49, for a render that
 /// asks each pixel's allocation in every block it spans).
 fn pooled_allocations(pilots: &[Pilot], w: usize, h: usize, mis: Mis) -> Vec<Allocation> {
-    box_pool(pilots, w, h, PILOT_RADIUS, Pilot::merge)
-        .iter()
-        .map(|p| p.choose(mis.n_bsdf, mis.n_light))
-        .collect()
+    box_pool(
+        w,
+        h,
+        PILOT_RADIUS,
+        |i| pilots[i],
+        Pilot::merge,
+        |_, p| p.choose(mis.n_bsdf, mis.n_light),
+    )
 }
 
-/// Each cell of a `w × h` grid (row by row) pooled with the cells of the
-/// `(2r + 1)²` box around it (fewer at the edges) by `merge`, starting
-/// from `T::default()`: along the rows first, then down the columns (`2(2r
-/// + 1)` merges a cell instead of `(2r + 1)²`), each in increasing order.
-fn box_pool<T: Clone + Default>(
-    cells: &[T],
+/// Each cell of a `w × h` grid (row by row, cell `i` is `cell(i)`) pooled
+/// with the cells of the `(2r + 1)²` box around it (fewer at the edges) by
+/// `merge`, starting from `T::default()`, and then `finish`ed (with its
+/// index): along the rows first, then down the columns (`2(2r + 1)` merges
+/// a cell instead of `(2r + 1)²`), each in increasing order. Both passes
+/// run over rayon's threads, each cell's merges in the same order whatever
+/// the thread; the pooled cells are finished as they come (no second grid
+/// of them).
+fn box_pool<T: Default + Send + Sync, U: Send>(
     w: usize,
     h: usize,
     r: usize,
-    merge: impl Fn(&mut T, &T),
-) -> Vec<T> {
-    let mut across = vec![T::default(); w * h];
-    for y in 0..h {
-        for x in 0..w {
-            let p = &mut across[y * w + x];
+    cell: impl Fn(usize) -> T + Sync,
+    merge: impl Fn(&mut T, &T) + Sync,
+    finish: impl Fn(usize, &T) -> U + Sync,
+) -> Vec<U> {
+    let across: Vec<T> = (0..w * h)
+        .into_par_iter()
+        .map(|i| {
+            let (y, x) = (i / w, i % w);
+            let mut p = T::default();
             for xx in x.saturating_sub(r)..(x + r + 1).min(w) {
-                merge(p, &cells[y * w + xx]);
+                merge(&mut p, &cell(y * w + xx));
             }
-        }
-    }
-    let mut out = vec![T::default(); w * h];
-    for y in 0..h {
-        for x in 0..w {
-            let p = &mut out[y * w + x];
+            p
+        })
+        .collect();
+    (0..w * h)
+        .into_par_iter()
+        .map(|i| {
+            let (y, x) = (i / w, i % w);
+            let mut p = T::default();
             for yy in y.saturating_sub(r)..(y + r + 1).min(h) {
-                merge(p, &across[yy * w + x]);
+                merge(&mut p, &across[yy * w + x]);
             }
-        }
-    }
-    out
+            finish(i, &p)
+        })
+        .collect()
 }
 
 /// One pass, and what its pilot decided when it ran one (pass 0 runs the
