@@ -706,8 +706,13 @@ fn pilot_phase(scene: &Scene, opts: &RenderOptions) -> (Prior, RenderStats) {
     } else {
         FirstBounce::Plain
     };
-    let mut pilots = vec![Pilot::default(); w * h];
-    let mut moments = vec![Moments::default(); w * h];
+    // (Made on rayon's threads, which share out the first touch of their
+    // pages.)
+    fn fresh<T: Default + Send>(n: usize) -> Vec<T> {
+        (0..n).into_par_iter().map(|_| T::default()).collect()
+    }
+    let mut pilots: Vec<Pilot> = fresh(w * h);
+    let mut moments: Vec<Moments> = fresh(w * h);
     if w == 0 {
         return (Prior::default(), RenderStats::default());
     }

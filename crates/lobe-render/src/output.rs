@@ -95,13 +95,16 @@ pub fn srgb_encode(x: f64) -> f64 {
 }
 
 impl Image {
-    /// The sRGB bytes tone-mapped by `tone`, `RGB RGB ...`, row 0 at the top.
+    /// The sRGB bytes tone-mapped by `tone`, `RGB RGB ...`, row 0 at the top
+    /// (the pixels mapped on rayon's threads, each on its own).
     #[must_use]
     pub fn to_srgb8(&self, tone: &ToneMap) -> Vec<u8> {
+        use rayon::prelude::*;
         self.pixels
-            .iter()
-            .flat_map(|p| tone.srgb8(p.to_array()))
-            .collect()
+            .par_iter()
+            .map(|p| tone.srgb8(p.to_array()))
+            .collect::<Vec<[u8; 3]>>()
+            .into_flattened()
     }
 
     /// The linear values as f32, `RGB RGB ...`; non-finite values as 0.
