@@ -113,6 +113,14 @@ fn read_exr_rgb(path: &Path) -> Result<TexelBuffer, String> {
 /// every texel comes from the same bytes of the file whatever the number
 /// of bands.
 fn read_exr_rgb_lines(path: &Path) -> Result<Option<TexelBuffer>, exr::error::Error> {
+    read_exr_rgb_lines_in(path, 2 * rayon::current_num_threads())
+}
+
+/// [`read_exr_rgb_lines`] in about `bands` bands (at least one block each).
+fn read_exr_rgb_lines_in(
+    path: &Path,
+    bands: usize,
+) -> Result<Option<TexelBuffer>, exr::error::Error> {
     use rayon::prelude::*;
     let open = || -> Result<_, exr::error::Error> {
         let file = std::io::BufReader::new(std::fs::File::open(path)?);
@@ -134,11 +142,10 @@ fn read_exr_rgb_lines(path: &Path) -> Result<Option<TexelBuffer>, exr::error::Er
     {
         return Ok(None);
     }
-    // Bands of whole blocks (a block's rows in one band): about two per
-    // thread, for balance.
+    // Bands of whole blocks (a block's rows in one band).
     let block_rows = header.max_block_pixel_size().height().max(1);
     let blocks = size.height().div_ceil(block_rows).max(1);
-    let per_band = blocks.div_ceil((2 * rayon::current_num_threads()).clamp(1, blocks));
+    let per_band = blocks.div_ceil(bands.clamp(1, blocks));
     let mut texels = TexelBuffer::new(size.width(), size.height());
     let rgb = [r, g, b];
     let mut first = Some(reader);
@@ -467,6 +474,7 @@ mod tests {
 
     /// The line reader gives the pixel reader's texels, bit for bit, for
     /// scanline and tiled files, four compressions and every sample type,
+    /// in any number of bands,
     /// with other channels beside R, G and B, lines stored bottom-up, and
     /// the full-resolution level of a mip map; it leaves files of more than
     /// one layer to the pixel reader.
@@ -524,6 +532,12 @@ mod tests {
                     let lines = read_exr_rgb_lines(&p).unwrap().expect("one flat layer");
                     let pixels = read_exr_rgb_pixels(&p).unwrap();
                     assert_eq!(lines, pixels, "{b:?} {c:?} {t}");
+                    // In 1 to 25 bands (as many as the file has blocks):
+                    // the same texels.
+                    for bands in [1, 2, 3, 25] {
+                        let banded = read_exr_rgb_lines_in(&p, bands).unwrap().unwrap();
+                        assert_eq!(banded, pixels, "{b:?} {c:?} {t}, {bands} bands");
+                    }
                     // Texel (1, 0)'s red: sample 1 of R, value(0, 1) = 7.
                     let (m, _) = load_envmap(&p, 1.0, 0.0).unwrap();
                     let red = match t {
