@@ -453,8 +453,10 @@ impl Texel {
 }
 
 /// The texels of a map being decoded, in the map's own storage, zero until
-/// set: a decoder writes each texel where it belongs ([`TexelBuffer::set`])
-/// and [`EnvMap::from_texel_buffer`] takes the storage as it is.
+/// set: a decoder writes each texel where it belongs ([`TexelBuffer::set`],
+/// or a line's channel at a time into a band of rows,
+/// [`TexelBuffer::bands`]) and [`EnvMap::from_texel_buffer`] takes the
+/// storage as it is.
 #[derive(Debug, Clone, PartialEq)]
 pub struct TexelBuffer {
     width: usize,
@@ -508,29 +510,6 @@ impl TexelBuffer {
         self.texels[j * self.width + i] = Texel { rgb };
     }
 
-    /// Set channel `c` (0 red, 1 green, 2 blue) of the run of texels
-    /// starting at `(i0, j)`: `values[k]` to texel `(i0 + k, j)` (a
-    /// decoder's line of one channel, as [`TexelBuffer::set`] sets texels).
-    ///
-    /// # Panics
-    /// If the run leaves row `j` or the buffer, or `c > 2`.
-    #[inline]
-    pub fn set_channel_run(
-        &mut self,
-        i0: usize,
-        j: usize,
-        c: usize,
-        values: impl ExactSizeIterator<Item = f32>,
-    ) {
-        TexelBand {
-            width: self.width,
-            first_row: 0,
-            rows: self.height,
-            texels: &mut self.texels,
-        }
-        .set_channel_run(i0, j, c, values);
-    }
-
     /// The buffer cut into bands of `rows` rows each from the top (the last
     /// one shorter when `rows` does not divide the height), each one borrowed
     /// on its own: a decoder's threads can set a band each
@@ -582,8 +561,11 @@ impl TexelBand<'_> {
         self.width
     }
 
-    /// [`TexelBuffer::set_channel_run`] on a row of the band (`j` counted
-    /// from the top of the buffer, as there).
+    /// Set channel `c` (0 red, 1 green, 2 blue) of the run of texels
+    /// starting at `(i0, j)` (`j` counted from the top of the buffer):
+    /// `values[k]` to texel `(i0 + k, j)` (a decoder's line of one channel,
+    /// as [`TexelBuffer::set`] sets texels). A whole buffer is one band
+    /// (`bands(height)`).
     ///
     /// # Panics
     /// If the run leaves row `j` or the band, or `c > 2`.
