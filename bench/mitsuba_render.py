@@ -69,7 +69,10 @@ that reaches it (its warm render time: Mitsuba renders every spp twice, a
 warm-up that compiles the kernels unless Dr.Jit's cache has them, then the
 timed render with a fixed seed per step, so that its error does not depend on
 the cache; stratified samplers compile one kernel per spp), the fastest of
---repeat timings of the same render (lobe: of the same process). The
+--repeat timings of the same render (lobe: of the same process), and with
+--rounds R of R - 1 more, one per step per round, taken renderer after
+renderer once every ladder is built (so that a host busier for a while
+slows one timing of each step rather than every timing of a few). The
 "interp." columns interpolate between the last two steps (error as a power of
 spp, time linear in spp), since doubling alone can overstate the time by up
 to 2x. A ladder stops early when one render takes more than --max-seconds.
@@ -354,7 +357,8 @@ def ladder(name, render, start, target, max_seconds, max_spp, log):
             continue
         e = rel_rmse(img, *log["ref"])
         share = CPU_SHARE[-1] if CPU_SHARE else float("nan")
-        steps.append({"spp": used, "seconds": t, "err": e, "cpu_share": share})
+        steps.append({"spp": used, "seconds": t, "err": e, "cpu_share": share,
+                      "requested": spp, "k": len(steps)})
         print(f"  {name}: {used} spp, {t:.3f} s, rel. RMSE {100 * e:.3f}%, CPU share {100 * share:.0f}%",
               file=sys.stderr, flush=True)
         log["last_img"][name] = img
@@ -396,6 +400,11 @@ def main():
     p.add_argument("--repeat", type=int, default=3,
                    help="time each step this many times (the same seed) and keep the fastest "
                         "(default 3; a shared machine's noise only ever adds time)")
+    p.add_argument("--rounds", type=int, default=1,
+                   help="after every ladder is built, time each of its steps once more this many "
+                        "times minus one, renderer after renderer, and keep the fastest of all "
+                        "(default 1: none; a host that gets busier for a while then slows one "
+                        "timing of each step instead of every timing of a few)")
     p.add_argument("--skip-lobe", action="store_true")
     p.add_argument("--skip-mitsuba", action="store_true", help="only the reference and lobe")
     p.add_argument("--out", default=os.path.join(HERE, "out"), help="images and maps (default bench/out)")
@@ -404,8 +413,9 @@ def main():
                    help="lobe's copy of the map: uncompressed EXR (default; lobe reads it in its timed "
                         "process, Mitsuba its own before the timer) or PIZ as Mitsuba writes it")
     args = p.parse_args()
-    if args.threads < 1 or args.ref_spp < 1 or args.ref_passes < 1 or not 0 < args.target < 1:
-        die("--threads, --ref-spp, --ref-passes must be >= 1 and --target in (0, 1)")
+    if (args.threads < 1 or args.ref_spp < 1 or args.ref_passes < 1 or args.rounds < 1
+            or args.repeat < 1 or not 0 < args.target < 1):
+        die("--threads, --ref-spp, --ref-passes, --rounds, --repeat must be >= 1 and --target in (0, 1)")
     samplers = [] if args.skip_mitsuba else [s.strip() for s in args.samplers.split(",") if s.strip()]
     for s in samplers + [args.ref_sampler]:
         if s not in SAMPLERS:
@@ -453,6 +463,7 @@ def main():
     save_png(os.path.join(args.out, "reference.png"), ref)
     log = {"ref": (ref, mask), "last_img": {}}
     results = {}
+    retimers = {}  # name -> (requested spp, step index) -> (seconds, CPU share), one timing
 
     comps = {"off": [False], "on": [True], "both": [False, True]}[args.mis_compensation]
     for s, comp in [(s, c) for c in comps for s in samplers]:
@@ -477,6 +488,11 @@ def main():
             CPU_SHARE.append(share)
             return img, t, used
 
+        def retime(spp, k, scene=scene):
+            t = mi_render(scene, spp, 2 * k + 2)[1]
+            return t, CPU_SHARE[-1]
+
+        retimers[name] = retime
         results[name] = ladder(name, render, args.start_spp, args.target,
                                args.max_seconds, args.max_spp, log)
 
@@ -490,7 +506,7 @@ def main():
                 + (f" --loop {lp}" if lp else "") + (f" --spp-allocation {al}" if al else ""))
         print(name, file=sys.stderr, flush=True)
 
-        def render_lobe(spp, k, st=st, seq=seq, lp=lp, al=al):
+        def lobe_cmd(spp, k, st=st, seq=seq, lp=lp, al=al):
             tag = ((st + "-" if st != "mis" else "") + (seq + "-" if seq else "") + (lp + "-" if lp else "")
                    + (al + "-" if al else ""))
             out = os.path.join(args.out, f"lobe-{tag}{spp}")
@@ -498,23 +514,38 @@ def main():
                     "--threads", str(args.threads), "--strategy", st, "--out", out, "-q"]
                    + (["--sequence", seq] if seq else []) + (["--loop", lp] if lp else [])
                    + (["--spp-allocation", al] if al else []))
-            t = float("inf")
-            for _ in range(args.repeat):
-                c0 = cpu_time(resource.RUSAGE_CHILDREN)
-                t0 = time.perf_counter()
-                r = subprocess.run(cmd, capture_output=True, text=True)
-                dt = time.perf_counter() - t0
-                if r.returncode != 0:
-                    die(f"{' '.join(cmd)} failed: {r.stderr.strip()}")
-                if dt < t:
-                    t = dt
-                    share = (cpu_time(resource.RUSAGE_CHILDREN) - c0) / (dt * args.threads)
+            return cmd, out
+
+        def lobe_once(cmd):
+            """One timed process: (seconds, CPU share)."""
+            c0 = cpu_time(resource.RUSAGE_CHILDREN)
+            t0 = time.perf_counter()
+            r = subprocess.run(cmd, capture_output=True, text=True)
+            dt = time.perf_counter() - t0
+            if r.returncode != 0:
+                die(f"{' '.join(cmd)} failed: {r.stderr.strip()}")
+            return dt, (cpu_time(resource.RUSAGE_CHILDREN) - c0) / (dt * args.threads)
+
+        def render_lobe(spp, k, lobe_cmd=lobe_cmd):
+            cmd, out = lobe_cmd(spp, k)
+            t, share = min(lobe_once(cmd) for _ in range(args.repeat))
             CPU_SHARE.append(share)
             img = np.array(mi.Bitmap(out + ".exr"), dtype=np.float64)[..., :3]
             return img, t, spp
 
+        retimers[name] = lambda spp, k, lobe_cmd=lobe_cmd: lobe_once(lobe_cmd(spp, k)[0])
         results[name] = ladder(name, render_lobe, args.lobe_start_spp, args.target,
                                args.max_seconds, args.max_spp, log)
+
+    # More rounds: every step of every ladder timed once more per round,
+    # renderer after renderer, the fastest kept.
+    for r in range(1, args.rounds):
+        print(f"round {r + 1} of {args.rounds}", file=sys.stderr, flush=True)
+        for name, steps in results.items():
+            for step in steps:
+                t, share = retimers[name](step["requested"], step["k"])
+                if t < step["seconds"]:
+                    step["seconds"], step["cpu_share"] = t, share
 
     # The table.
     lobe_ver = "?"
