@@ -471,7 +471,12 @@ def main():
         print(name, file=sys.stderr, flush=True)
         scene = build_mitsuba_scene(cam, spheres, maps["mitsuba"], s, args.start_spp, comp)
 
-        def render(spp, k, scene=scene):
+        def retime(spp, k, scene=scene):
+            """One more timed render of step `k`: (seconds, CPU share)."""
+            t = mi_render(scene, spp, 2 * k + 2)[1]
+            return t, CPU_SHARE[-1]
+
+        def render(spp, k, scene=scene, retime=retime):
             # Always a warm-up render first (it compiles the kernels unless
             # Dr.Jit's cache has them), then the timed one: warm, and with
             # the same seed whatever the cache held, so that the error of a
@@ -480,17 +485,9 @@ def main():
             img, t, compiled, used = mi_render(scene, spp, 2 * k + 2)
             if compiled:
                 print(f"  (spp {spp}: the timed render compiled a kernel too)", file=sys.stderr)
-            share = CPU_SHARE[-1]
-            for _ in range(args.repeat - 1):
-                dt = mi_render(scene, spp, 2 * k + 2)[1]
-                if dt < t:
-                    t, share = dt, CPU_SHARE[-1]
+            t, share = min([(t, CPU_SHARE[-1])] + [retime(spp, k) for _ in range(args.repeat - 1)])
             CPU_SHARE.append(share)
             return img, t, used
-
-        def retime(spp, k, scene=scene):
-            t = mi_render(scene, spp, 2 * k + 2)[1]
-            return t, CPU_SHARE[-1]
 
         retimers[name] = retime
         results[name] = ladder(name, render, args.start_spp, args.target,

@@ -109,9 +109,8 @@ fn read_exr_rgb(path: &Path) -> Result<TexelBuffer, String> {
 /// in bands on rayon's threads, each band by a reader of its own, which
 /// also decompresses its blocks (`exr` reads an uncompressed file's blocks
 /// one after the other on one thread, and starts a thread pool of its own
-/// to decompress):
-/// every texel comes from the same bytes of the file whatever the number
-/// of bands.
+/// to decompress). Every texel comes from the same bytes of the file
+/// whatever the number of bands.
 fn read_exr_rgb_lines(path: &Path) -> Result<Option<TexelBuffer>, exr::error::Error> {
     read_exr_rgb_lines_in(path, 2 * rayon::current_num_threads())
 }

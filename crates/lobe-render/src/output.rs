@@ -134,20 +134,18 @@ impl Image {
             return Err(err("the pixel buffer does not match the size".into()));
         }
         let w = self.width;
-        let mut out =
-            std::io::BufWriter::new(create_replacing(path).map_err(|e| err(e.to_string()))?);
-        ExrImage::from_channels(
-            (self.width, self.height),
-            SpecificChannels::rgb(|p: exr::math::Vec2<usize>| {
-                let k = 3 * (p.y() * w + p.x());
-                (rgb[k], rgb[k + 1], rgb[k + 2])
-            }),
-        )
-        .write()
-        .non_parallel()
-        .to_buffered(&mut out)
-        .map_err(|e| err(e.to_string()))?;
-        std::io::Write::flush(&mut out).map_err(|e| err(e.to_string()))
+        write_replacing(path, |out| {
+            ExrImage::from_channels(
+                (self.width, self.height),
+                SpecificChannels::rgb(|p: exr::math::Vec2<usize>| {
+                    let k = 3 * (p.y() * w + p.x());
+                    (rgb[k], rgb[k + 1], rgb[k + 2])
+                }),
+            )
+            .write()
+            .non_parallel()
+            .to_buffered(out)
+        })
     }
 
     /// The samples per pixel of a variance-allocated render
@@ -213,18 +211,31 @@ impl Image {
         if bytes.len() != 3 * self.width * self.height {
             return Err(err(format!("the {what} buffer does not match the size")));
         }
-        let mut out =
-            std::io::BufWriter::new(create_replacing(path).map_err(|e| err(e.to_string()))?);
-        image::codecs::png::PngEncoder::new(&mut out)
-            .write_image(
+        write_replacing(path, |out| {
+            image::codecs::png::PngEncoder::new(out).write_image(
                 &bytes,
                 self.width as u32,
                 self.height as u32,
                 image::ExtendedColorType::Rgb8,
             )
-            .map_err(|e| err(e.to_string()))?;
-        std::io::Write::flush(&mut out).map_err(|e| err(e.to_string()))
+        })
     }
+}
+
+/// Write the file at `path` by `write` into a buffer over
+/// [`create_replacing`]'s file, flushed at the end; any error as an
+/// [`OutputError`] naming the path.
+fn write_replacing<E: std::fmt::Display>(
+    path: &Path,
+    write: impl FnOnce(&mut std::io::BufWriter<std::fs::File>) -> Result<(), E>,
+) -> Result<(), OutputError> {
+    let err = |message: String| OutputError {
+        path: path.to_path_buf(),
+        message,
+    };
+    let mut out = std::io::BufWriter::new(create_replacing(path).map_err(|e| err(e.to_string()))?);
+    write(&mut out).map_err(|e| err(e.to_string()))?;
+    std::io::Write::flush(&mut out).map_err(|e| err(e.to_string()))
 }
 
 /// A new, empty file at `path` to write. A regular file already there, the
