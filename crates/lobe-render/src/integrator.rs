@@ -838,13 +838,24 @@ fn render_on_pool(
     let stats = match opts.strategy {
         Strategy::Mis(mis) if mis.form == MisForm::Adaptive => {
             let allocs = pooled_allocations(&prior.pilots, w, h, mis);
+            // Pixels given to light sampling alone draw from the map's plain
+            // distribution, whose tables wait for their first draw: built
+            // here on the pool's threads instead of by the first of them.
+            if allocs.contains(&Allocation::Light) {
+                scene.environment.prepare_sampling();
+            }
             render_rows(&ctx, &mut img.pixels, count, |x, y| {
                 (count(x, y), FirstBounce::Allocated(allocs[y * w + x]))
             })
         }
-        _ => render_rows(&ctx, &mut img.pixels, count, |x, y| {
-            (count(x, y), FirstBounce::Plain)
-        }),
+        s => {
+            if s == Strategy::Light {
+                scene.environment.prepare_sampling();
+            }
+            render_rows(&ctx, &mut img.pixels, count, |x, y| {
+                (count(x, y), FirstBounce::Plain)
+            })
+        }
     };
     for (i, px) in img.pixels.iter_mut().enumerate() {
         *px *= 1.0 / count(i % w, i / w) as f64;

@@ -315,7 +315,7 @@ impl Step for SampleLookups<'_> {
                     continue;
                 }
                 let j = rj[k] as usize;
-                if let Some((i, r)) = map.sampler(comp).cols.row(j).sample(u.y) {
+                if let Some((i, r)) = map.sampler(comp).columns(&map.texels).row(j).sample(u.y) {
                     (ci[k], rv[k]) = (i as u32, r);
                     prefetch(&map.texels[j * map.width + i]);
                 }
@@ -609,30 +609,120 @@ struct TexelSampler {
 /// buffers (row `j`'s CDF at `cdf[j (width + 1)..]`, its guide table at
 /// `guide[j width..]`): two allocations instead of two per row, which the
 /// threads that build the rows fill in place.
-#[derive(Debug, Clone, PartialEq)]
+///
+/// The rows' totals (the marginal's weights, and so the density) are
+/// computed when the sampler is; the tables, needed only to draw from it,
+/// when they are first asked for ([`TexelSampler::columns`]), or up front
+/// ([`EnvMap::prepare_sampling`]): a renderer that draws only from the
+/// compensated density never builds the plain one's.
+#[derive(Debug, Clone)]
 struct Columns {
     width: usize,
-    cdf: Vec<f64>,
-    guide: Vec<u32>,
-    /// Each row's sum of weights.
+    /// Each row's sum of weights, bit for bit the sum the row's tables are
+    /// normalized by.
     totals: Vec<f64>,
+    tables: std::sync::OnceLock<ColumnTables>,
 }
 
-impl Columns {
+/// Two samplers of the same texels are equal when their weights are: the
+/// tables are a function of them, built or not.
+impl PartialEq for Columns {
+    fn eq(&self, other: &Self) -> bool {
+        self.width == other.width && self.totals == other.totals
+    }
+}
+
+/// The buffers of [`Columns`].
+#[derive(Debug, Clone)]
+struct ColumnTables {
+    cdf: Vec<f64>,
+    guide: Vec<u32>,
+}
+
+/// [`Columns`] with its tables built, borrowed.
+#[derive(Debug, Clone, Copy)]
+struct BuiltColumns<'a> {
+    width: usize,
+    totals: &'a [f64],
+    tables: &'a ColumnTables,
+}
+
+impl<'a> BuiltColumns<'a> {
     /// Row `j`'s distribution.
     #[inline]
-    fn row(&self, j: usize) -> Tables<'_> {
+    fn row(self, j: usize) -> Tables<'a> {
         let w = self.width;
         Tables {
-            cdf: &self.cdf[j * (w + 1)..(j + 1) * (w + 1)],
+            cdf: &self.tables.cdf[j * (w + 1)..(j + 1) * (w + 1)],
             total: self.totals[j],
-            guide: &self.guide[j * w..(j + 1) * w],
+            guide: &self.tables.guide[j * w..(j + 1) * w],
         }
     }
 }
 
 impl TexelSampler {
-    fn new(width: usize, height: usize, shift: Option<f64>, texels: &[Texel]) -> Self {
+    /// The sampler of the texels' weights under `shift`: the rows' totals,
+    /// the marginal and the norm now; with `tables`, the rows' tables too
+    /// (else when first drawn from).
+    fn new(
+        width: usize,
+        height: usize,
+        shift: Option<f64>,
+        texels: &[Texel],
+        tables: bool,
+    ) -> Self {
+        let dphi = 2.0 * PI / width as f64;
+        let (totals, built) = if tables {
+            let (t, c) = Self::build_tables(width, height, shift, texels, true);
+            (t, Some(c))
+        } else {
+            // Each row's sum in the order `Distribution1D::build` sums it:
+            // the same bits as the tables' totals.
+            let row = |j: usize| {
+                let omega = dphi * EnvMap::band(height, j);
+                texels[j * width..(j + 1) * width]
+                    .iter()
+                    .fold(0.0, |acc, t| {
+                        acc + (Self::weight_of(shift, t.lum()) * omega).max(0.0)
+                    })
+            };
+            #[cfg(feature = "parallel")]
+            let totals: Vec<f64> = {
+                use rayon::prelude::*;
+                (0..height).into_par_iter().map(row).collect()
+            };
+            #[cfg(not(feature = "parallel"))]
+            let totals: Vec<f64> = (0..height).map(row).collect();
+            (totals, None)
+        };
+        let rows = Distribution1D::new(&totals);
+        let norm = rows.total();
+        let cell = std::sync::OnceLock::new();
+        if let Some(c) = built {
+            let _ = cell.set(c);
+        }
+        TexelSampler {
+            shift,
+            rows,
+            cols: Columns {
+                width,
+                totals,
+                tables: cell,
+            },
+            norm,
+        }
+    }
+
+    /// The rows' tables and totals, each row's its own computation (the
+    /// same numbers in parallel or not): on rayon's threads when `parallel`
+    /// and the feature allow.
+    fn build_tables(
+        width: usize,
+        height: usize,
+        shift: Option<f64>,
+        texels: &[Texel],
+        parallel: bool,
+    ) -> (Vec<f64>, ColumnTables) {
         let dphi = 2.0 * PI / width as f64;
         let steps = Distribution1D::steps(width);
         // (Zeros from the allocator: pages that the rows' threads touch
@@ -652,36 +742,60 @@ impl TexelSampler {
             }
             Distribution1D::build(texels.iter().map(weight), &steps, c, g)
         };
-        // Each row's distribution is its own computation: the same numbers
-        // in parallel or not.
         #[cfg(feature = "parallel")]
-        let totals: Vec<f64> = {
+        let totals: Vec<f64> = if parallel {
             use rayon::prelude::*;
             cdf.par_chunks_mut(width + 1)
                 .zip(guide.par_chunks_mut(width))
                 .enumerate()
                 .map(row)
                 .collect()
+        } else {
+            cdf.chunks_mut(width + 1)
+                .zip(guide.chunks_mut(width))
+                .enumerate()
+                .map(row)
+                .collect()
         };
         #[cfg(not(feature = "parallel"))]
-        let totals: Vec<f64> = cdf
-            .chunks_mut(width + 1)
-            .zip(guide.chunks_mut(width))
-            .enumerate()
-            .map(row)
-            .collect();
-        let rows = Distribution1D::new(&totals);
-        let norm = rows.total();
-        TexelSampler {
-            shift,
-            rows,
-            cols: Columns {
-                width,
-                cdf,
-                guide,
-                totals,
-            },
-            norm,
+        let totals: Vec<f64> = {
+            let _ = parallel;
+            cdf.chunks_mut(width + 1)
+                .zip(guide.chunks_mut(width))
+                .enumerate()
+                .map(row)
+                .collect()
+        };
+        (totals, ColumnTables { cdf, guide })
+    }
+
+    /// The rows' tables, built on the first call. Built on rayon's threads
+    /// unless the caller is one of them: a thread of the pool that waited
+    /// for the rows' jobs could take another job of its own that asks for
+    /// the same tables, inside their construction.
+    #[inline]
+    fn columns(&self, texels: &[Texel]) -> BuiltColumns<'_> {
+        let tables = self.cols.tables.get_or_init(|| {
+            #[cfg(feature = "parallel")]
+            let parallel = rayon::current_thread_index().is_none();
+            #[cfg(not(feature = "parallel"))]
+            let parallel = false;
+            let height = self.cols.totals.len();
+            let (totals, tables) =
+                Self::build_tables(self.cols.width, height, self.shift, texels, parallel);
+            debug_assert!(
+                totals
+                    .iter()
+                    .zip(&self.cols.totals)
+                    .all(|(a, b)| a.to_bits() == b.to_bits()),
+                "TexelSampler: the tables' totals differ from the rows' sums"
+            );
+            tables
+        });
+        BuiltColumns {
+            width: self.cols.width,
+            totals: &self.cols.totals,
+            tables,
         }
     }
 }
@@ -894,11 +1008,13 @@ impl EnvMap {
         scale: f64,
         rotation_y_deg: f64,
     ) -> Self {
-        let plain = TexelSampler::new(width, height, None, &texels);
+        // The plain density's tables only when something draws from it (light
+        // sampling alone; MIS draws from the compensated one).
+        let plain = TexelSampler::new(width, height, None, &texels, false);
         // Mean luminance over the sphere, then the part above it.
         let mean = plain.norm / (4.0 * PI);
         let compensated = if texels.iter().any(|t| (t.lum() - mean).max(0.0) > 0.0) {
-            TexelSampler::new(width, height, Some(mean), &texels)
+            TexelSampler::new(width, height, Some(mean), &texels, true)
         } else {
             plain.clone()
         };
@@ -1056,6 +1172,15 @@ impl EnvMap {
         self.texel(i, j)
     }
 
+    /// Build the tables that drawing from the map needs now, for both
+    /// densities ([`EnvMap::sample`]'s is otherwise built by the first draw
+    /// from it): on rayon's threads, where a first draw on one of them
+    /// builds them on that thread alone. The same draws either way.
+    pub fn prepare_sampling(&self) {
+        let _ = self.plain.columns(&self.texels);
+        let _ = self.compensated.columns(&self.texels);
+    }
+
     /// Draw a world direction with density ∝ luminance; `None` for a black map.
     #[must_use]
     pub fn sample(&self, u: DVec2) -> Option<(DVec3, f64)> {
@@ -1087,7 +1212,7 @@ impl EnvMap {
 
     fn sample_with(&self, t: &TexelSampler, u: DVec2) -> Option<(DVec3, f64)> {
         let (j, ru) = t.rows.sample(u.x)?;
-        let (i, rv) = t.cols.row(j).sample(u.y)?;
+        let (i, rv) = t.columns(&self.texels).row(j).sample(u.y)?;
         // Uniform in solid angle inside the texel: uniform in cos θ and φ.
         let t0 = PI * j as f64 / self.height as f64;
         let t1 = PI * (j + 1) as f64 / self.height as f64;
@@ -1149,7 +1274,7 @@ impl EnvMap {
     pub fn sample_lookup(&self, compensated: bool, u: DVec2) -> Option<(DVec3, EnvLookup)> {
         let t = self.sampler(compensated);
         let (j, ru) = t.rows.sample(u.x)?;
-        let (i, rv) = t.cols.row(j).sample(u.y)?;
+        let (i, rv) = t.columns(&self.texels).row(j).sample(u.y)?;
         self.finish_sample(compensated, (j, ru), (i, rv))
     }
 
@@ -1343,6 +1468,68 @@ impl EnvMap {
 
 #[cfg(test)]
 mod tests {
+    /// The plain density's tables wait for the first draw: a map fresh from
+    /// `EnvMap::new` has the compensated one's only. Built by draws on
+    /// the threads of a pool (several asking at once, each of them a thread
+    /// that could otherwise take a job of the build), they are the tables
+    /// [`EnvMap::prepare_sampling`] builds on the calling thread, and they
+    /// draw the same directions and densities, bit for bit; their rows'
+    /// totals are the sums the density had before.
+    #[test]
+    fn plain_tables_are_built_on_first_draw() {
+        use rayon::prelude::*;
+        let (w, h) = (64, 32);
+        let rgb: Vec<Rgb> = (0..w * h)
+            .map(|k| {
+                let (i, j) = (k % w, k / w);
+                if j == 3 {
+                    Rgb::ZERO
+                } else if (i, j) == (17, 9) {
+                    Rgb::splat(3e4)
+                } else {
+                    Rgb::new(0.1 + (i as f64 * 0.3).cos().abs(), 0.4, 0.5 + j as f64)
+                }
+            })
+            .collect();
+        let lazy = EnvMap::new(w, h, rgb.clone(), 1.5, 20.0).unwrap().0;
+        let eager = EnvMap::new(w, h, rgb, 1.5, 20.0).unwrap().0;
+        assert!(lazy.plain.cols.tables.get().is_none());
+        assert!(lazy.compensated.cols.tables.get().is_some());
+        eager.prepare_sampling();
+        assert!(eager.plain.cols.tables.get().is_some());
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(3)
+            .build()
+            .unwrap();
+        let us: Vec<DVec2> = (0..4000)
+            .map(|k| DVec2::new((k as f64 * 0.618_034) % 1.0, (k as f64 * 0.754_877) % 1.0))
+            .collect();
+        let drawn: Vec<_> = pool.install(|| {
+            us.par_iter()
+                .with_max_len(1)
+                .map(|&u| (lazy.sample(u), lazy.sample_lookup(false, u)))
+                .collect()
+        });
+        for (&u, (s, l)) in us.iter().zip(&drawn) {
+            assert_eq!(*s, eager.sample(u), "u {u}");
+            assert_eq!(*l, eager.sample_lookup(false, u), "u {u}");
+        }
+        let (a, b) = (
+            lazy.plain.columns(&lazy.texels),
+            eager.plain.columns(&eager.texels),
+        );
+        assert_eq!(a.tables.cdf, b.tables.cdf);
+        assert_eq!(a.tables.guide, b.tables.guide);
+        let (_, built) = TexelSampler::build_tables(w, h, None, &lazy.texels, false);
+        assert_eq!(a.tables.cdf, built.cdf);
+        for j in 0..h {
+            assert_eq!(a.row(j).total.to_bits(), a.totals[j].to_bits());
+        }
+        let (totals, _) = TexelSampler::build_tables(w, h, None, &lazy.texels, true);
+        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&totals), bits(&lazy.plain.cols.totals));
+    }
+
     /// A sampler's rows, built in place in its two shared buffers
     /// ([`Columns`]), are the distributions [`Distribution1D::from_weights`]
     /// builds alone, bit for bit, and sample alike (a sun in a sky, a
@@ -1372,7 +1559,7 @@ mod tests {
                         .iter()
                         .map(|x| TexelSampler::weight_of(t.shift, x.lum()) * omega),
                 );
-                let row = t.cols.row(j);
+                let row = t.columns(&m.texels).row(j);
                 assert_eq!(row.cdf, &alone.cdf[..], "row {j}");
                 assert_eq!(row.guide, &alone.guide[..], "row {j}");
                 assert_eq!(row.total.to_bits(), alone.total().to_bits(), "row {j}");
