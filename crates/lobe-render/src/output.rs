@@ -55,7 +55,12 @@ impl ToneMap {
     /// RGB value: the filmic curve on luminance, the colour scaled along.
     #[must_use]
     pub fn display(&self, rgb: [f64; 3]) -> [f64; 3] {
-        let k = self.exposure.exp2();
+        Self::display_scaled(self.exposure.exp2(), rgb)
+    }
+
+    /// [`ToneMap::display`] with the exposure's factor `k = 2^exposure`.
+    #[inline]
+    fn display_scaled(k: f64, rgb: [f64; 3]) -> [f64; 3] {
         // NaN and negative values as 0; infinity as a radiance far past white.
         let c = rgb.map(|v| {
             if v == f64::INFINITY {
@@ -77,8 +82,67 @@ impl ToneMap {
     /// The 8-bit sRGB values of a linear RGB value.
     #[must_use]
     pub fn srgb8(&self, rgb: [f64; 3]) -> [u8; 3] {
-        self.display(rgb)
-            .map(|v| (srgb_encode(v) * 255.0).round() as u8)
+        self.display(rgb).map(srgb8_of)
+    }
+}
+
+/// The 8-bit code of a display value: `srgb_encode(v) · 255`, rounded.
+#[inline]
+fn srgb8_of(v: f64) -> u8 {
+    (srgb_encode(v) * 255.0).round() as u8
+}
+
+/// The display values where [`srgb8_of`] steps up: `steps[n − 1]` is the
+/// least `f64` whose code is `n` or more. A value's code is then the count
+/// of steps at or below it (eight comparisons instead of a `powf`; the
+/// same byte, the code being non-decreasing in the value).
+struct Srgb8Steps([f64; 255]);
+
+impl Srgb8Steps {
+    /// The table, made on first use (by bisection over the `f64`s around
+    /// each step's value by the inverse transfer function: a few thousand
+    /// calls of [`srgb8_of`]).
+    fn get() -> &'static Self {
+        static STEPS: std::sync::OnceLock<Srgb8Steps> = std::sync::OnceLock::new();
+        STEPS.get_or_init(|| {
+            // The inverse of `srgb_encode`, for a first guess.
+            let decode = |y: f64| {
+                if y <= 0.04045 {
+                    y / 12.92
+                } else {
+                    ((y + 0.055) / 1.055).powf(2.4)
+                }
+            };
+            Srgb8Steps(std::array::from_fn(|k| {
+                let n = k as u8 + 1;
+                let guess = decode((f64::from(n) - 0.5) / 255.0).to_bits();
+                // A bracket `lo < step ≤ hi` in the bits of positive f64s
+                // (ordered as the values), widened until it holds.
+                let mut d = 64u64;
+                let (mut lo, mut hi) = loop {
+                    let (lo, hi) = (guess.saturating_sub(d), guess + d);
+                    if srgb8_of(f64::from_bits(lo)) < n && srgb8_of(f64::from_bits(hi)) >= n {
+                        break (lo, hi);
+                    }
+                    d *= 16;
+                };
+                while hi - lo > 1 {
+                    let mid = lo + (hi - lo) / 2;
+                    if srgb8_of(f64::from_bits(mid)) >= n {
+                        hi = mid;
+                    } else {
+                        lo = mid;
+                    }
+                }
+                f64::from_bits(hi)
+            }))
+        })
+    }
+
+    /// [`srgb8_of`]`(v)` for a display value (in [0, 1], or NaN: 0).
+    #[inline]
+    fn code(&self, v: f64) -> u8 {
+        self.0.partition_point(|&t| t <= v) as u8
     }
 }
 
@@ -100,9 +164,10 @@ impl Image {
     #[must_use]
     pub fn to_srgb8(&self, tone: &ToneMap) -> Vec<u8> {
         use rayon::prelude::*;
+        let (k, steps) = (tone.exposure.exp2(), Srgb8Steps::get());
         self.pixels
             .par_iter()
-            .map(|p| tone.srgb8(p.to_array()))
+            .map(|p| ToneMap::display_scaled(k, p.to_array()).map(|v| steps.code(v)))
             .collect::<Vec<[u8; 3]>>()
             .into_flattened()
     }
@@ -119,10 +184,11 @@ impl Image {
             .collect()
     }
 
-    /// Write the linear image as OpenEXR (RGB, 32-bit float, `exr`'s
-    /// default encoding), on the calling thread: a small image's blocks
-    /// compressed in parallel cost more (a thread pool started per file)
-    /// than they save, and the file's bytes stay the same from run to run.
+    /// Write the linear image as OpenEXR (RGB, 32-bit float, scan lines
+    /// without compression: a render's noisy floats hardly compress, by
+    /// `exr`'s run-length default 5%, which took half again as long to
+    /// write), on the calling thread (a thread pool per file would cost
+    /// more than it saves).
     pub fn write_exr(&self, path: &Path) -> Result<(), OutputError> {
         use exr::prelude::{Image as ExrImage, SpecificChannels, WritableImage};
         let err = |message: String| OutputError {
@@ -135,8 +201,9 @@ impl Image {
         }
         let w = self.width;
         write_replacing(path, |out| {
-            ExrImage::from_channels(
+            ExrImage::from_encoded_channels(
                 (self.width, self.height),
+                exr::prelude::Encoding::UNCOMPRESSED,
                 SpecificChannels::rgb(|p: exr::math::Vec2<usize>| {
                     let k = 3 * (p.y() * w + p.x());
                     (rgb[k], rgb[k + 1], rgb[k + 2])
@@ -166,23 +233,30 @@ impl Image {
             [0.98, 0.53, 0.38],
             [0.99, 0.99, 0.75],
         ];
-        Some(
-            counts
-                .iter()
-                .flat_map(|&n| {
-                    let t = if hi > lo {
-                        ((n as f64).max(1.0).ln() - lo) / (hi - lo)
-                    } else {
-                        1.0
-                    };
-                    let x = t.clamp(0.0, 1.0) * (STOPS.len() - 1) as f64;
-                    let k = (x as usize).min(STOPS.len() - 2);
-                    let f = x - k as f64;
-                    let (a, b) = (STOPS[k], STOPS[k + 1]);
-                    [0, 1, 2].map(|c| ((a[c] + (b[c] - a[c]) * f) * 255.0).round() as u8)
-                })
-                .collect(),
-        )
+        let colour = |n: u64| {
+            let t = if hi > lo {
+                ((n as f64).max(1.0).ln() - lo) / (hi - lo)
+            } else {
+                1.0
+            };
+            let x = t.clamp(0.0, 1.0) * (STOPS.len() - 1) as f64;
+            let k = (x as usize).min(STOPS.len() - 2);
+            let f = x - k as f64;
+            let (a, b) = (STOPS[k], STOPS[k + 1]);
+            [0, 1, 2].map(|c| ((a[c] + (b[c] - a[c]) * f) * 255.0).round() as u8)
+        };
+        // (Neighbours mostly share a count: its colour is kept.)
+        let mut bytes = Vec::with_capacity(3 * counts.len());
+        let mut last = None;
+        for &n in counts {
+            let c = match last {
+                Some((m, c)) if m == n => c,
+                _ => colour(n),
+            };
+            last = Some((n, c));
+            bytes.extend_from_slice(&c);
+        }
+        Some(bytes)
     }
 
     /// Write [`Image::spp_srgb8`] as a PNG; `Ok(false)` (nothing written)
@@ -344,6 +418,37 @@ mod tests {
             assert!(v >= last - 1e-12, "{i}: {v} < {last}");
             last = v;
         }
+    }
+
+    /// The table of steps gives the code the transfer function gives: at
+    /// and around every step (a thousand `f64`s either side), and at a
+    /// million values spread over [0, 1] (and 0, 1, NaN).
+    #[test]
+    fn srgb8_steps_give_the_transfer_functions_codes() {
+        let steps = Srgb8Steps::get();
+        let check = |v: f64| assert_eq!(steps.code(v), srgb8_of(v), "{v:e}");
+        for &t in &steps.0 {
+            let b = t.to_bits();
+            for d in 0..=1000 {
+                check(f64::from_bits(b - d));
+                check(f64::from_bits(b + d));
+            }
+        }
+        let mut x = 0x9e37_79b9_7f4a_7c15_u64;
+        for i in 0..1_000_000u32 {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            let v = (x >> 11) as f64 / (1u64 << 53) as f64;
+            // (Half of them squared: more of the small values.)
+            check(if i % 2 == 0 { v } else { v * v });
+        }
+        for v in [0.0, -0.0, 1.0, f64::NAN, 0.003_130_8] {
+            check(v);
+        }
+        // Every code is some value's: the steps rise.
+        assert!(steps.0.windows(2).all(|w| w[0] < w[1]));
+        assert_eq!(srgb8_of(steps.0[254]), 255);
     }
 
     #[test]
