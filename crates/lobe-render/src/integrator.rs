@@ -663,8 +663,9 @@ impl Moments {
 /// What pass 0's pilot decided, for every pass.
 #[derive(Debug, Clone, Default)]
 struct Prior {
-    /// Adaptive MIS: per pixel its pilot (empty otherwise).
-    pilots: Vec<Pilot>,
+    /// Adaptive MIS: per pixel the allocation its pooled pilots chose
+    /// ([`pooled_allocations`]; empty otherwise).
+    allocs: Vec<Allocation>,
     /// The variance allocation: per pixel its samples per pass.
     counts: Option<Vec<u64>>,
 }
@@ -734,14 +735,20 @@ fn pilot_phase(scene: &Scene, opts: &RenderOptions) -> (Prior, RenderStats) {
             stats
         })
         .reduce(RenderStats::default, add_stats);
-    let counts = (opts.spp_allocation == SppAllocation::Variance).then(|| {
-        let var: Vec<f64> = moments.iter().map(Moments::variance).collect();
-        spp_counts(&var, w, h, opts.spp.max(1))
-    });
-    if !adaptive {
-        pilots = Vec::new();
-    }
-    (Prior { pilots, counts }, stats)
+    // The two decisions are independent: made side by side.
+    let (counts, allocs) = rayon::join(
+        || {
+            (opts.spp_allocation == SppAllocation::Variance).then(|| {
+                let var: Vec<f64> = moments.iter().map(Moments::variance).collect();
+                spp_counts(&var, w, h, opts.spp.max(1))
+            })
+        },
+        || match opts.strategy {
+            Strategy::Mis(mis) if adaptive => pooled_allocations(&pilots, w, h, mis),
+            _ => Vec::new(),
+        },
+    );
+    (Prior { allocs, counts }, stats)
 }
 
 /// Every pixel's allocation (row by row): from the pilots of the pixels
@@ -837,7 +844,7 @@ fn render_on_pool(
     let count = |x: usize, y: usize| prior.counts.as_ref().map_or(spp, |c| c[y * w + x]);
     let stats = match opts.strategy {
         Strategy::Mis(mis) if mis.form == MisForm::Adaptive => {
-            let allocs = pooled_allocations(&prior.pilots, w, h, mis);
+            let allocs = &prior.allocs;
             // Pixels given to light sampling alone draw from the map's plain
             // distribution, whose tables wait for their first draw: built
             // here on the pool's threads instead of by the first of them.
