@@ -1468,6 +1468,23 @@ impl EnvMap {
 
 #[cfg(test)]
 mod tests {
+    /// `w × h` texels (at least 41 × 10) with a black row (5), a sun (one
+    /// texel, (40, 9)) and a sky that varies along both axes.
+    fn black_row_and_sun(w: usize, h: usize) -> Vec<Rgb> {
+        (0..w * h)
+            .map(|k| {
+                let (i, j) = (k % w, k / w);
+                if j == 5 {
+                    Rgb::ZERO
+                } else if (i, j) == (40, 9) {
+                    Rgb::splat(5e4)
+                } else {
+                    Rgb::new(0.2 + (i as f64 * 0.37).sin().abs(), 0.5, 1.0 + j as f64)
+                }
+            })
+            .collect()
+    }
+
     /// The plain density's tables wait for the first draw: a map fresh from
     /// `EnvMap::new` has the compensated one's only. Built by draws on
     /// the threads of a pool (several asking at once, each of them a thread
@@ -1478,19 +1495,8 @@ mod tests {
     #[test]
     fn plain_tables_are_built_on_first_draw() {
         use rayon::prelude::*;
-        let (w, h) = (64, 32);
-        let rgb: Vec<Rgb> = (0..w * h)
-            .map(|k| {
-                let (i, j) = (k % w, k / w);
-                if j == 3 {
-                    Rgb::ZERO
-                } else if (i, j) == (17, 9) {
-                    Rgb::splat(3e4)
-                } else {
-                    Rgb::new(0.1 + (i as f64 * 0.3).cos().abs(), 0.4, 0.5 + j as f64)
-                }
-            })
-            .collect();
+        let (w, h) = (64, 16);
+        let rgb = black_row_and_sun(w, h);
         let lazy = EnvMap::new(w, h, rgb.clone(), 1.5, 20.0).unwrap().0;
         let eager = EnvMap::new(w, h, rgb, 1.5, 20.0).unwrap().0;
         assert!(lazy.plain.cols.tables.get().is_none());
@@ -1537,19 +1543,9 @@ mod tests {
     #[test]
     fn columns_are_the_rows_distributions() {
         let (w, h) = (64usize, 16usize);
-        let rgb: Vec<Rgb> = (0..w * h)
-            .map(|k| {
-                let (i, j) = (k % w, k / w);
-                if j == 5 {
-                    Rgb::ZERO
-                } else if (i, j) == (40, 9) {
-                    Rgb::splat(5e4)
-                } else {
-                    Rgb::new(0.2 + (i as f64 * 0.37).sin().abs(), 0.5, 1.0 + j as f64)
-                }
-            })
-            .collect();
-        let m = EnvMap::new(w, h, rgb, 1.0, 0.0).unwrap().0;
+        let m = EnvMap::new(w, h, black_row_and_sun(w, h), 1.0, 0.0)
+            .unwrap()
+            .0;
         for t in [&m.plain, &m.compensated] {
             let dphi = 2.0 * PI / w as f64;
             for j in 0..h {
