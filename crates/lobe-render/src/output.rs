@@ -82,7 +82,15 @@ impl ToneMap {
     /// The 8-bit sRGB values of a linear RGB value.
     #[must_use]
     pub fn srgb8(&self, rgb: [f64; 3]) -> [u8; 3] {
-        self.display(rgb).map(srgb8_of)
+        Self::srgb8_scaled(self.exposure.exp2(), rgb)
+    }
+
+    /// [`ToneMap::srgb8`] with the exposure's factor `k = 2^exposure`: the
+    /// display values' codes ([`srgb8_of`]) by [`Srgb8Steps`].
+    #[inline]
+    fn srgb8_scaled(k: f64, rgb: [f64; 3]) -> [u8; 3] {
+        let steps = Srgb8Steps::get();
+        Self::display_scaled(k, rgb).map(|v| steps.code(v))
     }
 }
 
@@ -164,10 +172,10 @@ impl Image {
     #[must_use]
     pub fn to_srgb8(&self, tone: &ToneMap) -> Vec<u8> {
         use rayon::prelude::*;
-        let (k, steps) = (tone.exposure.exp2(), Srgb8Steps::get());
+        let k = tone.exposure.exp2();
         self.pixels
             .par_iter()
-            .map(|p| ToneMap::display_scaled(k, p.to_array()).map(|v| steps.code(v)))
+            .map(|p| ToneMap::srgb8_scaled(k, p.to_array()))
             .collect::<Vec<[u8; 3]>>()
             .into_flattened()
     }

@@ -671,7 +671,6 @@ impl TexelSampler {
         texels: &[Texel],
         tables: bool,
     ) -> Self {
-        let dphi = 2.0 * PI / width as f64;
         let (totals, built) = if tables {
             let (t, c) = Self::build_tables(width, height, shift, texels, true);
             (t, Some(c))
@@ -679,12 +678,8 @@ impl TexelSampler {
             // Each row's sum in the order `Distribution1D::build` sums it:
             // the same bits as the tables' totals.
             let row = |j: usize| {
-                let omega = dphi * EnvMap::band(height, j);
-                texels[j * width..(j + 1) * width]
-                    .iter()
-                    .fold(0.0, |acc, t| {
-                        acc + (Self::weight_of(shift, t.lum()) * omega).max(0.0)
-                    })
+                Self::row_weights(width, height, shift, texels, j)
+                    .fold(0.0, |acc, w| acc + w.max(0.0))
             };
             #[cfg(feature = "parallel")]
             let totals: Vec<f64> = {
@@ -697,20 +692,31 @@ impl TexelSampler {
         };
         let rows = Distribution1D::new(&totals);
         let norm = rows.total();
-        let cell = std::sync::OnceLock::new();
-        if let Some(c) = built {
-            let _ = cell.set(c);
-        }
         TexelSampler {
             shift,
             rows,
             cols: Columns {
                 width,
                 totals,
-                tables: cell,
+                tables: built.map_or_else(std::sync::OnceLock::new, std::sync::OnceLock::from),
             },
             norm,
         }
+    }
+
+    /// Row `j`'s weights: each texel's weight under `shift` times its solid
+    /// angle (the same for the row's texels).
+    fn row_weights(
+        width: usize,
+        height: usize,
+        shift: Option<f64>,
+        texels: &[Texel],
+        j: usize,
+    ) -> impl ExactSizeIterator<Item = f64> + Clone + '_ {
+        let omega = 2.0 * PI / width as f64 * EnvMap::band(height, j);
+        texels[j * width..(j + 1) * width]
+            .iter()
+            .map(move |t| Self::weight_of(shift, t.lum()) * omega)
     }
 
     /// The rows' tables and totals, each row's its own computation (the
@@ -723,49 +729,41 @@ impl TexelSampler {
         texels: &[Texel],
         parallel: bool,
     ) -> (Vec<f64>, ColumnTables) {
-        let dphi = 2.0 * PI / width as f64;
         let steps = Distribution1D::steps(width);
         // (Zeros from the allocator: pages that the rows' threads touch
         // first.)
         let mut cdf = vec![0.0; height * (width + 1)];
         let mut guide = vec![0u32; height * width];
         let row = |(j, (c, g)): (usize, (&mut [f64], &mut [u32]))| {
-            let omega = dphi * EnvMap::band(height, j);
-            let texels = &texels[j * width..(j + 1) * width];
-            let weight = |t: &Texel| Self::weight_of(shift, t.lum()) * omega;
+            let weights = Self::row_weights(width, height, shift, texels, j);
             // A row of weight 0 (most of a compensated sampler's rows
             // under a sky with a sun) leaves its tables as allocated, the
             // zeros `Distribution1D::build` would leave too: pages of them
             // that are never touched cost neither a fault nor a clearing.
-            if !texels.iter().any(|t| weight(t) > 0.0) {
+            if !weights.clone().any(|w| w > 0.0) {
                 return 0.0;
             }
-            Distribution1D::build(texels.iter().map(weight), &steps, c, g)
+            Distribution1D::build(weights, &steps, c, g)
         };
         #[cfg(feature = "parallel")]
-        let totals: Vec<f64> = if parallel {
+        if parallel {
             use rayon::prelude::*;
-            cdf.par_chunks_mut(width + 1)
+            let totals = cdf
+                .par_chunks_mut(width + 1)
                 .zip(guide.par_chunks_mut(width))
                 .enumerate()
                 .map(row)
-                .collect()
-        } else {
-            cdf.chunks_mut(width + 1)
-                .zip(guide.chunks_mut(width))
-                .enumerate()
-                .map(row)
-                .collect()
-        };
+                .collect();
+            return (totals, ColumnTables { cdf, guide });
+        }
         #[cfg(not(feature = "parallel"))]
-        let totals: Vec<f64> = {
-            let _ = parallel;
-            cdf.chunks_mut(width + 1)
-                .zip(guide.chunks_mut(width))
-                .enumerate()
-                .map(row)
-                .collect()
-        };
+        let _ = parallel;
+        let totals = cdf
+            .chunks_mut(width + 1)
+            .zip(guide.chunks_mut(width))
+            .enumerate()
+            .map(row)
+            .collect();
         (totals, ColumnTables { cdf, guide })
     }
 
