@@ -14,7 +14,7 @@
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use glam::{DVec2, DVec3};
-use lobe::{BsdfStrategy, Material, Rgb};
+use lobe::{BsdfSampler, Rgb};
 use rand::RngExt;
 use std::f64::consts::PI;
 use std::hint::black_box;
@@ -59,14 +59,15 @@ fn inputs() -> Vec<Input> {
 /// and `pdf` that `sample` computed internally: a renderer calls `eval` and
 /// `pdf` from elsewhere (light sampling, MIS), not on the same values inline.
 #[inline(never)]
-fn sample_eval_pdf(m: &Material, strategy: BsdfStrategy, inputs: &[Input]) -> (Rgb, Rgb, f64) {
+fn sample_eval_pdf(sampler: &BsdfSampler<'_>, inputs: &[Input]) -> (Rgb, Rgb, f64) {
+    let m = sampler.material();
     let (mut weights, mut fs, mut pdfs) = (Rgb::ZERO, Rgb::ZERO, 0.0);
     for x in inputs {
-        if let Some(s) = m.sample(strategy, x.wo, x.uc, x.u) {
+        if let Some(s) = sampler.sample(x.wo, x.uc, x.u) {
             weights += s.weight;
             let wi = black_box(s.wi);
             fs += m.eval(x.wo, wi);
-            pdfs += m.pdf(strategy, x.wo, wi);
+            pdfs += sampler.pdf(x.wo, wi);
         }
     }
     (weights, fs, pdfs)
@@ -74,10 +75,10 @@ fn sample_eval_pdf(m: &Material, strategy: BsdfStrategy, inputs: &[Input]) -> (R
 
 /// `sample` alone (its result already carries `f` and `pdf`).
 #[inline(never)]
-fn sample_only(m: &Material, strategy: BsdfStrategy, inputs: &[Input]) -> Rgb {
+fn sample_only(sampler: &BsdfSampler<'_>, inputs: &[Input]) -> Rgb {
     let mut weights = Rgb::ZERO;
     for x in inputs {
-        if let Some(s) = m.sample(strategy, x.wo, x.uc, x.u) {
+        if let Some(s) = sampler.sample(x.wo, x.uc, x.u) {
             weights += s.weight;
         }
     }
@@ -97,13 +98,18 @@ fn throughput(c: &mut Criterion) {
                 if !reported {
                     let ok = inputs
                         .iter()
-                        .filter(|x| m.sample(strategy, x.wo, x.uc, x.u).is_some())
+                        .filter(|x| {
+                            m.sampler(strategy)
+                                .is_ok_and(|s| s.sample(x.wo, x.uc, x.u).is_some())
+                        })
                         .count();
                     eprintln!("throughput/{name}/{strategy}: {ok} of {BATCH} samples valid");
                     reported = true;
                 }
                 // The material and strategy are runtime values, as in a renderer.
-                b.iter(|| sample_eval_pdf(black_box(&m), black_box(strategy), black_box(&inputs)));
+                // Resolved once per benchmark, as a renderer resolves it once per material.
+                let sampler = m.sampler(strategy).expect("one of the material's strategies");
+                b.iter(|| sample_eval_pdf(black_box(&sampler), black_box(&inputs)));
             });
         }
         group.finish();
@@ -121,7 +127,8 @@ fn throughput(c: &mut Criterion) {
     group.throughput(Throughput::Elements(BATCH as u64));
     for strategy in m.strategies() {
         group.bench_function(BenchmarkId::from_parameter(strategy), |b| {
-            b.iter(|| sample_only(black_box(&m), black_box(strategy), black_box(&inputs)));
+            let sampler = m.sampler(strategy).expect("one of the material's strategies");
+            b.iter(|| sample_only(black_box(&sampler), black_box(&inputs)));
         });
     }
     group.finish();

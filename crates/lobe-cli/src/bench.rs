@@ -160,6 +160,9 @@ fn work(
     } = job;
     let mut total = 0.0f64;
     if mode == Mode::Scalar {
+        let sampler = m
+            .sampler(strategy)
+            .expect("the strategy was checked when the job was made");
         for i in range {
             let wo = DVec3::new(
                 inputs.wo[0][i].into(),
@@ -167,9 +170,9 @@ fn work(
                 inputs.wo[2][i].into(),
             );
             let u = DVec2::new(inputs.u1[i].into(), inputs.u2[i].into());
-            if let Some(s) = m.sample(strategy, wo, inputs.uc[i].into(), u) {
+            if let Some(s) = sampler.sample(wo, inputs.uc[i].into(), u) {
                 let wi = black_box(s.wi);
-                total += s.weight.x + m.eval(wo, wi).x + m.pdf(strategy, wo, wi);
+                total += s.weight.x + m.eval(wo, wi).x + sampler.pdf(wo, wi);
             }
         }
         return total;

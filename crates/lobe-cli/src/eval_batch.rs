@@ -8,7 +8,7 @@
 //! printed are the f32 results, in the shortest form that parses back to
 //! the same f32.
 
-use crate::eval::{Failure, Request, parse_line, unit_interval_f32};
+use crate::eval_line::{Failure, Request, parse_line, unit_interval_f32};
 use lobe::batch::{BatchSampler, Dirs, DirsMut, EvalPdfOutput, RgbMut, SampleInput, SampleOutput};
 use lobe::{BsdfStrategy, Material};
 use serde::Serialize;
@@ -70,7 +70,7 @@ impl Columns {
 }
 
 /// A direction as the line gave it (checked to be unit within
-/// [`crate::eval::UNIT_TOLERANCE`]), rounded to f32.
+/// [`crate::eval_line::UNIT_TOLERANCE`]), rounded to f32.
 fn push3(cols: &mut [Vec<f32>; 3], v: [f64; 3]) {
     cols[0].push(v[0] as f32);
     cols[1].push(v[1] as f32);

@@ -15,7 +15,7 @@ use anyhow::{Result, anyhow, bail};
 use glam::{DVec2, DVec3};
 use lobe::experiment::histogram::{WeightPixel, weight_pixels};
 use lobe::experiment::polar::{CurveKind, PolarCurves};
-use lobe::{BsdfStrategy, Material};
+use lobe::BsdfSampler;
 use plotters::coord::Shift;
 use plotters::coord::ranged1d::{DefaultFormatting, KeyPointHint, Ranged};
 use plotters::prelude::*;
@@ -195,15 +195,14 @@ pub fn warp_histogram(
 pub fn weight_heatmap(
     path: &Path,
     title: &str,
-    material: &Material,
-    strategy: BsdfStrategy,
+    sampler: &BsdfSampler<'_>,
     wo: DVec3,
     res: usize,
 ) -> Result<()> {
     if res == 0 {
         bail!("weight_heatmap: res must be at least 1");
     }
-    let pixels = weight_pixels(material, strategy, wo, res);
+    let pixels = weight_pixels(sampler, wo, res);
     save_figure(
         path,
         &WeightMap {
@@ -1605,6 +1604,7 @@ impl Figure for WeightMap<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use lobe::{BsdfStrategy, Material};
 
     #[test]
     fn numbers_read_well() {
@@ -1676,8 +1676,7 @@ mod tests {
         let m = Material::lambert(lobe::Rgb::splat(0.8)).unwrap();
         let wo = DVec3::new(0.5, 0.0, 0.75f64.sqrt());
         let h = lobe::experiment::histogram::projected_histograms(
-            &m,
-            BsdfStrategy::Cosine,
+            &m.sampler(BsdfStrategy::Cosine).unwrap(),
             wo,
             10_000,
             3,
@@ -1730,7 +1729,7 @@ mod tests {
             polar_plot(&p("polar"), "polar", &polar, PolarScale::Linear).unwrap();
             polar_plot(&p("polar-log"), "polar, log", &polar, PolarScale::Log).unwrap();
             warp_histogram(&p("histogram"), "cosine", &o, &e, 16, 0.5).unwrap();
-            weight_heatmap(&p("weights"), "weights", &m, BsdfStrategy::Uniform, wo, 16).unwrap();
+            weight_heatmap(&p("weights"), "weights", &m.sampler(BsdfStrategy::Uniform).unwrap(), wo, 16).unwrap();
             for name in [
                 "convergence",
                 "convergence-empty",

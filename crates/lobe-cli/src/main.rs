@@ -12,6 +12,7 @@ mod converge;
 mod demo;
 mod estimate;
 mod eval;
+mod eval_line;
 mod eval_batch;
 mod figures;
 mod fit;

@@ -13,17 +13,15 @@
 //! The figures themselves are drawn by [`crate::figures`].
 
 use crate::common::load_material;
-use crate::common::{Bar, ViewArgs, progress};
+use crate::common::{Bar, ViewArgs};
 use crate::figures;
 use anyhow::{Context, Result, anyhow, bail};
 use clap::Args;
 use glam::DVec3;
-use lobe::experiment::histogram::projected_histograms;
-use lobe::stats::chi2::{Chi2Config, chi2_test};
+use lobe::experiment::warp_test::{WarpTest, chi2_config, warp_test};
+use lobe::stats::chi2::Chi2Config;
 use lobe::{BsdfStrategy, Material};
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
-use std::time::Duration;
 
 /// Largest accepted `--res`.
 const MAX_RES: usize = 1024;
@@ -202,7 +200,7 @@ pub fn run(args: &PlotArgs) -> Result<()> {
                 let s = strategy.expect("checked above");
                 let path = args.out.join(format!("weights-{s}.png"));
                 let title = format!("{label}, {s}, {view}: sample weight f·cos θi / pdf");
-                figures::weight_heatmap(&path, &title, &material, s, wo, args.res)?;
+                figures::weight_heatmap(&path, &title, &material.sampler(s)?, wo, args.res)?;
                 println!("{}", path.display());
             }
         }
@@ -282,37 +280,19 @@ fn histogram(
     title: &str,
     path: &Path,
 ) -> Result<()> {
-    let bar = Bar::new(args.quiet);
-    let h = projected_histograms(m, s, wo, args.samples, args.seed, args.res, &bar);
-    bar.finish();
-
-    let cfg = Chi2Config {
+    let sampler = m.sampler(s)?;
+    let config = Chi2Config {
         samples: args.samples,
         seed: args.seed,
-        ..Chi2Config::for_material(m)
+        ..chi2_config(m)
     };
-    let pb = progress(args.samples as u64, "chi-square test", args.quiet);
-    let drawn = AtomicU64::new(0);
-    let integrating = AtomicBool::new(false);
-    let result = chi2_test(
-        &cfg,
-        |uc, u| {
-            if drawn.fetch_add(1, Ordering::Relaxed) % 65_536 == 65_535 {
-                pb.inc(65_536);
-            }
-            m.sample(s, wo, uc, u).map(|x| x.wi)
-        },
-        |wi| {
-            // The first pdf call starts the cubature of the expected counts.
-            if !integrating.load(Ordering::Relaxed) && !integrating.swap(true, Ordering::Relaxed) {
-                pb.set_position(args.samples as u64);
-                pb.set_message("chi-square: expected");
-                pb.enable_steady_tick(Duration::from_millis(200));
-            }
-            m.pdf(s, wo, wi)
-        },
-    );
-    pb.finish_and_clear();
+    let bar = Bar::new(args.quiet);
+    let WarpTest {
+        histograms: h,
+        chi2: result,
+        config: cfg,
+    } = warp_test(&sampler, wo, config, args.res, &bar);
+    bar.finish();
     let verdict = if result.p_value > figures::PASS_LEVEL {
         "pass"
     } else {

@@ -23,13 +23,14 @@ use clap::Args;
 use glam::DVec3;
 use lobe::estimator::Strategy;
 use lobe::experiment::converge::{Curve, CurveSettings, curves};
-use lobe::experiment::histogram::{lost_fraction, projected_histograms};
+use lobe::experiment::histogram::lost_fraction;
 use lobe::experiment::polar;
 use lobe::experiment::table::{Row, Table, TableSettings, run_table};
 use lobe::math::luminance;
 use lobe::progress::SystemClock;
 use lobe::sequence::{Sequence, hash64};
-use lobe::stats::chi2::{Chi2Config, chi2_test};
+use lobe::experiment::warp_test::{WarpTest, chi2_config, warp_test};
+use lobe::stats::chi2::Chi2Config;
 use lobe::{BsdfStrategy, Light, Material, MaterialDesc, Rgb};
 use rayon::prelude::*;
 use std::fmt::Write as _;
@@ -619,14 +620,13 @@ fn run_job(
                 n_phi: st.chi2_nphi,
                 samples: st.warp_samples,
                 seed: wseed,
-                ..Chi2Config::for_material(m)
+                ..chi2_config(m)
             };
-            let chi2 = chi2_test(
-                &cfg,
-                |uc, u| m.sample(s, wo, uc, u).map(|x| x.wi),
-                |w| m.pdf(s, wo, w),
-            );
-            let h = projected_histograms(m, s, wo, st.warp_samples, wseed, st.warp_res, &());
+            let WarpTest {
+                histograms: h,
+                chi2,
+                ..
+            } = warp_test(&m.sampler(s)?, wo, cfg, st.warp_res, &());
             let file = format!("{}-warp-{}.png", model.id, s.name());
             let title = format!(
                 "{}, θo = {}°: {} sampler",
@@ -661,7 +661,7 @@ fn run_job(
             let m = &materials[i][k];
             let file = format!("{}-weights-{}.png", model.id, s.name());
             let title = format!("{}: weights of {}", caption(model), s.name());
-            figures::weight_heatmap(&dir.join(&file), &title, m, s, wo, st.heat_res)
+            figures::weight_heatmap(&dir.join(&file), &title, &m.sampler(s)?, wo, st.heat_res)
                 .with_context(|| format!("cannot write {file}"))?;
             Ok(Done::Heat(
                 s,

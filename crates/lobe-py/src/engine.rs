@@ -17,7 +17,7 @@ use glam::{DVec2, DVec3};
 use lobe::batch::{
     BatchSampler, Dirs, DirsMut, EvalPdfOutput, RgbMut, SampleInput, SampleOutput, Store,
 };
-use lobe::{BsdfStrategy, Material};
+use lobe::{BsdfSampler, BsdfStrategy, Material};
 use ndarray::{ArrayView1, ArrayView2, Axis};
 use rayon::prelude::*;
 
@@ -420,7 +420,8 @@ fn check_uniform<'a, T: Real>(
 #[derive(Debug, Clone, Copy)]
 pub struct Engine<'m> {
     pub material: &'m Material,
-    pub strategy: BsdfStrategy,
+    /// The strategy, resolved for the material (the scalar f64 path).
+    pub sampler: BsdfSampler<'m>,
     /// The batch kernels, where they cover the material and strategy.
     pub batch: Option<BatchSampler>,
 }
@@ -433,7 +434,7 @@ impl<'m> Engine<'m> {
         strategy: BsdfStrategy,
         reference: bool,
     ) -> Result<Self, lobe::Error> {
-        material.check(strategy)?;
+        let sampler = material.sampler(strategy)?;
         let batch = if reference {
             None
         } else {
@@ -441,7 +442,7 @@ impl<'m> Engine<'m> {
         };
         Ok(Engine {
             material,
-            strategy,
+            sampler,
             batch,
         })
     }
@@ -456,18 +457,21 @@ impl<'m> Engine<'m> {
         let strategies = material.strategies();
         if !reference {
             for &s in &strategies {
-                if let Ok(b) = BatchSampler::new(material, s) {
+                if let (Ok(b), Ok(sampler)) = (BatchSampler::new(material, s), material.sampler(s)) {
                     return Engine {
                         material,
-                        strategy: s,
+                        sampler,
                         batch: Some(b),
                     };
                 }
             }
         }
+        let first = strategies.first().copied().unwrap_or(BsdfStrategy::Uniform);
         Engine {
             material,
-            strategy: strategies.first().copied().unwrap_or(BsdfStrategy::Uniform),
+            sampler: material
+                .sampler(first)
+                .expect("a strategy of the material's own list applies to it"),
             batch: None,
         }
     }
@@ -845,8 +849,7 @@ pub fn sample_scalar_into<T: Real>(
 ) -> Result<(), BadInput> {
     let n = wo.rows();
     debug_assert!(u.rows() == n && uc.is_none_or(|c| c.len() == n) && out.n == n);
-    let m = e.material;
-    let strategy = e.strategy;
+    let sampler = e.sampler;
     let results: Vec<Result<(), BadInput>> = sample_blocks(out)
         .into_par_iter()
         .map_init(
@@ -873,20 +876,15 @@ pub fn sample_scalar_into<T: Real>(
                 for i in 0..pdf.len() {
                     let wo = unit(DVec3::new(x[i], y[i], z[i]));
                     let ucv = ucs.as_ref().map_or(0.5, |c| c[i]);
-                    let s = m.sample(strategy, wo, ucv, DVec2::new(u1[i], u2[i]));
-                    let z = lobe::BsdfSample {
-                        wi: DVec3::ZERO,
-                        f: lobe::Rgb::ZERO,
-                        pdf: 0.0,
-                        weight: lobe::Rgb::ZERO,
-                        component: lobe::Component::Hemisphere,
-                    };
-                    let v = s.unwrap_or(z);
+                    let s = sampler.sample(wo, ucv, DVec2::new(u1[i], u2[i]));
+                    // A failed sample: zeros.
+                    let (v_wi, v_weight, v_pdf) =
+                        s.map_or((DVec3::ZERO, lobe::Rgb::ZERO, 0.0), |v| (v.wi, v.weight, v.pdf));
                     for c in 0..3 {
-                        wi[c][i] = T::from_f64(v.wi[c]);
-                        w[c][i] = T::from_f64(v.weight[c]);
+                        wi[c][i] = T::from_f64(v_wi[c]);
+                        w[c][i] = T::from_f64(v_weight[c]);
                     }
-                    pdf[i] = T::from_f64(v.pdf);
+                    pdf[i] = T::from_f64(v_pdf);
                     valid[i] = u8::from(s.is_some());
                 }
                 Ok(())
@@ -1092,7 +1090,7 @@ pub fn eval_pdf_scalar_into<T: Real>(
         _ => Want::Both,
     };
     let m = e.material;
-    let strategy = e.strategy;
+    let sampler = e.sampler;
     let results: Vec<Result<(), BadInput>> = eval_blocks(out)
         .into_par_iter()
         .map_init(
@@ -1121,8 +1119,8 @@ pub fn eval_pdf_scalar_into<T: Real>(
                         let b = unit(b);
                         match want {
                             Want::Eval => (m.eval(a, b), 0.0),
-                            Want::Pdf => (lobe::Rgb::ZERO, m.pdf(strategy, a, b)),
-                            Want::Both => m.eval_pdf(strategy, a, b),
+                            Want::Pdf => (lobe::Rgb::ZERO, sampler.pdf(a, b)),
+                            Want::Both => sampler.eval_pdf(a, b),
                         }
                     };
                     if let Some(f) = f.as_mut() {
@@ -1407,8 +1405,7 @@ mod tests {
         let r32 = |x: f64| f64::from(x as f32);
         for i in 0..n {
             let w = DVec3::new(r32(wo[[i, 0]]), r32(wo[[i, 1]]), r32(wo[[i, 2]])).normalize();
-            let r = m.sample(
-                BsdfStrategy::Brdf,
+            let r = m.sampler(BsdfStrategy::Brdf).unwrap().sample(
                 w,
                 r32(uc[i]),
                 DVec2::new(r32(u[[i, 0]]), r32(u[[i, 1]])),

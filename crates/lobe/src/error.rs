@@ -17,8 +17,14 @@ pub enum Error {
     /// A strategy name (a BSDF strategy, `light` or a form of MIS) that lobe
     /// does not know.
     UnknownStrategy { value: String, expected: String },
-    /// A strategy that does not apply to the material.
-    Unsupported { strategy: String, reason: String },
+    /// A strategy that does not apply to the material: why, and the
+    /// strategies the material has (their names, in the order of
+    /// `BsdfStrategy::ALL`).
+    Unsupported {
+        strategy: String,
+        reason: String,
+        available: Vec<&'static str>,
+    },
     /// A material description that cannot be parsed.
     Parse(String),
     /// A data file (a measured BRDF table) that cannot be read or is not
@@ -41,9 +47,14 @@ impl std::fmt::Display for Error {
             Error::UnknownStrategy { value, expected } => {
                 write!(f, "unknown strategy `{value}`, expected one of: {expected}")
             }
-            Error::Unsupported { strategy, reason } => write!(
+            Error::Unsupported {
+                strategy,
+                reason,
+                available,
+            } => write!(
                 f,
-                "strategy `{strategy}` does not apply to this material ({reason})"
+                "strategy `{strategy}` does not apply to this material ({reason}); it has: {}",
+                available.join(", ")
             ),
             Error::Parse(message) => f.write_str(message),
             Error::File { path, message } => write!(f, "file {path}: {message}"),

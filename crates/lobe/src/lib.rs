@@ -67,6 +67,7 @@
 //! ```
 
 pub mod batch;
+pub mod bsdf_strategy;
 #[cfg(feature = "desc")]
 pub mod desc;
 pub mod envmap;
@@ -99,5 +100,6 @@ pub use light::Light;
 pub use material::{BsdfSampler, Glossy, Material};
 pub use math::Rgb;
 pub use microfacet::{Microfacet, Ndf, Shadowing};
-pub use sample::{BsdfSample, Component};
-pub use strategy::{BsdfStrategy, Strategy};
+pub use sample::{BsdfSample, Component, LobeSample, Scattering};
+pub use bsdf_strategy::BsdfStrategy;
+pub use strategy::Strategy;

@@ -1,5 +1,7 @@
 //! A material: a Lambertian term plus at most one glossy lobe, with
-//! evaluation, sampling by any strategy, and the matching pdf.
+//! evaluation, and a sampler for each strategy that applies to it
+//! ([`Material::sampler`], resolved once) that draws directions and gives
+//! the matching pdf.
 //!
 //! With two lobes, `sample` chooses the glossy lobe with probability
 //! `P = a_g / (a_g + a_d)` from the lobes' albedo estimates
@@ -8,9 +10,10 @@
 //! balance heuristic), so `pdf` is always the density that `sample` draws from.
 
 use crate::math::Rgb;
+use crate::models::lambert::CosineSampler;
+use crate::models::{Bxdf, GlossySampler, Lambert, Lobes};
 pub use crate::models::Glossy;
-use crate::models::{Bxdf, Lambert};
-use crate::sample::{BsdfSample, Component};
+use crate::sample::{BsdfSample, Component, Scattering};
 use crate::{BsdfStrategy, Error, warp};
 use glam::{DVec2, DVec3};
 
@@ -32,13 +35,7 @@ impl Material {
 
     /// A glossy lobe plus a diffuse term `kd/π`.
     pub fn with_diffuse(kd: Rgb, glossy: Glossy) -> crate::error::Result<Self> {
-        let diffuse = Lambert::new(kd).map_err(|_| {
-            Error::param(
-                "kd",
-                format!("{kd} is out of range: each channel must be in [0, 1]"),
-            )
-        })?;
-        Ok(Material { diffuse, glossy })
+        Lobes::with_diffuse(kd, glossy).map(Material::from)
     }
 
     /// Build a material from a command-line style argument: JSON text, or
@@ -72,16 +69,9 @@ impl Material {
     }
 
     /// `Ok` when `strategy` applies to this material, otherwise an error
-    /// that says why.
+    /// that says why and which strategies it has.
     pub fn check(&self, strategy: BsdfStrategy) -> crate::error::Result<()> {
-        let r = match self.glossy {
-            Glossy::None => self.diffuse.supports(strategy),
-            g => g.supports(strategy),
-        };
-        r.map_err(|reason| Error::Unsupported {
-            strategy: strategy.name().into(),
-            reason,
-        })
+        self.sampler(strategy).map(|_| ())
     }
 
     /// The strategies that apply to this material, in [`BsdfStrategy::ALL`] order.
@@ -89,7 +79,7 @@ impl Material {
     pub fn strategies(&self) -> Vec<BsdfStrategy> {
         BsdfStrategy::ALL
             .into_iter()
-            .filter(|&s| self.check(s).is_ok())
+            .filter(|&s| self.draw(s).is_ok())
             .collect()
     }
 
@@ -104,10 +94,10 @@ impl Material {
         }
     }
 
-    /// Whether `sample(strategy, ..)` uses `uc` to choose between two lobes:
-    /// the material has a diffuse term and a glossy lobe, and the strategy
-    /// samples them (not `uniform` or `cosine`). Where it does not, `uc` does
-    /// not change the sample.
+    /// Whether the sampler of `strategy` uses `uc` to choose between two
+    /// lobes: the material has a diffuse term and a glossy lobe, and the
+    /// strategy samples them (not `uniform` or `cosine`). Where it does not,
+    /// `uc` does not change the sample.
     #[must_use]
     pub fn chooses_lobe(&self, strategy: BsdfStrategy) -> bool {
         !matches!(strategy, BsdfStrategy::Uniform | BsdfStrategy::Cosine)
@@ -146,152 +136,115 @@ impl Material {
         g + self.diffuse.eval(wo, wi)
     }
 
-    /// Validate `strategy` for this material once, into a handle that
-    /// samples and gives pdfs by it: the error says why a strategy does not
-    /// apply (see [`Material::check`]).
+    /// What the material's samples do when a strategy ignores its lobes.
+    fn hemisphere_scattering(&self) -> Scattering {
+        self.glossy
+            .scattering()
+            .unwrap_or(Scattering::DiffuseReflection)
+    }
+
+    /// How `strategy` draws for this material: the one place a strategy is
+    /// turned into samplers (`uniform` and `cosine` here, the others by the
+    /// lobes' own tables, [`Bxdf::sampler`]).
+    fn draw(&self, strategy: BsdfStrategy) -> Result<Draw, String> {
+        match strategy {
+            BsdfStrategy::Uniform => Ok(Draw::Uniform),
+            BsdfStrategy::Cosine => Ok(Draw::Cosine),
+            _ => match self.glossy {
+                // A Lambertian material: its own `brdf` only.
+                Glossy::None => {
+                    self.diffuse.sampler(strategy)?;
+                    Ok(Draw::Lobes(GlossySampler::None, CosineSampler))
+                }
+                // The glossy lobe's sampler; the diffuse term (if any) is
+                // cosine sampled whatever the strategy.
+                g => Ok(Draw::Lobes(g.sampler(strategy)?, CosineSampler)),
+            },
+        }
+    }
+
+    /// Resolve `strategy` for this material once, into a sampler that draws
+    /// directions and gives pdfs by it; the error says why a strategy does
+    /// not apply and which strategies the material has.
     pub fn sampler(&self, strategy: BsdfStrategy) -> crate::error::Result<BsdfSampler<'_>> {
-        self.check(strategy)?;
-        Ok(BsdfSampler {
-            material: self,
-            strategy,
-        })
-    }
-
-    /// Density in solid angle with which `sample(strategy, wo, ..)` returns
-    /// `wi`; zero below the horizon. `strategy` must apply to the material
-    /// (checked in debug builds); [`Material::sampler`] validates it once.
-    #[inline]
-    #[must_use]
-    pub fn pdf(&self, strategy: BsdfStrategy, wo: DVec3, wi: DVec3) -> f64 {
-        debug_assert!(self.check(strategy).is_ok(), "{strategy} does not apply");
-        if wo.z <= 0.0 || wi.z <= 0.0 {
-            return 0.0;
+        match self.draw(strategy) {
+            Ok(draw) => Ok(BsdfSampler {
+                material: self,
+                strategy,
+                draw,
+            }),
+            Err(reason) => Err(Error::Unsupported {
+                strategy: strategy.name().into(),
+                reason,
+                available: self.strategies().into_iter().map(BsdfStrategy::name).collect(),
+            }),
         }
-        match strategy {
-            BsdfStrategy::Uniform => warp::square_to_uniform_hemisphere_pdf(wi),
-            BsdfStrategy::Cosine => warp::square_to_cosine_hemisphere_pdf(wi),
-            _ => {
-                let p = self.glossy_probability(wo);
-                let pg = if p > 0.0 {
-                    self.glossy.pdf(strategy, wo, wi)
-                } else {
-                    0.0
-                };
-                let pd = if p < 1.0 {
-                    self.diffuse.pdf(strategy, wo, wi)
-                } else {
-                    0.0
-                };
-                p * pg + (1.0 - p) * pd
-            }
-        }
-    }
-
-    /// `(eval(wo, wi), pdf(strategy, wo, wi))` in one call: the lobe-choice
-    /// probability (which evaluates Fresnel) and each lobe's shared terms
-    /// are computed once. `f` is without the cosine; the pdf is in solid
-    /// angle. Bit for bit the same numbers as the two calls.
-    #[inline]
-    #[must_use]
-    pub fn eval_pdf(&self, strategy: BsdfStrategy, wo: DVec3, wi: DVec3) -> (Rgb, f64) {
-        debug_assert!(self.check(strategy).is_ok(), "{strategy} does not apply");
-        if wo.z <= 0.0 || wi.z <= 0.0 {
-            return (Rgb::ZERO, 0.0);
-        }
-        let fd = self.diffuse.eval(wo, wi);
-        match strategy {
-            BsdfStrategy::Uniform | BsdfStrategy::Cosine => {
-                let f = self.glossy.eval(wo, wi) + fd;
-                let pdf = if strategy == BsdfStrategy::Uniform {
-                    warp::square_to_uniform_hemisphere_pdf(wi)
-                } else {
-                    warp::square_to_cosine_hemisphere_pdf(wi)
-                };
-                (f, pdf)
-            }
-            _ => {
-                let p = self.glossy_probability(wo);
-                let (fg, pg) = if p > 0.0 {
-                    self.glossy.eval_pdf(strategy, wo, wi)
-                } else {
-                    (self.glossy.eval(wo, wi), 0.0)
-                };
-                let pd = if p < 1.0 {
-                    self.diffuse.pdf(strategy, wo, wi)
-                } else {
-                    0.0
-                };
-                (fg + fd, p * pg + (1.0 - p) * pd)
-            }
-        }
-    }
-
-    /// Draw `wi` for `wo` with `strategy`. `uc` chooses the lobe, `u` the
-    /// direction. `None` is a failed sample (below the horizon, or `wo`
-    /// below it), which an estimator counts with weight zero. `strategy`
-    /// must apply to the material (checked in debug builds);
-    /// [`Material::sampler`] validates it once.
-    #[inline]
-    #[must_use]
-    pub fn sample(
-        &self,
-        strategy: BsdfStrategy,
-        wo: DVec3,
-        uc: f64,
-        u: DVec2,
-    ) -> Option<BsdfSample> {
-        debug_assert!(self.check(strategy).is_ok(), "{strategy} does not apply");
-        if wo.z <= 0.0 {
-            return None;
-        }
-        let (wi, lobe) = match strategy {
-            BsdfStrategy::Uniform => (warp::square_to_uniform_hemisphere(u), Component::Hemisphere),
-            BsdfStrategy::Cosine => (warp::square_to_cosine_hemisphere(u), Component::Hemisphere),
-            _ => {
-                let p = self.glossy_probability(wo);
-                if p >= 1.0 {
-                    // One lobe: its own f and pdf, computed with the sample.
-                    let (wi, f, pdf) = self.glossy.sample_eval(strategy, wo, u)?;
-                    return Self::finish(wi, f, pdf, Component::Glossy);
-                }
-                if uc < p {
-                    (self.glossy.sample(strategy, wo, u)?, Component::Glossy)
-                } else {
-                    (self.diffuse.sample(strategy, wo, u)?, Component::Diffuse)
-                }
-            }
-        };
-        if wi.z <= 0.0 {
-            return None;
-        }
-        Self::finish(wi, self.eval(wo, wi), self.pdf(strategy, wo, wi), lobe)
-    }
-
-    #[inline]
-    fn finish(wi: DVec3, f: Rgb, pdf: f64, component: Component) -> Option<BsdfSample> {
-        if !(pdf > 0.0 && pdf.is_finite() && wi.z > 0.0) {
-            return None;
-        }
-        Some(BsdfSample {
-            wi,
-            f,
-            pdf,
-            weight: f * (wi.z / pdf),
-            component,
-        })
     }
 }
 
-/// A strategy validated for one material ([`Material::sampler`]): it can
-/// only be asked for what that strategy has, so there is no meaningless pdf.
+impl From<Lobes> for Material {
+    fn from(l: Lobes) -> Self {
+        Material {
+            diffuse: l.diffuse,
+            glossy: l.glossy,
+        }
+    }
+}
+
+#[cfg(feature = "desc")]
+impl crate::desc::MaterialDesc {
+    /// Check every field and build the material: the model's own
+    /// [`crate::models::ModelInfo::from_desc`], once every key given is
+    /// known to belong to the model. (Here rather than beside
+    /// `MaterialDesc`: the models read descriptions, so `desc` must not
+    /// read the models.)
+    pub fn build(&self) -> Result<Material, Error> {
+        let kind = self.kind.as_str();
+        let Some(model) = crate::models::find(kind) else {
+            return Err(Error::UnknownName {
+                field: "type".into(),
+                value: self.kind.clone(),
+                expected: crate::models::names(", "),
+            });
+        };
+        for (name, present) in self.present_fields() {
+            if present && !model.keys().any(|k| k == name) {
+                return Err(Error::param(
+                    name,
+                    format!(
+                        "does not apply to type {kind} (its keys: {})",
+                        model.keys().collect::<Vec<_>>().join(", ")
+                    ),
+                ));
+            }
+        }
+        (model.from_desc)(self).map(Material::from)
+    }
+}
+
+/// How a [`BsdfSampler`] draws: resolved once from its strategy.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Draw {
+    /// Uniform over the hemisphere, whatever the lobes.
+    Uniform,
+    /// Cosine-weighted, whatever the lobes.
+    Cosine,
+    /// The glossy lobe by its sampler, the diffuse term by cosine sampling,
+    /// one of them chosen by `uc` with the lobes' albedo hints.
+    Lobes(GlossySampler, CosineSampler),
+}
+
+/// A strategy resolved for one material ([`Material::sampler`]): it draws
+/// directions and answers pdfs by that strategy, with no further check.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BsdfSampler<'m> {
     material: &'m Material,
     strategy: BsdfStrategy,
+    draw: Draw,
 }
 
 impl<'m> BsdfSampler<'m> {
-    /// The strategy this handle samples by.
+    /// The strategy this sampler draws by.
     #[inline]
     #[must_use]
     pub fn strategy(&self) -> BsdfStrategy {
@@ -305,25 +258,133 @@ impl<'m> BsdfSampler<'m> {
         self.material
     }
 
-    /// [`Material::sample`]: `uc` chooses the lobe, `u` the direction;
-    /// `None` is a failed sample. The weight includes the cosine.
-    #[inline]
-    #[must_use]
-    pub fn sample(&self, wo: DVec3, uc: f64, u: DVec2) -> Option<BsdfSample> {
-        self.material.sample(self.strategy, wo, uc, u)
-    }
-
-    /// [`Material::pdf`]: the solid-angle density of `sample` at `wi`.
+    /// Density in solid angle with which `sample(wo, ..)` returns `wi`;
+    /// zero below the horizon.
     #[inline]
     #[must_use]
     pub fn pdf(&self, wo: DVec3, wi: DVec3) -> f64 {
-        self.material.pdf(self.strategy, wo, wi)
+        if wo.z <= 0.0 || wi.z <= 0.0 {
+            return 0.0;
+        }
+        match self.draw {
+            Draw::Uniform => warp::square_to_uniform_hemisphere_pdf(wi),
+            Draw::Cosine => warp::square_to_cosine_hemisphere_pdf(wi),
+            Draw::Lobes(glossy, diffuse) => {
+                let m = self.material;
+                let p = m.glossy_probability(wo);
+                let pg = if p > 0.0 { glossy.pdf(wo, wi) } else { 0.0 };
+                let pd = if p < 1.0 {
+                    m.diffuse.pdf(diffuse, wo, wi)
+                } else {
+                    0.0
+                };
+                p * pg + (1.0 - p) * pd
+            }
+        }
     }
 
-    /// [`Material::eval_pdf`]: `f` (no cosine) and the pdf at `wi`.
+    /// `(f, pdf)` at `wi` in one call: the lobe-choice probability (which
+    /// evaluates Fresnel) and each lobe's shared terms are computed once.
+    /// `f` is without the cosine; the pdf is in solid angle. Bit for bit
+    /// the numbers of [`Material::eval`] and [`BsdfSampler::pdf`].
     #[inline]
     #[must_use]
     pub fn eval_pdf(&self, wo: DVec3, wi: DVec3) -> (Rgb, f64) {
-        self.material.eval_pdf(self.strategy, wo, wi)
+        if wo.z <= 0.0 || wi.z <= 0.0 {
+            return (Rgb::ZERO, 0.0);
+        }
+        let m = self.material;
+        let fd = m.diffuse.eval(wo, wi);
+        match self.draw {
+            Draw::Uniform => (
+                m.glossy.eval(wo, wi) + fd,
+                warp::square_to_uniform_hemisphere_pdf(wi),
+            ),
+            Draw::Cosine => (
+                m.glossy.eval(wo, wi) + fd,
+                warp::square_to_cosine_hemisphere_pdf(wi),
+            ),
+            Draw::Lobes(glossy, diffuse) => {
+                let p = m.glossy_probability(wo);
+                let (fg, pg) = if p > 0.0 {
+                    glossy.eval_pdf(wo, wi)
+                } else {
+                    (m.glossy.eval(wo, wi), 0.0)
+                };
+                let pd = if p < 1.0 {
+                    m.diffuse.pdf(diffuse, wo, wi)
+                } else {
+                    0.0
+                };
+                (fg + fd, p * pg + (1.0 - p) * pd)
+            }
+        }
     }
+
+    /// Draw `wi` for `wo`: `uc` chooses the lobe, `u` the direction. `None`
+    /// is a failed sample (below the horizon, or `wo` below it), which an
+    /// estimator counts with weight zero. The weight includes the cosine.
+    #[inline]
+    #[must_use]
+    pub fn sample(&self, wo: DVec3, uc: f64, u: DVec2) -> Option<BsdfSample> {
+        if wo.z <= 0.0 {
+            return None;
+        }
+        let m = self.material;
+        let (wi, component, scattering) = match self.draw {
+            Draw::Uniform => (
+                warp::square_to_uniform_hemisphere(u),
+                Component::Hemisphere,
+                m.hemisphere_scattering(),
+            ),
+            Draw::Cosine => (
+                warp::square_to_cosine_hemisphere(u),
+                Component::Hemisphere,
+                m.hemisphere_scattering(),
+            ),
+            Draw::Lobes(glossy, diffuse) => {
+                let p = m.glossy_probability(wo);
+                let glossy_scattering = m.glossy.scattering();
+                if p >= 1.0 {
+                    // One lobe: its own f and pdf, computed with the sample.
+                    let s = glossy.sample_eval(wo, u)?;
+                    return finish(s.wi, s.f, s.pdf, Component::Glossy, glossy_scattering?);
+                }
+                if uc < p {
+                    (glossy.sample(wo, u)?, Component::Glossy, glossy_scattering?)
+                } else {
+                    (
+                        m.diffuse.sample(diffuse, wo, u)?,
+                        Component::Diffuse,
+                        m.diffuse.scattering(),
+                    )
+                }
+            }
+        };
+        if wi.z <= 0.0 {
+            return None;
+        }
+        finish(wi, m.eval(wo, wi), self.pdf(wo, wi), component, scattering)
+    }
+}
+
+#[inline]
+fn finish(
+    wi: DVec3,
+    f: Rgb,
+    pdf: f64,
+    component: Component,
+    scattering: Scattering,
+) -> Option<BsdfSample> {
+    if !(pdf > 0.0 && pdf.is_finite() && wi.z > 0.0) {
+        return None;
+    }
+    Some(BsdfSample {
+        wi,
+        f,
+        pdf,
+        weight: f * (wi.z / pdf),
+        component,
+        scattering,
+    })
 }

@@ -1,80 +1,11 @@
-//! Sampling strategies, selected by name.
+//! How the directions of an estimate are drawn ([`Strategy`]): a BSDF
+//! strategy ([`BsdfStrategy`], in its own module), light sampling, or MIS
+//! with its heuristic and form; selected by name.
 
 use crate::Error;
 use crate::Material;
+pub use crate::bsdf_strategy::BsdfStrategy;
 use crate::light::LightDistribution;
-
-/// How a direction `wi` is drawn for a given `wo`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub enum BsdfStrategy {
-    /// Uniform over the upper hemisphere, `1/(2π)`: the lecture's baseline.
-    Uniform,
-    /// Cosine-weighted hemisphere, `cos θ/π`.
-    Cosine,
-    /// The lecture's classic importance sampling: Phong's lobe around the
-    /// mirror direction, Blinn-Phong's half vector, Cook-Torrance's
-    /// `D(h) cos θh`; a diffuse term is cosine sampled.
-    Brdf,
-    /// Visible normals (Heitz 2018; GGX and Beckmann).
-    Vndf,
-    /// Visible normals by spherical caps (Dupuy and Benyoub 2023; GGX).
-    SphericalCaps,
-    /// Bounded VNDF (Eto and Tokuyoshi 2023; GGX reflection).
-    BoundedVndf,
-}
-
-impl BsdfStrategy {
-    pub const ALL: [BsdfStrategy; 6] = [
-        BsdfStrategy::Uniform,
-        BsdfStrategy::Cosine,
-        BsdfStrategy::Brdf,
-        BsdfStrategy::Vndf,
-        BsdfStrategy::SphericalCaps,
-        BsdfStrategy::BoundedVndf,
-    ];
-
-    #[must_use]
-    pub fn name(self) -> &'static str {
-        match self {
-            BsdfStrategy::Uniform => "uniform",
-            BsdfStrategy::Cosine => "cosine",
-            BsdfStrategy::Brdf => "brdf",
-            BsdfStrategy::Vndf => "vndf",
-            BsdfStrategy::SphericalCaps => "spherical-caps",
-            BsdfStrategy::BoundedVndf => "bounded-vndf",
-        }
-    }
-
-    /// All names, comma separated, for error messages and help.
-    #[must_use]
-    pub fn names() -> String {
-        BsdfStrategy::ALL
-            .iter()
-            .map(|s| s.name())
-            .collect::<Vec<_>>()
-            .join(", ")
-    }
-}
-
-impl std::fmt::Display for BsdfStrategy {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-impl std::str::FromStr for BsdfStrategy {
-    type Err = Error;
-    fn from_str(s: &str) -> Result<Self, Error> {
-        BsdfStrategy::ALL
-            .into_iter()
-            .find(|x| x.name() == s)
-            .ok_or_else(|| Error::UnknownName {
-                field: "strategy".into(),
-                value: s.into(),
-                expected: BsdfStrategy::names(),
-            })
-    }
-}
 
 /// How Multiple Importance Sampling weights its techniques (Veach 1997).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]

@@ -212,7 +212,7 @@ fn samples_round_trip_through_pdf_lines() {
         let mut drawn = Vec::new();
         for ((s, wo, u, uc), out) in queries.iter().zip(&samples) {
             // Full precision: the printed numbers are exactly the core's.
-            let expected = m.sample(*s, *wo, *uc, *u);
+            let expected = m.sampler(*s).unwrap().sample(*wo, *uc, *u);
             if out["wi"].is_null() {
                 assert!(expected.is_none(), "{material} {s}: {out}");
                 assert_eq!(out["pdf"].as_f64(), Some(0.0));
@@ -273,7 +273,7 @@ fn failed_samples_give_null() {
     let wo = dir(1.45, 0.0);
     let u = (0..64 * 64)
         .map(|k| DVec2::new((k % 64) as f64 / 64.0, (k / 64) as f64 / 64.0))
-        .find(|&u| m.sample(BsdfStrategy::Brdf, wo, 0.5, u).is_none())
+        .find(|&u| m.sampler(BsdfStrategy::Brdf).unwrap().sample(wo, 0.5, u).is_none())
         .expect("a failed brdf sample at grazing wo");
     let input = format!(
         "{{\"wo\":{},\"u\":[{},{}],\"strategy\":\"brdf\"}}\n",

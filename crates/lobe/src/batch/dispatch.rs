@@ -8,6 +8,7 @@
 //! the block size, on where the block was cut, or on the thread.
 
 use super::SimdLevel;
+use super::block::{EvalIn, EvalOut, F_ONLY, PDF_ONLY, SampleIn, SampleOut};
 use super::kernel::phong::{BLINN, LectureParams, PHONG};
 use super::kernel::{
     self, BECKMANN, BLINN_PHONG, BOUNDED, BRDF, CAPS, COSINE, CtParams, GGX, Sampled, UNIFORM, VNDF,
@@ -113,13 +114,6 @@ impl VecKernel for LectureParams {
     }
 }
 
-/// Which outputs [`eval_pdf`] writes: `f` and the pdf, `f` only, the pdf
-/// only. The analytic kernels compute both and skip the stores (one
-/// instance per kernel, not three: CI's time is compile time); the measured
-/// kernels (`super::measured`) skip the work.
-pub(crate) const BOTH: u8 = 0;
-pub(crate) const F_ONLY: u8 = 1;
-pub(crate) const PDF_ONLY: u8 = 2;
 
 /// A level with its token.
 #[derive(Debug, Clone, Copy)]
@@ -156,11 +150,6 @@ impl Backend {
     }
 }
 
-/// Inputs of `sample`: `wo.x, wo.y, wo.z, u1, u2, uc`, all of one length
-/// (`uc` is read only where it chooses a lobe).
-pub(crate) type SampleIn<'a> = [&'a [f32]; 6];
-/// Outputs of `sample`: `wi.xyz, f.rgb, pdf, weight.rgb`, and the mask.
-pub(crate) type SampleOut<'a, 'b> = (&'b mut [&'a mut [f32]; 10], &'b mut [u8]);
 /// How `sample` writes its outputs: `f` at all (its slices may be empty
 /// when not), and with streaming stores ([`Lanes::stream_ptr`]) or plain
 /// ones (a block streams only where every output it writes is aligned for
@@ -180,11 +169,6 @@ pub(crate) struct SampleWrites {
 type SampleFn<L, P> = unsafe fn(L, &P, SampleIn<'_>, SampleOut<'_, '_>, SampleWrites);
 /// As [`SampleFn`], for `eval_pdf`.
 type EvalFn<L, P> = unsafe fn(L, &P, u8, EvalIn<'_>, EvalOut<'_, '_>, bool);
-/// Inputs of `eval_pdf`: `wo.xyz, wi.xyz`.
-pub(crate) type EvalIn<'a> = [&'a [f32]; 6];
-/// Outputs of `eval_pdf`: `f.rgb, pdf` (the ones the mode does not write
-/// may be empty).
-pub(crate) type EvalOut<'a, 'b> = &'b mut [&'a mut [f32]; 4];
 
 /// One vector of `sample` from the `L::N` values at `ip[i] + k`, stored at
 /// `op[j] + k` (`f`, `op[3..6]`, only if `w.f`; streamed if `w.stream`) and

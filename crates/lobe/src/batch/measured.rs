@@ -18,7 +18,7 @@
 //! `uniform`, `cosine`, `brdf` (the tabulated half-vector sampler) and, for
 //! RGL files, `vndf` (the file's luminance and visible-normal warps).
 
-use super::dispatch::{BOTH, EvalIn, EvalOut, F_ONLY, PDF_ONLY, SampleIn, SampleOut};
+use super::block::{BOTH, EvalIn, EvalOut, F_ONLY, PDF_ONLY, SampleIn, SampleOut};
 use crate::models::measured::{Measured, MeasuredData, Table};
 use crate::{BsdfStrategy, Material, Rgb, warp};
 use glam::{DVec2, DVec3};
@@ -282,8 +282,9 @@ fn eval_pdf_lanes<const MODE: u8>(
 /// lobe); without, the table's strategy directly (`uc` unread).
 pub(crate) fn sample_block(k: &MeasuredKernel, inp: SampleIn<'_>, out: SampleOut<'_, '_>) {
     if let Some((m, s)) = &k.mixture {
+        let sampler = m.sampler(*s).expect("the strategy was checked when the kernel was made");
         return sample_lanes(inp, out, |wo, u, uc| {
-            m.sample(*s, wo, uc, u).map(|x| (x.wi, x.f, x.pdf))
+            sampler.sample(wo, uc, u).map(|x| (x.wi, x.f, x.pdf))
         });
     }
     let d = k.data;
@@ -307,7 +308,8 @@ pub(crate) fn eval_pdf_block(k: &MeasuredKernel, mode: u8, inp: EvalIn<'_>, out:
         };
     }
     if let Some((m, s)) = &k.mixture {
-        return by_mode!(|wo, wi| m.eval_pdf(*s, wo, wi));
+        let sampler = m.sampler(*s).expect("the strategy was checked when the kernel was made");
+        return by_mode!(|wo, wi| sampler.eval_pdf(wo, wi));
     }
     let d = k.data;
     macro_rules! by_strat {
@@ -519,7 +521,7 @@ pub(super) mod tests {
                 let mut valid = 0;
                 for k in 0..n {
                     let o = d(&wo, k);
-                    let r = m.sample(s, o, uc[k].into(), DVec2::new(u1[k].into(), u2[k].into()));
+                    let r = m.sampler(s).unwrap().sample(o, uc[k].into(), DVec2::new(u1[k].into(), u2[k].into()));
                     match r {
                         None => assert_eq!(out.valid[k], 0, "{name} {s} #{k}"),
                         Some(r) => {
@@ -545,7 +547,7 @@ pub(super) mod tests {
                             assert_eq!(got, want, "{name} {s} #{k}");
                         }
                     }
-                    let (f, p) = m.eval_pdf(s, o, d(&wi, k));
+                    let (f, p) = m.sampler(s).unwrap().eval_pdf(o, d(&wi, k));
                     let got = [ep.f[0][k], ep.f[1][k], ep.f[2][k], ep.pdf[k]];
                     assert_eq!(
                         got,

@@ -238,6 +238,7 @@
 //! `is_x86_feature_detected!`. Every operation is exactly rounded (fused
 //! multiply-add at every level), so the three levels give the same bits.
 
+mod block;
 mod dispatch;
 mod kernel;
 mod lanes;
@@ -246,7 +247,7 @@ mod measured;
 #[cfg(test)]
 mod tests;
 
-use crate::models::{Bxdf, CookTorrance, Glossy};
+use crate::models::{CookTorrance, Glossy};
 use crate::{BsdfStrategy, Fresnel, Material, Ndf, Rgb, Shadowing};
 use dispatch::{Backend, Kernel};
 use kernel::{CtParams, FresnelP, Shadow};
@@ -757,7 +758,7 @@ impl BatchSampler {
         store: Store,
     ) -> Result<(), BatchError> {
         let o = [out.f.r, out.f.g, out.f.b, out.pdf];
-        self.run_eval_pdf(wo, wi, dispatch::BOTH, o, store)
+        self.run_eval_pdf(wo, wi, block::BOTH, o, store)
     }
 
     /// `eval_pdf` writing what `mode` names into `o` (`f.rgb`, `pdf`; the
@@ -777,8 +778,8 @@ impl BatchSampler {
             ("pdf", o[3].len()),
         ];
         let written = match mode {
-            dispatch::F_ONLY => &lens[..3],
-            dispatch::PDF_ONLY => &lens[3..],
+            block::F_ONLY => &lens[..3],
+            block::PDF_ONLY => &lens[3..],
             _ => &lens[..],
         };
         check_pairs(wo, wi, written)?;
@@ -808,7 +809,7 @@ impl BatchSampler {
         f: RgbMut<'_>,
         store: Store,
     ) -> Result<(), BatchError> {
-        self.run_eval_pdf(wo, wi, dispatch::F_ONLY, [f.r, f.g, f.b, &mut []], store)
+        self.run_eval_pdf(wo, wi, block::F_ONLY, [f.r, f.g, f.b, &mut []], store)
     }
 
     /// The pdf (solid angle) of this sampler's strategy at `(wo[i], wi[i])`,
@@ -830,7 +831,7 @@ impl BatchSampler {
         self.run_eval_pdf(
             wo,
             wi,
-            dispatch::PDF_ONLY,
+            block::PDF_ONLY,
             [&mut [], &mut [], &mut [], pdf],
             store,
         )
@@ -960,8 +961,6 @@ fn kernel_for(m: &Material, strategy: BsdfStrategy) -> Result<Kernel, BatchError
         BsdfStrategy::SphericalCaps => kernel::CAPS,
         BsdfStrategy::BoundedVndf => kernel::BOUNDED,
     };
-    // Defensive: `check` accepted the strategy, so the lobe supports it.
-    debug_assert!(m.glossy.supports(strategy).is_ok());
     let (ax, ay) = microfacet.alpha();
     let fresnel = match fresnel {
         Fresnel::None => FresnelP::Schlick {

@@ -1152,9 +1152,9 @@ fn two_vectors_at_a_time_give_the_same_bits() {
                 ];
                 let mut e = ev.each_mut().map(|v| &mut v[..]);
                 if x2 && d::runs_x2(k, true, false) {
-                    d::eval_pdf_x2(Scalar, k, d::BOTH, ein, &mut e, false);
+                    d::eval_pdf_x2(Scalar, k, super::block::BOTH, ein, &mut e, false);
                 } else {
-                    d::eval_pdf_level(Scalar, k, d::BOTH, ein, &mut e, false);
+                    d::eval_pdf_level(Scalar, k, super::block::BOTH, ein, &mut e, false);
                 }
             }
             (out, valid, ev)

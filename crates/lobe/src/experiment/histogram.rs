@@ -10,7 +10,7 @@
 use super::map_indices;
 use crate::math::luminance;
 use crate::progress::Progress;
-use crate::{BsdfStrategy, Material};
+use crate::{BsdfSampler, BsdfStrategy, Material};
 use glam::{DVec2, DVec3};
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64;
@@ -38,7 +38,7 @@ pub fn disk_cell(x: f64, res: usize) -> usize {
     }
 }
 
-/// Observed and expected sample counts of `material.sample(strategy, wo, ..)`
+/// Observed and expected sample counts of `sampler.sample(wo, ..)`
 /// over a `res × res` grid on the projected hemisphere (layout in the
 /// [module docs](self); `res` below 1 is taken as 1). Pixels outside the
 /// disk hold zero.
@@ -52,13 +52,11 @@ pub fn disk_cell(x: f64, res: usize) -> usize {
 /// its solid angle ([`rect_solid_angle`], exact, so the pixels on the rim,
 /// where `1/z` blows up, are as accurate as the others).
 ///
-/// The strategy must apply to the material (see [`Material::check`]),
-/// otherwise the pdf is meaningless. Progress: one task `histogram` of
+/// Progress: one task `histogram` of
 /// `samples` steps (the draws; the expected counts are not counted).
 #[must_use]
 pub fn projected_histograms(
-    material: &Material,
-    strategy: BsdfStrategy,
+    sampler: &BsdfSampler<'_>,
     wo: DVec3,
     samples: usize,
     seed: u64,
@@ -74,7 +72,7 @@ pub fn projected_histograms(
         let uc: f64 = rng.random();
         let ux: f64 = rng.random();
         let uy: f64 = rng.random();
-        if let Some(s) = material.sample(strategy, wo, uc, DVec2::new(ux, uy)) {
+        if let Some(s) = sampler.sample(wo, uc, DVec2::new(ux, uy)) {
             let (i, j) = (disk_cell(s.wi.x, res), disk_cell(s.wi.y, res));
             observed[j * res + i] += 1.0;
         }
@@ -109,7 +107,7 @@ pub fn projected_histograms(
                     c *= (1.0 - 1e-7) / r;
                 }
                 let wi = DVec3::new(c.x, c.y, (1.0 - c.length_squared()).max(0.0).sqrt());
-                let p = material.pdf(strategy, wo, wi);
+                let p = sampler.pdf(wo, wi);
                 if p.is_finite() && p > 0.0 {
                     acc += p * omega;
                 }
@@ -199,16 +197,12 @@ pub enum WeightPixel {
 }
 
 /// The sample weight `f·cos θi / pdf` (cosine included; `f` is the
-/// luminance of `material.eval`) that `strategy` gives the direction at the
+/// luminance of the material's `eval`) that `sampler` gives the direction at the
 /// centre of each pixel of a `res × res` grid over the projected hemisphere
 /// (layout in the [module docs](self)). `res` must be at least 1.
 #[must_use]
-pub fn weight_pixels(
-    material: &Material,
-    strategy: BsdfStrategy,
-    wo: DVec3,
-    res: usize,
-) -> Vec<WeightPixel> {
+pub fn weight_pixels(sampler: &BsdfSampler<'_>, wo: DVec3, res: usize) -> Vec<WeightPixel> {
+    let material = sampler.material();
     map_indices(res * res, |k| {
         let (i, j) = (k % res, k / res);
         let x = -1.0 + (i as f64 + 0.5) * 2.0 / res as f64;
@@ -219,7 +213,7 @@ pub fn weight_pixels(
         }
         let wi = DVec3::new(x, y, (1.0 - r2).sqrt());
         let f = luminance(material.eval(wo, wi));
-        let pdf = material.pdf(strategy, wo, wi);
+        let pdf = sampler.pdf(wo, wi);
         if f.is_nan() || f <= 0.0 {
             WeightPixel::ZeroF
         } else if pdf.is_nan() || pdf <= 0.0 {
@@ -357,8 +351,7 @@ mod tests {
         let wo = DVec3::new(0.0, 0.0, 1.0);
         let res = 16;
         let h = projected_histograms(
-            &lambert(),
-            BsdfStrategy::Uniform,
+            &lambert().sampler(BsdfStrategy::Uniform).unwrap(),
             wo,
             1_000_000,
             1,
@@ -391,7 +384,8 @@ mod tests {
     fn histograms_agree_for_cosine_sampling() {
         let wo = DVec3::new(0.5, 0.0, 0.75f64.sqrt());
         let steps = Steps(std::sync::Mutex::new((0, 0)));
-        let h = projected_histograms(&lambert(), BsdfStrategy::Cosine, wo, 200_000, 3, 16, &steps);
+        let h = projected_histograms(
+            &lambert().sampler(BsdfStrategy::Cosine).unwrap(), wo, 200_000, 3, 16, &steps);
         assert_eq!(h.res, 16);
         assert_eq!((h.observed.len(), h.expected.len()), (256, 256));
         let (so, se): (f64, f64) = (h.observed.iter().sum(), h.expected.iter().sum());
@@ -399,7 +393,8 @@ mod tests {
         assert!((se / 200_000.0 - 1.0).abs() < 2e-3, "{se}");
         assert_eq!(*steps.0.lock().unwrap(), (200_000, 200_000));
         // The same seed gives the same counts.
-        let again = projected_histograms(&lambert(), BsdfStrategy::Cosine, wo, 200_000, 3, 16, &());
+        let again = projected_histograms(
+            &lambert().sampler(BsdfStrategy::Cosine).unwrap(), wo, 200_000, 3, 16, &());
         assert_eq!(again, h);
     }
 
@@ -409,8 +404,8 @@ mod tests {
     fn weights_of_lambert() {
         let wo = DVec3::Z;
         let res = 9;
-        let cos = weight_pixels(&lambert(), BsdfStrategy::Cosine, wo, res);
-        let uni = weight_pixels(&lambert(), BsdfStrategy::Uniform, wo, res);
+        let cos = weight_pixels(&lambert().sampler(BsdfStrategy::Cosine).unwrap(), wo, res);
+        let uni = weight_pixels(&lambert().sampler(BsdfStrategy::Uniform).unwrap(), wo, res);
         assert_eq!(cos.len(), 81);
         assert_eq!(cos[0], WeightPixel::Outside);
         let mut inside = 0;

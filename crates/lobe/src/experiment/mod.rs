@@ -10,6 +10,8 @@
 //!   `lobe report`).
 //! * [`polar`]: the integrand and each strategy's pdf in the plane of
 //!   incidence (`lobe plot --kind polar`, `lobe report`).
+//! * [`warp_test`]: Nori's warp test of a sampler, histograms and
+//!   chi-square (`lobe plot`, `lobe report`; feature `stats`).
 //! * [`variance`]: exact variances by quadrature (the baseline of "vs
 //!   uniform") and the largest directional albedo of a material.
 //!
@@ -25,6 +27,8 @@ pub mod histogram;
 pub mod polar;
 pub mod table;
 pub mod variance;
+#[cfg(feature = "stats")]
+pub mod warp_test;
 
 use crate::estimator::{
     Accumulator, Plan, ShadingPoint, estimate_chunk, reference, reference_env_row,

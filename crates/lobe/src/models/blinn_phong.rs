@@ -28,6 +28,7 @@
 
 use super::{Bxdf, ModelInfo, Param, Value};
 use crate::math::{Rgb, luminance, reflect};
+use crate::sample::Scattering;
 use crate::{BsdfStrategy, warp};
 use glam::{DVec2, DVec3};
 
@@ -53,10 +54,10 @@ pub const INFO: ModelInfo = ModelInfo {
 };
 
 #[cfg(feature = "desc")]
-fn from_desc(d: &crate::desc::MaterialDesc) -> crate::error::Result<crate::Material> {
+fn from_desc(d: &crate::desc::MaterialDesc) -> crate::error::Result<super::Lobes> {
     let (ks, kd, exponent, normalized) = super::lecture_keys(d, KS, EXPONENT, NORMALIZED);
     let lobe = BlinnPhong::new(ks, exponent, normalized)?;
-    crate::Material::with_diffuse(kd, super::Glossy::BlinnPhong(lobe))
+    super::Lobes::with_diffuse(kd, super::Glossy::BlinnPhong(lobe))
 }
 
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -92,7 +93,28 @@ impl BlinnPhong {
     }
 }
 
+/// Blinn-Phong's one sampler: the half vector by `cosⁿθh`, reflected (its
+/// `brdf`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct HalfVectorSampler;
+
 impl Bxdf for BlinnPhong {
+    type Sampler = HalfVectorSampler;
+
+    /// | strategy | sampler |
+    /// |---|---|
+    /// | `brdf` | [`HalfVectorSampler`] |
+    fn sampler(&self, strategy: BsdfStrategy) -> Result<HalfVectorSampler, String> {
+        match strategy {
+            BsdfStrategy::Brdf => Ok(HalfVectorSampler),
+            _ => Err("Blinn-Phong here is the lecture's model, not a microfacet one; use uniform, cosine or brdf, or cook-torrance with distribution blinn-phong".into()),
+        }
+    }
+
+    fn scattering(&self) -> Scattering {
+        Scattering::GlossyReflection
+    }
+
     #[inline]
     fn eval(&self, wo: DVec3, wi: DVec3) -> Rgb {
         let Some(h) = (wo + wi).try_normalize() else {
@@ -102,14 +124,14 @@ impl Bxdf for BlinnPhong {
     }
 
     #[inline]
-    fn sample(&self, _strategy: BsdfStrategy, wo: DVec3, u: DVec2) -> Option<DVec3> {
+    fn sample(&self, _: HalfVectorSampler, wo: DVec3, u: DVec2) -> Option<DVec3> {
         let h = warp::square_to_cos_power(u, self.exponent);
         let wi = reflect(wo, h);
         (wi.z > 0.0 && wo.dot(h) > 0.0).then(|| wi.normalize())
     }
 
     #[inline]
-    fn pdf(&self, _strategy: BsdfStrategy, wo: DVec3, wi: DVec3) -> f64 {
+    fn pdf(&self, _: HalfVectorSampler, wo: DVec3, wi: DVec3) -> f64 {
         let Some(h) = (wo + wi).try_normalize() else {
             return 0.0;
         };
@@ -126,13 +148,6 @@ impl Bxdf for BlinnPhong {
             a
         } else {
             a / normalization(self.exponent)
-        }
-    }
-
-    fn supports(&self, strategy: BsdfStrategy) -> Result<(), String> {
-        match strategy {
-            BsdfStrategy::Uniform | BsdfStrategy::Cosine | BsdfStrategy::Brdf => Ok(()),
-            _ => Err("Blinn-Phong here is the lecture's model, not a microfacet one; use uniform, cosine or brdf, or cook-torrance with distribution blinn-phong".into()),
         }
     }
 }

@@ -32,6 +32,7 @@
 
 use super::{Bxdf, ModelInfo, Param, Range, Value};
 use crate::math::{Rgb, luminance, reflect};
+use crate::sample::{LobeSample, Scattering};
 use crate::microfacet::{MAX_ALPHA, MIN_ALPHA, Microfacet, Ndf, Shadowing};
 use crate::{Fresnel, BsdfStrategy};
 use glam::{DVec2, DVec3};
@@ -119,7 +120,7 @@ pub const INFO: ModelInfo = ModelInfo {
 };
 
 #[cfg(feature = "desc")]
-fn from_desc(d: &crate::desc::MaterialDesc) -> crate::error::Result<crate::Material> {
+fn from_desc(d: &crate::desc::MaterialDesc) -> crate::error::Result<super::Lobes> {
     use crate::Error;
     let ndf: Ndf = d
         .distribution
@@ -149,7 +150,7 @@ fn from_desc(d: &crate::desc::MaterialDesc) -> crate::error::Result<crate::Mater
         .as_ref()
         .map_or(Ok(Fresnel::None), crate::desc::FresnelDesc::build)?;
     let lobe = CookTorrance::new(super::colour(d.ks, KS), mf, shadowing, fresnel)?;
-    crate::Material::with_diffuse(super::colour(d.kd, super::KD), super::Glossy::CookTorrance(lobe))
+    super::Lobes::with_diffuse(super::colour(d.kd, super::KD), super::Glossy::CookTorrance(lobe))
 }
 
 /// `(alpha_u, alpha_v)` from `alpha`, `alpha_u`/`alpha_v` or `roughness`.
@@ -211,16 +212,31 @@ impl CookTorrance {
     }
 }
 
+/// Cook-Torrance's samplers: how the microfacet normal `wm` is drawn
+/// before `wo` is reflected about it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum MicrofacetSampler {
+    /// `p(wm) = D(wm) cos θm`, the lecture's (`brdf`).
+    DCos,
+    /// Visible normals, Heitz 2018 (`vndf`).
+    Visible,
+    /// Visible normals by spherical caps, Dupuy and Benyoub 2023
+    /// (`spherical-caps`): the density of `Visible`.
+    SphericalCaps,
+    /// Bounded VNDF, Eto and Tokuyoshi 2023 (`bounded-vndf`).
+    BoundedVisible,
+}
+
 impl CookTorrance {
-    /// Draw the microfacet normal by `strategy` and reflect: `(wi, wm)`.
+    /// Draw the microfacet normal by `sampler` and reflect: `(wi, wm)`.
     #[inline]
-    fn sample_wm(&self, strategy: BsdfStrategy, wo: DVec3, u: DVec2) -> Option<(DVec3, DVec3)> {
+    fn sample_wm(&self, sampler: MicrofacetSampler, wo: DVec3, u: DVec2) -> Option<(DVec3, DVec3)> {
         let mf = &self.microfacet;
-        let wm = match strategy {
-            BsdfStrategy::Vndf => mf.sample_visible(wo, u)?,
-            BsdfStrategy::SphericalCaps => mf.sample_visible_caps(wo, u),
-            BsdfStrategy::BoundedVndf => mf.sample_visible_bounded(wo, u),
-            _ => mf.sample_wm(u),
+        let wm = match sampler {
+            MicrofacetSampler::Visible => mf.sample_visible(wo, u)?,
+            MicrofacetSampler::SphericalCaps => mf.sample_visible_caps(wo, u),
+            MicrofacetSampler::BoundedVisible => mf.sample_visible_bounded(wo, u),
+            MicrofacetSampler::DCos => mf.sample_wm(u),
         };
         if wo.dot(wm) <= 0.0 {
             return None;
@@ -229,9 +245,63 @@ impl CookTorrance {
         let wi = reflect(wo, wm);
         (wi.z > 0.0).then_some((wi, wm))
     }
+
+    /// The pdf of the reflected direction by `sampler` from the terms it
+    /// shares with `f`: `h` the half vector, `cos_oh = wo·h > 0`,
+    /// `d = D(h)`, `lo` gives `Λ(wo)` (computed only where needed).
+    #[inline]
+    fn pdf_of(
+        &self,
+        sampler: MicrofacetSampler,
+        wo: DVec3,
+        h: DVec3,
+        cos_oh: f64,
+        d: f64,
+        lo: impl FnOnce() -> f64,
+    ) -> f64 {
+        let mf = &self.microfacet;
+        match sampler {
+            MicrofacetSampler::BoundedVisible => mf.pdf_reflect_bounded_d(d, wo),
+            MicrofacetSampler::Visible | MicrofacetSampler::SphericalCaps => {
+                Microfacet::pdf_visible_reflect(d, lo(), wo)
+            }
+            MicrofacetSampler::DCos => mf.pdf_wm(h) / (4.0 * cos_oh),
+        }
+    }
 }
 
 impl Bxdf for CookTorrance {
+    type Sampler = MicrofacetSampler;
+
+    /// | strategy | sampler | needs |
+    /// |---|---|---|
+    /// | `brdf` | [`MicrofacetSampler::DCos`] | |
+    /// | `vndf` | [`MicrofacetSampler::Visible`] | GGX or Beckmann |
+    /// | `spherical-caps` | [`MicrofacetSampler::SphericalCaps`] | GGX |
+    /// | `bounded-vndf` | [`MicrofacetSampler::BoundedVisible`] | GGX |
+    fn sampler(&self, strategy: BsdfStrategy) -> Result<MicrofacetSampler, String> {
+        let ndf = self.microfacet.ndf();
+        match (strategy, ndf) {
+            (BsdfStrategy::Brdf, _) => Ok(MicrofacetSampler::DCos),
+            (BsdfStrategy::Vndf, Ndf::Ggx | Ndf::Beckmann) => Ok(MicrofacetSampler::Visible),
+            (BsdfStrategy::Vndf, _) => {
+                Err("visible-normal sampling needs distribution ggx or beckmann".into())
+            }
+            (BsdfStrategy::SphericalCaps, Ndf::Ggx) => Ok(MicrofacetSampler::SphericalCaps),
+            (BsdfStrategy::BoundedVndf, Ndf::Ggx) => Ok(MicrofacetSampler::BoundedVisible),
+            (BsdfStrategy::SphericalCaps | BsdfStrategy::BoundedVndf, _) => {
+                Err(format!("{strategy} needs distribution ggx"))
+            }
+            (BsdfStrategy::Uniform | BsdfStrategy::Cosine, _) => {
+                Err(format!("{strategy} is drawn by the material, not the lobe"))
+            }
+        }
+    }
+
+    fn scattering(&self) -> Scattering {
+        Scattering::GlossyReflection
+    }
+
     #[inline]
     fn eval(&self, wo: DVec3, wi: DVec3) -> Rgb {
         let Some(h) = (wo + wi).try_normalize() else {
@@ -250,15 +320,15 @@ impl Bxdf for CookTorrance {
     }
 
     #[inline]
-    fn sample(&self, strategy: BsdfStrategy, wo: DVec3, u: DVec2) -> Option<DVec3> {
-        self.sample_wm(strategy, wo, u).map(|(wi, _)| wi)
+    fn sample(&self, sampler: MicrofacetSampler, wo: DVec3, u: DVec2) -> Option<DVec3> {
+        self.sample_wm(sampler, wo, u).map(|(wi, _)| wi)
     }
 
     /// The sampled `wm` is the half vector of `wo` and the reflected `wi`,
     /// so `D(wm)` and `Λ(wo)` serve `f` and the pdf at once.
     #[inline]
-    fn sample_eval(&self, strategy: BsdfStrategy, wo: DVec3, u: DVec2) -> Option<(DVec3, Rgb, f64)> {
-        let (wi, wm) = self.sample_wm(strategy, wo, u)?;
+    fn sample_eval(&self, sampler: MicrofacetSampler, wo: DVec3, u: DVec2) -> Option<LobeSample> {
+        let (wi, wm) = self.sample_wm(sampler, wo, u)?;
         let mf = &self.microfacet;
         let cos_oh = wo.dot(wm);
         let d = mf.d(wm);
@@ -266,22 +336,28 @@ impl Bxdf for CookTorrance {
         let g = mf.g_with_lambda_o(self.shadowing, lo, wo, wi, wm);
         let inv4o = 0.25 / wo.z;
         let dg = d * g * inv4o / wi.z;
-        let pdf = match strategy {
-            BsdfStrategy::Vndf | BsdfStrategy::SphericalCaps => Microfacet::pdf_visible_reflect(d, lo, wo),
-            BsdfStrategy::BoundedVndf => mf.pdf_reflect_bounded(wo, wi),
-            _ => mf.pdf_wm(wm) * 0.25 / cos_oh,
+        let pdf = match sampler {
+            MicrofacetSampler::Visible | MicrofacetSampler::SphericalCaps => {
+                Microfacet::pdf_visible_reflect(d, lo, wo)
+            }
+            MicrofacetSampler::BoundedVisible => mf.pdf_reflect_bounded(wo, wi),
+            MicrofacetSampler::DCos => mf.pdf_wm(wm) * 0.25 / cos_oh,
         };
         if !(dg.is_finite() && pdf.is_finite()) {
             return None;
         }
-        Some((wi, self.ks * self.fresnel.eval(cos_oh) * dg, pdf))
+        Some(LobeSample {
+            wi,
+            f: self.ks * self.fresnel.eval(cos_oh) * dg,
+            pdf,
+        })
     }
 
     #[inline]
-    fn pdf(&self, strategy: BsdfStrategy, wo: DVec3, wi: DVec3) -> f64 {
+    fn pdf(&self, sampler: MicrofacetSampler, wo: DVec3, wi: DVec3) -> f64 {
         let mf = &self.microfacet;
-        // Every strategy draws `wi` by reflecting `wo` about a normal `wm`
-        // with `wo·wm > 0`, so no strategy's density reaches a pair whose
+        // Every sampler draws `wi` by reflecting `wo` about a normal `wm`
+        // with `wo·wm > 0`, so no sampler's density reaches a pair whose
         // half vector faces away from `wo` (for unit vectors only
         // `wi = −wo`; for vectors rounded to f32, pairs near it).
         let Some(h) = (wo + wi).try_normalize() else {
@@ -291,22 +367,16 @@ impl Bxdf for CookTorrance {
         if cos_oh <= 0.0 {
             return 0.0;
         }
-        let p = match strategy {
-            BsdfStrategy::BoundedVndf => mf.pdf_reflect_bounded_d(mf.d(h), wo),
-            BsdfStrategy::Vndf | BsdfStrategy::SphericalCaps => {
-                Microfacet::pdf_visible_reflect(mf.d(h), mf.lambda(wo), wo)
-            }
-            _ => mf.pdf_wm(h) / (4.0 * cos_oh),
-        };
+        let p = self.pdf_of(sampler, wo, h, cos_oh, mf.d(h), || mf.lambda(wo));
         if p.is_finite() { p } else { 0.0 }
     }
 
     /// `eval` and `pdf` sharing the half vector, `D(h)` and `Λ(wo)`; the
     /// same numbers as the two calls.
     #[inline]
-    fn eval_pdf(&self, strategy: BsdfStrategy, wo: DVec3, wi: DVec3) -> (Rgb, f64) {
+    fn eval_pdf(&self, sampler: MicrofacetSampler, wo: DVec3, wi: DVec3) -> (Rgb, f64) {
         let mf = &self.microfacet;
-        // As `pdf`: no strategy reaches a pair with `wo·h <= 0`.
+        // As `pdf`: no sampler reaches a pair with `wo·h <= 0`.
         let Some(h) = (wo + wi).try_normalize() else {
             return (Rgb::ZERO, 0.0);
         };
@@ -322,28 +392,11 @@ impl Bxdf for CookTorrance {
         } else {
             Rgb::ZERO
         };
-        let p = match strategy {
-            BsdfStrategy::BoundedVndf => mf.pdf_reflect_bounded_d(d, wo),
-            BsdfStrategy::Vndf | BsdfStrategy::SphericalCaps => Microfacet::pdf_visible_reflect(d, lo, wo),
-            _ => mf.pdf_wm(h) / (4.0 * cos_oh),
-        };
+        let p = self.pdf_of(sampler, wo, h, cos_oh, d, || lo);
         (f, if p.is_finite() { p } else { 0.0 })
     }
 
     fn albedo_hint(&self, wo: DVec3) -> f64 {
         luminance(self.ks * self.fresnel.eval(wo.z))
-    }
-
-    fn supports(&self, strategy: BsdfStrategy) -> Result<(), String> {
-        let ndf = self.microfacet.ndf();
-        match strategy {
-            BsdfStrategy::Uniform | BsdfStrategy::Cosine | BsdfStrategy::Brdf => Ok(()),
-            BsdfStrategy::Vndf if ndf != Ndf::BlinnPhong => Ok(()),
-            BsdfStrategy::Vndf => {
-                Err("visible-normal sampling needs distribution ggx or beckmann".into())
-            }
-            BsdfStrategy::SphericalCaps | BsdfStrategy::BoundedVndf if ndf == Ndf::Ggx => Ok(()),
-            _ => Err(format!("{strategy} needs distribution ggx")),
-        }
     }
 }

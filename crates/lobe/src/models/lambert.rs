@@ -12,6 +12,7 @@
 
 use super::{Bxdf, ModelInfo, Param, Range, Value};
 use crate::math::{INV_PI, Rgb};
+use crate::sample::Scattering;
 use crate::{BsdfStrategy, warp};
 use glam::{DVec2, DVec3};
 
@@ -36,11 +37,14 @@ pub const INFO: ModelInfo = ModelInfo {
 };
 
 #[cfg(feature = "desc")]
-fn from_desc(d: &crate::desc::MaterialDesc) -> crate::error::Result<crate::Material> {
-    crate::Material::lambert(
-        d.albedo
-            .map_or(Rgb::splat(DEFAULT_ALBEDO), crate::desc::Color::rgb),
-    )
+fn from_desc(d: &crate::desc::MaterialDesc) -> crate::error::Result<super::Lobes> {
+    Ok(super::Lobes {
+        diffuse: Lambert::new(
+            d.albedo
+                .map_or(Rgb::splat(DEFAULT_ALBEDO), crate::desc::Color::rgb),
+        )?,
+        glossy: super::Glossy::None,
+    })
 }
 
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -56,31 +60,44 @@ impl Lambert {
     }
 }
 
+/// Lambert's one sampler: the cosine-weighted hemisphere (its `brdf`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct CosineSampler;
+
 impl Bxdf for Lambert {
+    type Sampler = CosineSampler;
+
+    /// | strategy | sampler |
+    /// |---|---|
+    /// | `brdf` | [`CosineSampler`] |
+    fn sampler(&self, strategy: BsdfStrategy) -> Result<CosineSampler, String> {
+        match strategy {
+            BsdfStrategy::Brdf => Ok(CosineSampler),
+            _ => Err("a Lambertian term has no microfacets; use uniform, cosine or brdf".into()),
+        }
+    }
+
+    fn scattering(&self) -> Scattering {
+        Scattering::DiffuseReflection
+    }
+
     #[inline]
     fn eval(&self, _wo: DVec3, _wi: DVec3) -> Rgb {
         self.albedo * INV_PI
     }
 
     #[inline]
-    fn sample(&self, _strategy: BsdfStrategy, _wo: DVec3, u: DVec2) -> Option<DVec3> {
+    fn sample(&self, _: CosineSampler, _wo: DVec3, u: DVec2) -> Option<DVec3> {
         let wi = warp::square_to_cosine_hemisphere(u);
         (wi.z > 0.0).then_some(wi)
     }
 
     #[inline]
-    fn pdf(&self, _strategy: BsdfStrategy, _wo: DVec3, wi: DVec3) -> f64 {
+    fn pdf(&self, _: CosineSampler, _wo: DVec3, wi: DVec3) -> f64 {
         warp::square_to_cosine_hemisphere_pdf(wi)
     }
 
     fn albedo_hint(&self, _wo: DVec3) -> f64 {
         crate::math::luminance(self.albedo)
-    }
-
-    fn supports(&self, strategy: BsdfStrategy) -> Result<(), String> {
-        match strategy {
-            BsdfStrategy::Uniform | BsdfStrategy::Cosine | BsdfStrategy::Brdf => Ok(()),
-            _ => Err("a Lambertian term has no microfacets; use uniform, cosine or brdf".into()),
-        }
     }
 }

@@ -11,7 +11,7 @@
 //! A table is read once per process (per file, size, modification time and
 //! interpolation), stored as `f32`, and shared by every material that names
 //! it: the lobe holds a `&'static` reference to it, so that [`Measured`]
-//! (and [`crate::Material`]) stay `Copy`. The tables are never freed.
+//! (and a material) stay `Copy`. The tables are never freed.
 //!
 //! * MERL ([`merl`]): RGB per (θh, θd, φd) entry, nearest or trilinear; a
 //!   missing entry (negative in the file) reflects nothing.
@@ -31,6 +31,7 @@
 
 use super::{Bxdf, ModelInfo, Param, Range, Value};
 use crate::math::Rgb;
+use crate::sample::Scattering;
 use crate::{BsdfStrategy, Error};
 use glam::{DVec2, DVec3};
 use std::collections::HashMap;
@@ -70,7 +71,7 @@ pub const INFO: ModelInfo = ModelInfo {
 };
 
 #[cfg(feature = "desc")]
-fn from_desc(d: &crate::desc::MaterialDesc) -> crate::error::Result<crate::Material> {
+fn from_desc(d: &crate::desc::MaterialDesc) -> crate::error::Result<super::Lobes> {
     let Some(path) = d.path.as_deref() else {
         return Err(Error::param(
             "path",
@@ -94,7 +95,7 @@ fn from_desc(d: &crate::desc::MaterialDesc) -> crate::error::Result<crate::Mater
         _ => PathBuf::from(path),
     };
     let lobe = Measured::load(&path, interpolation)?;
-    crate::Material::with_diffuse(Rgb::ZERO, super::Glossy::Measured(lobe))
+    super::Lobes::with_diffuse(Rgb::ZERO, super::Glossy::Measured(lobe))
 }
 
 /// A table as read from a file.
@@ -299,36 +300,26 @@ impl Measured {
     }
 }
 
+/// A measured table's samplers.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum MeasuredSampler {
+    /// The tabulated half-vector sampler built from the data (`brdf`).
+    HalfVector,
+    /// An RGL file's own luminance and visible-normal warps (`vndf`).
+    Warps,
+}
+
 impl Bxdf for Measured {
-    #[inline]
-    fn eval(&self, wo: DVec3, wi: DVec3) -> Rgb {
-        self.data.table.eval(wo, wi, self.data.interpolation)
-    }
+    type Sampler = MeasuredSampler;
 
-    #[inline]
-    fn sample(&self, strategy: BsdfStrategy, wo: DVec3, u: DVec2) -> Option<DVec3> {
+    /// | strategy | sampler | needs |
+    /// |---|---|---|
+    /// | `brdf` | [`MeasuredSampler::HalfVector`] | |
+    /// | `vndf` | [`MeasuredSampler::Warps`] | an RGL file |
+    fn sampler(&self, strategy: BsdfStrategy) -> Result<MeasuredSampler, String> {
         match (strategy, &self.data.table) {
-            (BsdfStrategy::Vndf, Table::Rgl(r)) => r.sample_warps(wo, u),
-            _ => self.data.sampler.sample(wo, u),
-        }
-    }
-
-    #[inline]
-    fn pdf(&self, strategy: BsdfStrategy, wo: DVec3, wi: DVec3) -> f64 {
-        match (strategy, &self.data.table) {
-            (BsdfStrategy::Vndf, Table::Rgl(r)) => r.pdf_warps(wo, wi),
-            _ => self.data.sampler.pdf(wo, wi),
-        }
-    }
-
-    fn albedo_hint(&self, wo: DVec3) -> f64 {
-        self.data.sampler.albedo(wo)
-    }
-
-    fn supports(&self, strategy: BsdfStrategy) -> Result<(), String> {
-        match (strategy, &self.data.table) {
-            (BsdfStrategy::Uniform | BsdfStrategy::Cosine | BsdfStrategy::Brdf, _)
-            | (BsdfStrategy::Vndf, Table::Rgl(_)) => Ok(()),
+            (BsdfStrategy::Brdf, _) => Ok(MeasuredSampler::HalfVector),
+            (BsdfStrategy::Vndf, Table::Rgl(_)) => Ok(MeasuredSampler::Warps),
             (BsdfStrategy::Vndf, Table::Merl(_)) => Err(
                 "a MERL table has no visible-normal warp (RGL files do); use uniform, cosine or brdf (its tabulated sampler)"
                     .into(),
@@ -338,5 +329,37 @@ impl Bxdf for Measured {
                     .into(),
             ),
         }
+    }
+
+    fn scattering(&self) -> Scattering {
+        Scattering::GlossyReflection
+    }
+
+    #[inline]
+    fn eval(&self, wo: DVec3, wi: DVec3) -> Rgb {
+        self.data.table.eval(wo, wi, self.data.interpolation)
+    }
+
+    #[inline]
+    fn sample(&self, sampler: MeasuredSampler, wo: DVec3, u: DVec2) -> Option<DVec3> {
+        match (sampler, &self.data.table) {
+            (MeasuredSampler::Warps, Table::Rgl(r)) => r.sample_warps(wo, u),
+            // `Warps` is given for RGL files only (`sampler`).
+            (MeasuredSampler::Warps, Table::Merl(_)) => None,
+            (MeasuredSampler::HalfVector, _) => self.data.sampler.sample(wo, u),
+        }
+    }
+
+    #[inline]
+    fn pdf(&self, sampler: MeasuredSampler, wo: DVec3, wi: DVec3) -> f64 {
+        match (sampler, &self.data.table) {
+            (MeasuredSampler::Warps, Table::Rgl(r)) => r.pdf_warps(wo, wi),
+            (MeasuredSampler::Warps, Table::Merl(_)) => 0.0,
+            (MeasuredSampler::HalfVector, _) => self.data.sampler.pdf(wo, wi),
+        }
+    }
+
+    fn albedo_hint(&self, wo: DVec3) -> f64 {
+        self.data.sampler.albedo(wo)
     }
 }

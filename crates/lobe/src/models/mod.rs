@@ -1,60 +1,74 @@
-//! The reflection models, one file each. Each is a *lobe*: a material
-//! ([`crate::Material`]) is a Lambertian term plus at most one glossy lobe.
+//! The reflection models, one file each. Each is a *lobe*: one term of a
+//! material's BRDF (a material is a Lambertian lobe plus at most one
+//! glossy lobe, [`Lobes`]); a *model* is the kind of lobe (its `type` name and
+//! file); [`Bxdf`] is the interface every lobe implements.
 //!
 //! A model file holds everything about its model: the type, its
 //! [`Bxdf`] implementation, its parameter table ([`Param`]s, with ranges and
 //! defaults, from which its doc table and the text of `lobe eval --help`
-//! are made), its range checks, and how it is built from a
-//! [`crate::MaterialDesc`]. It publishes all of that as one [`ModelInfo`]
-//! named `INFO`. Adding a model is one new file and one line in the list at
-//! the end of this file ([`MODELS`], and the [`Glossy`] variant that the same
-//! line declares).
+//! are made), its table of strategies ([`Bxdf::sampler`]: one arm per
+//! strategy it has, into a small `Copy` sampler value), its range checks,
+//! and how it is built from a material description. It publishes all of
+//! that as one [`ModelInfo`] named `INFO`. Adding a model is one new file
+//! and one line in the list at the end of this file ([`MODELS`], and the
+//! [`Glossy`] and [`GlossySampler`] variants that the same line declares);
+//! docs/ARCHITECTURE.md has the checklist.
 
 use crate::BsdfStrategy;
 use crate::math::Rgb;
+use crate::sample::{LobeSample, Scattering};
 use glam::{DVec2, DVec3};
 use std::fmt::{self, Write as _};
 
 pub mod lambert;
 pub use lambert::Lambert;
 
-/// One lobe of a material, evaluated and sampled by its own strategy
-/// (`BsdfStrategy::Brdf` and the microfacet strategies). `uniform` and `cosine`
-/// are handled by [`crate::Material`] for every model.
+/// One lobe of a material, evaluated and sampled by its own samplers.
+/// `uniform` and `cosine` ignore the lobe: the material draws them
+/// for every model, so a model's table of strategies lists only its own
+/// (`brdf` and the microfacet strategies).
 ///
-/// The caller guarantees `wo.z > 0` (and `wi.z > 0` for `eval` and `pdf`).
-pub trait Bxdf {
+/// A strategy is resolved once, by [`Bxdf::sampler`], into a small `Copy`
+/// value of the model's own type; `sample` and `pdf` take that value and
+/// never see a strategy it does not have. The caller guarantees `wo.z > 0`
+/// (and `wi.z > 0` for `eval` and `pdf`).
+pub trait Bxdf: Copy {
+    /// The model's samplers: one value per strategy it has (an enum, or a
+    /// unit struct where it has one).
+    type Sampler: Copy + fmt::Debug + PartialEq;
+    /// The model's table of strategies: the sampler for `strategy`, or why
+    /// the model has none (the caller lists the strategies it has).
+    fn sampler(&self, strategy: BsdfStrategy) -> Result<Self::Sampler, String>;
+    /// What its samples are: reflection or transmission; diffuse, glossy or
+    /// specular.
+    fn scattering(&self) -> Scattering;
     /// `f_r(wo, wi)` of this lobe, without the cosine.
     fn eval(&self, wo: DVec3, wi: DVec3) -> Rgb;
-    /// Draw `wi` by the lobe's sampler for `strategy`; `None` for a failed
-    /// sample (below the horizon).
-    fn sample(&self, strategy: BsdfStrategy, wo: DVec3, u: DVec2) -> Option<DVec3>;
+    /// Draw `wi` by `sampler`; `None` for a failed sample (below the horizon).
+    fn sample(&self, sampler: Self::Sampler, wo: DVec3, u: DVec2) -> Option<DVec3>;
     /// Density in solid angle of what `sample` returns.
-    fn pdf(&self, strategy: BsdfStrategy, wo: DVec3, wi: DVec3) -> f64;
+    fn pdf(&self, sampler: Self::Sampler, wo: DVec3, wi: DVec3) -> f64;
     /// `sample`, and `eval` and `pdf` at the sampled direction, sharing what
     /// they have in common (a model may override it for speed).
     #[inline]
-    fn sample_eval(
-        &self,
-        strategy: BsdfStrategy,
-        wo: DVec3,
-        u: DVec2,
-    ) -> Option<(DVec3, Rgb, f64)> {
-        let wi = self.sample(strategy, wo, u)?;
-        Some((wi, self.eval(wo, wi), self.pdf(strategy, wo, wi)))
+    fn sample_eval(&self, sampler: Self::Sampler, wo: DVec3, u: DVec2) -> Option<LobeSample> {
+        let wi = self.sample(sampler, wo, u)?;
+        Some(LobeSample {
+            wi,
+            f: self.eval(wo, wi),
+            pdf: self.pdf(sampler, wo, wi),
+        })
     }
     /// `(eval, pdf)` at one `wi`, sharing what they have in common (a model
     /// may override it for speed; the numbers must be the same as the two
     /// calls).
     #[inline]
-    fn eval_pdf(&self, strategy: BsdfStrategy, wo: DVec3, wi: DVec3) -> (Rgb, f64) {
-        (self.eval(wo, wi), self.pdf(strategy, wo, wi))
+    fn eval_pdf(&self, sampler: Self::Sampler, wo: DVec3, wi: DVec3) -> (Rgb, f64) {
+        (self.eval(wo, wi), self.pdf(sampler, wo, wi))
     }
     /// An estimate of the lobe's directional albedo (luminance), used to
     /// choose between lobes.
     fn albedo_hint(&self, wo: DVec3) -> f64;
-    /// `Ok` when the lobe has its own sampler for `strategy`; otherwise why not.
-    fn supports(&self, strategy: BsdfStrategy) -> Result<(), String>;
 }
 
 /// What a key of a material description accepts.
@@ -221,10 +235,10 @@ pub struct ModelInfo {
     pub name: &'static str,
     /// Its keys, in the order the docs show them.
     pub params: &'static [Param],
-    /// Build the material from a description whose keys all belong to
-    /// `params` (checked by [`crate::MaterialDesc::build`]).
+    /// Build the material's lobes from a description whose keys all belong
+    /// to `params` (checked by `MaterialDesc::build`).
     #[cfg(feature = "desc")]
-    pub from_desc: fn(&crate::desc::MaterialDesc) -> crate::error::Result<crate::Material>,
+    pub from_desc: fn(&crate::desc::MaterialDesc) -> crate::error::Result<Lobes>,
 }
 
 impl ModelInfo {
@@ -261,6 +275,27 @@ pub fn find(name: &str) -> Option<&'static ModelInfo> {
 #[must_use]
 pub fn names(sep: &str) -> String {
     MODELS.iter().map(|m| m.name).collect::<Vec<_>>().join(sep)
+}
+
+/// A material's lobes, as a model builds them from a description: a
+/// Lambertian term and at most one glossy lobe. `Material` is made of them.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Lobes {
+    pub diffuse: Lambert,
+    pub glossy: Glossy,
+}
+
+impl Lobes {
+    /// A glossy lobe plus a diffuse term `kd/π`; the error names `kd`.
+    pub fn with_diffuse(kd: Rgb, glossy: Glossy) -> crate::error::Result<Self> {
+        let diffuse = Lambert::new(kd).map_err(|_| {
+            crate::Error::param(
+                "kd",
+                format!("{kd} is out of range: each channel must be in [0, 1]"),
+            )
+        })?;
+        Ok(Lobes { diffuse, glossy })
+    }
 }
 
 /// The key `kd` of every glossy model: the diffuse term the material adds.
@@ -301,8 +336,9 @@ fn lecture_keys(
 pub const MAX_EXPONENT: f64 = 1e7;
 
 /// Declares the glossy models, one line each: the module, the type (which
-/// names the [`Glossy`] variant), and puts the module's `INFO` in [`MODELS`].
-/// [`Glossy`] implements [`Bxdf`] by static dispatch over the variants.
+/// names the [`Glossy`] and [`GlossySampler`] variants), and puts the
+/// module's `INFO` in [`MODELS`]. Both enums dispatch statically over the
+/// variants.
 macro_rules! glossy_models {
     ($($module:ident :: $ty:ident),* $(,)?) => {
         $(pub mod $module; pub use $module::$ty;)*
@@ -310,11 +346,21 @@ macro_rules! glossy_models {
         /// Every model, Lambert first.
         pub const MODELS: &[&ModelInfo] = &[&lambert::INFO, $(&$module::INFO),*];
 
-        /// The glossy lobe of a material (static dispatch).
+        /// The glossy lobe of a material (static dispatch). `None` reflects
+        /// nothing.
         #[derive(Debug, Clone, Copy, PartialEq)]
         pub enum Glossy {
             None,
             $($ty($ty)),*
+        }
+
+        /// A glossy lobe with one of its samplers ([`Glossy::sampler`]):
+        /// what a material's sampler draws the glossy lobe with. `None`
+        /// draws nothing.
+        #[derive(Debug, Clone, Copy, PartialEq)]
+        pub enum GlossySampler {
+            None,
+            $($ty($ty, <$ty as Bxdf>::Sampler)),*
         }
 
         impl Glossy {
@@ -326,57 +372,81 @@ macro_rules! glossy_models {
                     $(Glossy::$ty(_) => $module::INFO.name),*
                 }
             }
-        }
 
-        /// `Glossy::None` is the lobe that reflects nothing and samples
-        /// nothing.
-        impl Bxdf for Glossy {
+            /// The lobe's sampler for `strategy` ([`Bxdf::sampler`]), or why
+            /// it has none.
+            pub fn sampler(&self, strategy: BsdfStrategy) -> Result<GlossySampler, String> {
+                match self {
+                    Glossy::None => Err("no glossy lobe".into()),
+                    $(Glossy::$ty(l) => Ok(GlossySampler::$ty(*l, l.sampler(strategy)?))),*
+                }
+            }
+
+            /// What the lobe's samples are; `None` for no lobe.
+            #[must_use]
+            pub fn scattering(&self) -> Option<Scattering> {
+                match self {
+                    Glossy::None => None,
+                    $(Glossy::$ty(l) => Some(l.scattering())),*
+                }
+            }
+
+            /// [`Bxdf::eval`]; zero for no lobe.
             #[inline]
-            fn eval(&self, wo: DVec3, wi: DVec3) -> Rgb {
+            #[must_use]
+            pub fn eval(&self, wo: DVec3, wi: DVec3) -> Rgb {
                 match self {
                     Glossy::None => Rgb::ZERO,
                     $(Glossy::$ty(l) => l.eval(wo, wi)),*
                 }
             }
+
+            /// [`Bxdf::albedo_hint`]; zero for no lobe.
             #[inline]
-            fn sample(&self, strategy: BsdfStrategy, wo: DVec3, u: DVec2) -> Option<DVec3> {
-                match self {
-                    Glossy::None => None,
-                    $(Glossy::$ty(l) => l.sample(strategy, wo, u)),*
-                }
-            }
-            #[inline]
-            fn pdf(&self, strategy: BsdfStrategy, wo: DVec3, wi: DVec3) -> f64 {
-                match self {
-                    Glossy::None => 0.0,
-                    $(Glossy::$ty(l) => l.pdf(strategy, wo, wi)),*
-                }
-            }
-            #[inline]
-            fn sample_eval(&self, strategy: BsdfStrategy, wo: DVec3, u: DVec2) -> Option<(DVec3, Rgb, f64)> {
-                match self {
-                    Glossy::None => None,
-                    $(Glossy::$ty(l) => l.sample_eval(strategy, wo, u)),*
-                }
-            }
-            #[inline]
-            fn eval_pdf(&self, strategy: BsdfStrategy, wo: DVec3, wi: DVec3) -> (Rgb, f64) {
-                match self {
-                    Glossy::None => (Rgb::ZERO, 0.0),
-                    $(Glossy::$ty(l) => l.eval_pdf(strategy, wo, wi)),*
-                }
-            }
-            #[inline]
-            fn albedo_hint(&self, wo: DVec3) -> f64 {
+            #[must_use]
+            pub fn albedo_hint(&self, wo: DVec3) -> f64 {
                 match self {
                     Glossy::None => 0.0,
                     $(Glossy::$ty(l) => l.albedo_hint(wo)),*
                 }
             }
-            fn supports(&self, strategy: BsdfStrategy) -> Result<(), String> {
+        }
+
+        impl GlossySampler {
+            /// [`Bxdf::sample`].
+            #[inline]
+            #[must_use]
+            pub fn sample(&self, wo: DVec3, u: DVec2) -> Option<DVec3> {
                 match self {
-                    Glossy::None => Err("no glossy lobe".into()),
-                    $(Glossy::$ty(l) => l.supports(strategy)),*
+                    GlossySampler::None => None,
+                    $(GlossySampler::$ty(l, s) => l.sample(*s, wo, u)),*
+                }
+            }
+            /// [`Bxdf::pdf`].
+            #[inline]
+            #[must_use]
+            pub fn pdf(&self, wo: DVec3, wi: DVec3) -> f64 {
+                match self {
+                    GlossySampler::None => 0.0,
+                    $(GlossySampler::$ty(l, s) => l.pdf(*s, wo, wi)),*
+                }
+            }
+            /// [`Bxdf::sample_eval`].
+            #[inline]
+            #[must_use]
+            pub fn sample_eval(&self, wo: DVec3, u: DVec2) -> Option<LobeSample> {
+                match self {
+                    GlossySampler::None => None,
+                    $(GlossySampler::$ty(l, s) => l.sample_eval(*s, wo, u)),*
+                }
+            }
+            /// [`Bxdf::eval_pdf`].
+            #[inline]
+            #[must_use]
+            pub fn eval_pdf(&self, wo: DVec3, wi: DVec3) -> (Rgb, f64) {
+                match self {
+                    GlossySampler::None => (Rgb::ZERO, 0.0),
+                    $(GlossySampler::$ty(l, s) => l.eval_pdf(*s, wo, wi)),*
                 }
             }
         }
@@ -446,35 +516,6 @@ fn defaults_text() -> String {
         let _ = write!(s, "\n  {object:<35} {says}");
     }
     s
-}
-
-#[cfg(feature = "desc")]
-impl crate::desc::MaterialDesc {
-    /// Check every field and build the material: the model's own
-    /// [`crate::models::ModelInfo::from_desc`], once every key given is
-    /// known to belong to the model.
-    pub fn build(&self) -> Result<crate::Material, crate::Error> {
-        let kind = self.kind.as_str();
-        let Some(model) = find(kind) else {
-            return Err(crate::Error::UnknownName {
-                field: "type".into(),
-                value: self.kind.clone(),
-                expected: names(", "),
-            });
-        };
-        for (name, present) in self.present_fields() {
-            if present && !model.keys().any(|k| k == name) {
-                return Err(crate::Error::param(
-                    name,
-                    format!(
-                        "does not apply to type {kind} (its keys: {})",
-                        model.keys().collect::<Vec<_>>().join(", ")
-                    ),
-                ));
-            }
-        }
-        (model.from_desc)(self)
-    }
 }
 
 #[cfg(test)]

@@ -30,6 +30,7 @@
 
 use super::{Bxdf, MAX_EXPONENT, ModelInfo, Param, Range, Value};
 use crate::math::{INV_TWO_PI, Rgb, luminance, mirror_z};
+use crate::sample::Scattering;
 use crate::{Frame, BsdfStrategy, warp};
 use glam::{DVec2, DVec3};
 
@@ -69,10 +70,10 @@ pub const INFO: ModelInfo = ModelInfo {
 };
 
 #[cfg(feature = "desc")]
-fn from_desc(d: &crate::desc::MaterialDesc) -> crate::error::Result<crate::Material> {
+fn from_desc(d: &crate::desc::MaterialDesc) -> crate::error::Result<super::Lobes> {
     let (ks, kd, exponent, normalized) = super::lecture_keys(d, KS, EXPONENT, NORMALIZED);
     let lobe = Phong::new(ks, exponent, normalized)?;
-    crate::Material::with_diffuse(kd, super::Glossy::Phong(lobe))
+    super::Lobes::with_diffuse(kd, super::Glossy::Phong(lobe))
 }
 
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -108,21 +109,41 @@ impl Phong {
     }
 }
 
+/// Phong's one sampler: `cosⁿα` around the mirror direction (its `brdf`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct MirrorLobeSampler;
+
 impl Bxdf for Phong {
+    type Sampler = MirrorLobeSampler;
+
+    /// | strategy | sampler |
+    /// |---|---|
+    /// | `brdf` | [`MirrorLobeSampler`] |
+    fn sampler(&self, strategy: BsdfStrategy) -> Result<MirrorLobeSampler, String> {
+        match strategy {
+            BsdfStrategy::Brdf => Ok(MirrorLobeSampler),
+            _ => Err("Phong has no microfacet distribution; use uniform, cosine or brdf".into()),
+        }
+    }
+
+    fn scattering(&self) -> Scattering {
+        Scattering::GlossyReflection
+    }
+
     #[inline]
     fn eval(&self, wo: DVec3, wi: DVec3) -> Rgb {
         self.ks * (self.norm() * Self::cos_alpha(wo, wi).powf(self.exponent))
     }
 
     #[inline]
-    fn sample(&self, _strategy: BsdfStrategy, wo: DVec3, u: DVec2) -> Option<DVec3> {
+    fn sample(&self, _: MirrorLobeSampler, wo: DVec3, u: DVec2) -> Option<DVec3> {
         let local = warp::square_to_cos_power(u, self.exponent);
         let wi = Frame::from_normal(mirror_z(wo)).to_world(local);
         (wi.z > 0.0).then_some(wi)
     }
 
     #[inline]
-    fn pdf(&self, _strategy: BsdfStrategy, wo: DVec3, wi: DVec3) -> f64 {
+    fn pdf(&self, _: MirrorLobeSampler, wo: DVec3, wi: DVec3) -> f64 {
         warp::cos_power_pdf(mirror_z(wo).dot(wi), self.exponent)
     }
 
@@ -132,13 +153,6 @@ impl Bxdf for Phong {
             a
         } else {
             a * 2.0 / (self.exponent + 2.0) * std::f64::consts::PI
-        }
-    }
-
-    fn supports(&self, strategy: BsdfStrategy) -> Result<(), String> {
-        match strategy {
-            BsdfStrategy::Uniform | BsdfStrategy::Cosine | BsdfStrategy::Brdf => Ok(()),
-            _ => Err("Phong has no microfacet distribution; use uniform, cosine or brdf".into()),
         }
     }
 }

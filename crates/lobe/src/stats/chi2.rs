@@ -80,22 +80,6 @@ impl Default for Chi2Config {
 pub const TABLE_MAX_EVALS_PER_CELL: usize = 4000;
 
 impl Chi2Config {
-    /// The default configuration with the cell budget that suits the
-    /// samplers of `m`: [`TABLE_MAX_EVALS_PER_CELL`] for a measured table,
-    /// the default for an analytic model.
-    #[must_use]
-    pub fn for_material(m: &crate::Material) -> Self {
-        let base = Self::default();
-        if m.measured().is_some() {
-            Self {
-                max_evals_per_cell: TABLE_MAX_EVALS_PER_CELL,
-                ..base
-            }
-        } else {
-            base
-        }
-    }
-
     /// Bounds `(z0, z1, phi0, phi1)` of cell `(iz, iphi)`.
     #[must_use]
     pub fn cell_bounds(&self, iz: usize, iphi: usize) -> (f64, f64, f64, f64) {

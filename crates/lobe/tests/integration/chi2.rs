@@ -32,8 +32,8 @@ fn run(cases: Vec<Case>) {
             let t0 = std::time::Instant::now();
             let r = chi2_test(
                 &cfg,
-                |uc, u| m.sample(s, wo, uc, u).map(|x| x.wi),
-                |wi| m.pdf(s, wo, wi),
+                |uc, u| m.sampler(s).unwrap().sample(wo, uc, u).map(|x| x.wi),
+                |wi| m.sampler(s).unwrap().pdf(wo, wi),
             );
             let label = format!("{}_{}_theta{}", c.name, s, theta);
             if std::env::var_os("LOBE_CHI2_VERBOSE").is_some() {
@@ -63,7 +63,7 @@ fn run(cases: Vec<Case>) {
                 _ => vec![(p, 0.5 * p), (1.0 - p, 0.5 * (1.0 + p))],
             };
             let kept = success_probability(
-                |uc, u: DVec2| m.sample(s, wo, uc, u).is_some(),
+                |uc, u: DVec2| m.sampler(s).unwrap().sample(wo, uc, u).is_some(),
                 &lobes,
                 1024,
             );
@@ -182,7 +182,7 @@ fn chi2_catches_a_wrong_pdf() {
     // The lecture's density over half vectors, used as if it were over wi.
     let r = chi2_test(
         &Chi2Config::default(),
-        |uc, u| m.sample(BsdfStrategy::Brdf, wo, uc, u).map(|x| x.wi),
+        |uc, u| m.sampler(BsdfStrategy::Brdf).unwrap().sample(wo, uc, u).map(|x| x.wi),
         |wi| {
             let h = (wo + wi).normalize();
             if wi.z > 0.0 {

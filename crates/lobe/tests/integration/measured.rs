@@ -188,7 +188,7 @@ fn chi2_of_the_tabulated_sampler() {
         samples: 400_000,
         n_z: 40,
         n_phi: 80,
-        ..Chi2Config::for_material(ggx_merl())
+        ..lobe::experiment::warp_test::chi2_config(ggx_merl())
     };
     assert_eq!(cfg.max_evals_per_cell, TABLE_MAX_EVALS_PER_CELL);
     let cases: [(&str, &Material); 3] = [
@@ -207,8 +207,8 @@ fn chi2_of_the_tabulated_sampler() {
             let o = wo(theta);
             let r = chi2_test(
                 &cfg,
-                |uc, u| m.sample(BsdfStrategy::Brdf, o, uc, u).map(|s| s.wi),
-                |wi| m.pdf(BsdfStrategy::Brdf, o, wi),
+                |uc, u| m.sampler(BsdfStrategy::Brdf).unwrap().sample(o, uc, u).map(|s| s.wi),
+                |wi| m.sampler(BsdfStrategy::Brdf).unwrap().pdf(o, wi),
             );
             eprintln!(
                 "{name} θo={theta}: χ² = {:.1}, dof {}, p = {:.3}",
@@ -242,13 +242,13 @@ fn sampled_pdf_is_the_pdf_of_the_pair() {
         for _ in 0..20_000 {
             let o = dir_of(rng.random::<f64>() * 89.0, rng.random::<f64>() * 360.0);
             let u = DVec2::new(rng.random(), rng.random());
-            let Some(s) = m.sample(BsdfStrategy::Brdf, o, rng.random(), u) else {
+            let Some(s) = m.sampler(BsdfStrategy::Brdf).unwrap().sample(o, rng.random(), u) else {
                 continue;
             };
             n += 1;
-            let p = m.pdf(BsdfStrategy::Brdf, o, s.wi);
+            let p = m.sampler(BsdfStrategy::Brdf).unwrap().pdf(o, s.wi);
             assert!((s.pdf - p).abs() <= 1e-12 * p, "{} vs {p}", s.pdf);
-            let (f, p2) = m.eval_pdf(BsdfStrategy::Brdf, o, s.wi);
+            let (f, p2) = m.sampler(BsdfStrategy::Brdf).unwrap().eval_pdf(o, s.wi);
             assert_eq!((f, p2), (m.eval(o, s.wi), p));
             assert_eq!(s.f, f);
             // Swapping the directions is another pair: its pdf is its own.
@@ -650,8 +650,8 @@ fn chi2_of_the_rgl_warps() {
         let o = dir_of(theta, 30.0);
         let r = chi2_test(
             &cfg,
-            |uc, u| m.sample(BsdfStrategy::Vndf, o, uc, u).map(|s| s.wi),
-            |wi| m.pdf(BsdfStrategy::Vndf, o, wi),
+            |uc, u| m.sampler(BsdfStrategy::Vndf).unwrap().sample(o, uc, u).map(|s| s.wi),
+            |wi| m.sampler(BsdfStrategy::Vndf).unwrap().pdf(o, wi),
         );
         eprintln!(
             "beckmann-rgl vndf θo={theta}: χ² = {:.1}, dof {}, p = {:.3}, ∫pdf = {:.4}, lost {}",
@@ -671,8 +671,8 @@ fn chi2_of_the_rgl_warps() {
                 (k as f64 + 0.5) / 200.0,
                 ((k * 37) % 200) as f64 / 200.0 + 0.0025,
             );
-            if let Some(s) = m.sample(BsdfStrategy::Vndf, o, 0.5, u) {
-                let p = m.pdf(BsdfStrategy::Vndf, o, s.wi);
+            if let Some(s) = m.sampler(BsdfStrategy::Vndf).unwrap().sample(o, 0.5, u) {
+                let p = m.sampler(BsdfStrategy::Vndf).unwrap().pdf(o, s.wi);
                 assert!(
                     p > 0.0 && (s.pdf - p).abs() <= 1e-12 * p,
                     "{} vs {p}",

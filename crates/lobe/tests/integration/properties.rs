@@ -38,7 +38,7 @@ fn sample_pdf_and_weight_agree_with_pdf_and_eval() {
             for _ in 0..2000 {
                 let wo = random_wo(&mut rng);
                 let (uc, u) = (rng.random::<f64>(), DVec2::new(rng.random(), rng.random()));
-                let Some(x) = m.sample(s, wo, uc, u) else {
+                let Some(x) = m.sampler(s).unwrap().sample(wo, uc, u) else {
                     continue;
                 };
                 assert!(
@@ -47,7 +47,7 @@ fn sample_pdf_and_weight_agree_with_pdf_and_eval() {
                     c.json,
                     x.wi
                 );
-                let pdf = m.pdf(s, wo, x.wi);
+                let pdf = m.sampler(s).unwrap().pdf(wo, x.wi);
                 assert!(
                     (x.pdf - pdf).abs() <= 1e-4 * pdf,
                     "{} {s}: sample pdf {} vs pdf() {pdf}",
@@ -139,7 +139,7 @@ fn lambert_furnace_is_exact() {
         for s in [BsdfStrategy::Cosine, BsdfStrategy::Brdf] {
             let x = c
                 .material
-                .sample(s, wo, rng.random(), DVec2::new(rng.random(), rng.random()))
+                .sampler(s).unwrap().sample(wo, rng.random(), DVec2::new(rng.random(), rng.random()))
                 .unwrap();
             assert!(
                 (x.weight - Rgb::new(0.2, 0.5, 0.9)).abs().max_element() < 1e-12,
@@ -214,7 +214,7 @@ fn every_strategy_is_unbiased() {
         for _ in 0..200_000 {
             let x = c
                 .material
-                .sample(*s, wo, rng.random(), DVec2::new(rng.random(), rng.random()));
+                .sampler(*s).unwrap().sample(wo, rng.random(), DVec2::new(rng.random(), rng.random()));
             mom.push(x.map_or(0.0, |x| luminance(x.weight)));
         }
         // The quadrature is good to ~1e-7 relative: fold that into the
@@ -283,12 +283,12 @@ fn check_finite(m: &Material, json: &str, wo: DVec3, wi: DVec3, uc: f64, u: DVec
         "{json}: eval({wo}, {wi}) = {f}"
     );
     for s in m.strategies() {
-        let p = m.pdf(s, wo, wi);
+        let p = m.sampler(s).unwrap().pdf(wo, wi);
         assert!(
             p.is_finite() && p >= 0.0,
             "{json} {s}: pdf({wo}, {wi}) = {p}"
         );
-        if let Some(x) = m.sample(s, wo, uc, u) {
+        if let Some(x) = m.sampler(s).unwrap().sample(wo, uc, u) {
             assert!(
                 x.wi.is_finite() && x.pdf.is_finite() && x.pdf > 0.0,
                 "{json} {s}: sample {x:?}"
@@ -404,8 +404,8 @@ fn eval_pdf_is_eval_and_pdf_bit_for_bit() {
                     2 => DVec3::new(1.0, 0.0, 1e-7).normalize(),
                     _ => random_wo(&mut rng),
                 };
-                let (f, p) = m.eval_pdf(s, wo, wi);
-                let (f0, p0) = (m.eval(wo, wi), m.pdf(s, wo, wi));
+                let (f, p) = m.sampler(s).unwrap().eval_pdf(wo, wi);
+                let (f0, p0) = (m.eval(wo, wi), m.sampler(s).unwrap().pdf(wo, wi));
                 assert!(
                     f.to_array().map(f64::to_bits) == f0.to_array().map(f64::to_bits)
                         && p.to_bits() == p0.to_bits(),
