@@ -14,7 +14,7 @@ _root = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
 @pytest.fixture(scope="session")
 def lobe_exe():
     """The `lobe` binary to compare with: $LOBE_BIN, else the newest of the
-    workspace's target/{debug,release}/lobe (the README's test command builds
+    workspace's target/{debug,release}/lobe (bash .ci/test, the README's test command, builds
     target/debug/lobe before pytest runs), else `lobe` on PATH."""
     env = os.environ.get("LOBE_BIN")
     if env:

@@ -14,7 +14,7 @@ use std::time::{Duration, Instant};
 const GGX_02: &str = r#"{"type":"cook-torrance","distribution":"ggx","alpha":0.2}"#;
 const BECKMANN_02: &str = r#"{"type":"cook-torrance","distribution":"beckmann","alpha":0.2}"#;
 
-/// The table of the README (no `--material`): the three rows issue 9 sets
+/// The default table (no `--material`; BENCHMARKS.md): the three rows issue 9 sets
 /// goals for, against Mitsuba 3's figures.
 const DEFAULT_TABLE: [(&str, BsdfStrategy); 3] = [
     (GGX_02, BsdfStrategy::Vndf),
@@ -51,7 +51,7 @@ const QUOTABLE_SAMPLES: usize = 1 << 22;
 )]
 pub struct BenchArgs {
     /// Material: JSON text, @file.json or @file.toml. Without it, the table
-    /// of the README: GGX alpha 0.2 vndf and brdf, Beckmann alpha 0.2 vndf
+    /// of BENCHMARKS.md: GGX alpha 0.2 vndf and brdf, Beckmann alpha 0.2 vndf
     #[arg(long)]
     pub material: Option<String>,
     /// Comma-separated strategies (default: every strategy the material
@@ -337,7 +337,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     if args.samples < QUOTABLE_SAMPLES {
         eprintln!(
             "lobe bench: note: --samples {} is below 2^22 = {QUOTABLE_SAMPLES}: more of the inputs \
-             stay in the caches, so these figures are not comparable with the README's",
+             stay in the caches, so these figures are not comparable with BENCHMARKS.md's",
             args.samples
         );
     }

@@ -29,7 +29,7 @@ fn bench_json_parses() {
     assert!(err.contains("below 2^22"), "{err}");
     let r = v["results"].as_array().unwrap();
     let names: Vec<&str> = r.iter().map(|x| x["strategy"].as_str().unwrap()).collect();
-    // The README's table: GGX vndf, GGX brdf, Beckmann vndf.
+    // The default table (BENCHMARKS.md): GGX vndf, GGX brdf, Beckmann vndf.
     assert_eq!(names, ["vndf", "brdf", "vndf"]);
     assert!(r[2]["material"].as_str().unwrap().contains("beckmann"));
     for x in r {
