@@ -8,6 +8,7 @@
 mod common;
 
 mod adaptive_mis;
+mod checklist;
 mod chi2;
 mod estimator;
 mod lights;

@@ -62,7 +62,7 @@ fn merl_material(json: &str, name: &str, interp: &str) -> Material {
     .unwrap()
 }
 
-fn ggx_merl() -> &'static Material {
+pub(crate) fn ggx_merl() -> &'static Material {
     static M: OnceLock<Material> = OnceLock::new();
     M.get_or_init(|| merl_material(GGX, "ggx.binary", "nearest"))
 }
@@ -72,7 +72,7 @@ fn glossy_merl() -> &'static Material {
     M.get_or_init(|| merl_material(GLOSSY, "glossy.binary", "linear"))
 }
 
-fn beckmann_rgl() -> &'static Material {
+pub(crate) fn beckmann_rgl() -> &'static Material {
     static M: OnceLock<Material> = OnceLock::new();
     M.get_or_init(|| {
         let m = analytic(BECKMANN);

@@ -1,0 +1,153 @@
+//! The "add a model" checklist of docs/ARCHITECTURE.md, enforced: every
+//! model of `lobe::models::MODELS` has a row here, and for every row the
+//! pieces a model needs exist. A model without a row, or a row whose piece
+//! is missing, fails with a message that names the missing piece and where
+//! it goes.
+
+use lobe::batch::BatchSampler;
+use lobe::models::MODELS;
+use lobe::{BsdfStrategy, Material};
+use std::path::Path;
+
+/// One model's pieces.
+struct Row {
+    /// The model's `type` name (`lobe::models::ModelInfo::name`).
+    model: &'static str,
+    /// Materials of the model that between them reach every strategy it
+    /// has.
+    examples: fn() -> Vec<Material>,
+    /// The integration test that runs its samplers' chi-square tests.
+    chi2_test: &'static str,
+    /// How the README's model table names it (the start of its row).
+    readme_row: &'static str,
+}
+
+fn load(json: &str) -> Material {
+    Material::load(json).unwrap_or_else(|e| panic!("{json}: {e}"))
+}
+
+const ROWS: &[Row] = &[
+    Row {
+        model: "lambert",
+        examples: || vec![load(r#"{"type":"lambert"}"#)],
+        chi2_test: "fn chi2_lambert",
+        readme_row: "| Lambert |",
+    },
+    Row {
+        model: "phong",
+        examples: || vec![load(r#"{"type":"phong","exponent":20,"kd":0.3}"#)],
+        chi2_test: "fn chi2_phong_and_blinn_phong",
+        readme_row: "| Phong ",
+    },
+    Row {
+        model: "blinn-phong",
+        examples: || vec![load(r#"{"type":"blinn-phong","exponent":20}"#)],
+        chi2_test: "fn chi2_phong_and_blinn_phong",
+        readme_row: "| Blinn-Phong ",
+    },
+    Row {
+        model: "cook-torrance",
+        examples: || {
+            vec![
+                load(r#"{"type":"cook-torrance","distribution":"ggx","alpha":0.3,"kd":0.2}"#),
+                load(r#"{"type":"cook-torrance","distribution":"beckmann","alpha":0.3}"#),
+                load(r#"{"type":"cook-torrance","distribution":"blinn-phong","alpha":0.3}"#),
+            ]
+        },
+        chi2_test: "fn chi2_microfacet_ggx",
+        readme_row: "| Cook-Torrance",
+    },
+    Row {
+        model: "measured",
+        examples: || vec![*super::measured::ggx_merl(), *super::measured::beckmann_rgl()],
+        chi2_test: "fn chi2_of_the_rgl_warps",
+        readme_row: "| Measured",
+    },
+];
+
+fn read(rel: &str) -> String {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(rel);
+    std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+}
+
+#[test]
+fn every_model_has_its_row() {
+    for m in MODELS {
+        assert!(
+            ROWS.iter().any(|r| r.model == m.name),
+            "model {} has no row in crates/lobe/tests/integration/checklist.rs \
+             (docs/ARCHITECTURE.md, \"Add a model\")",
+            m.name
+        );
+    }
+    for r in ROWS {
+        assert!(
+            MODELS.iter().any(|m| m.name == r.model),
+            "checklist row {} names no model of lobe::models::MODELS",
+            r.model
+        );
+        for m in (r.examples)() {
+            assert_eq!(m.model_name(), r.model, "an example of {} is not one", r.model);
+        }
+    }
+}
+
+/// Every strategy of every model has a batch kernel (`lobe::batch`).
+#[test]
+fn every_strategy_of_every_model_is_batched() {
+    for r in ROWS {
+        let mut reached = Vec::new();
+        for m in (r.examples)() {
+            for s in m.strategies() {
+                if let Err(e) = BatchSampler::new(&m, s) {
+                    panic!(
+                        "model {} strategy {s} has no batch kernel ({e}): add it in \
+                         crates/lobe/src/batch (kernel_for) or say in the batch module \
+                         doc why it is scalar only",
+                        r.model
+                    );
+                }
+                reached.push(s);
+            }
+        }
+        assert!(
+            [BsdfStrategy::Uniform, BsdfStrategy::Cosine, BsdfStrategy::Brdf]
+                .iter()
+                .all(|s| reached.contains(s)),
+            "the examples of {} miss a strategy every model has",
+            r.model
+        );
+    }
+}
+
+/// Every model has a chi-square test of its samplers, a row in the
+/// README's model table and a name in the Python module's docs.
+#[test]
+fn every_model_is_tested_documented_and_named_in_python() {
+    let tests = ["tests/integration/chi2.rs", "tests/integration/measured.rs"]
+        .map(read)
+        .join("\n");
+    let readme = read("../../README.md");
+    let stubs = read("../../python/lobe/_lobe.pyi");
+    for r in ROWS {
+        assert!(
+            tests.contains(r.chi2_test),
+            "model {}: no chi-square test `{}` in crates/lobe/tests/integration",
+            r.model,
+            r.chi2_test
+        );
+        assert!(
+            readme.lines().any(|l| l.starts_with(r.readme_row)),
+            "model {}: no row starting `{}` in the README's model table",
+            r.model,
+            r.readme_row
+        );
+        assert!(
+            [" ", "("].iter().any(|a| [",", ")"]
+                .iter()
+                .any(|b| stubs.contains(&format!("{a}{}{b}", r.model)))),
+            "model {}: not among the model names of python/lobe/_lobe.pyi (Material.model)",
+            r.model
+        );
+    }
+}
