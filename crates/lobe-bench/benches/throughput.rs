@@ -108,7 +108,9 @@ fn throughput(c: &mut Criterion) {
                 }
                 // The material and strategy are runtime values, as in a renderer.
                 // Resolved once per benchmark, as a renderer resolves it once per material.
-                let sampler = m.sampler(strategy).expect("one of the material's strategies");
+                let sampler = m
+                    .sampler(strategy)
+                    .expect("one of the material's strategies");
                 b.iter(|| sample_eval_pdf(black_box(&sampler), black_box(&inputs)));
             });
         }
@@ -127,7 +129,9 @@ fn throughput(c: &mut Criterion) {
     group.throughput(Throughput::Elements(BATCH as u64));
     for strategy in m.strategies() {
         group.bench_function(BenchmarkId::from_parameter(strategy), |b| {
-            let sampler = m.sampler(strategy).expect("one of the material's strategies");
+            let sampler = m
+                .sampler(strategy)
+                .expect("one of the material's strategies");
             b.iter(|| sample_only(black_box(&sampler), black_box(&inputs)));
         });
     }

@@ -13,9 +13,9 @@
 
 use anyhow::{Result, anyhow, bail};
 use glam::{DVec2, DVec3};
+use lobe::BsdfSampler;
 use lobe::experiment::histogram::{WeightPixel, weight_pixels};
 use lobe::experiment::polar::{CurveKind, PolarCurves};
-use lobe::BsdfSampler;
 use plotters::coord::Shift;
 use plotters::coord::ranged1d::{DefaultFormatting, KeyPointHint, Ranged};
 use plotters::prelude::*;
@@ -1729,7 +1729,14 @@ mod tests {
             polar_plot(&p("polar"), "polar", &polar, PolarScale::Linear).unwrap();
             polar_plot(&p("polar-log"), "polar, log", &polar, PolarScale::Log).unwrap();
             warp_histogram(&p("histogram"), "cosine", &o, &e, 16, 0.5).unwrap();
-            weight_heatmap(&p("weights"), "weights", &m.sampler(BsdfStrategy::Uniform).unwrap(), wo, 16).unwrap();
+            weight_heatmap(
+                &p("weights"),
+                "weights",
+                &m.sampler(BsdfStrategy::Uniform).unwrap(),
+                wo,
+                16,
+            )
+            .unwrap();
             for name in [
                 "convergence",
                 "convergence-empty",

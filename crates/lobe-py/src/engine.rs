@@ -457,7 +457,8 @@ impl<'m> Engine<'m> {
         let strategies = material.strategies();
         if !reference {
             for &s in &strategies {
-                if let (Ok(b), Ok(sampler)) = (BatchSampler::new(material, s), material.sampler(s)) {
+                if let (Ok(b), Ok(sampler)) = (BatchSampler::new(material, s), material.sampler(s))
+                {
                     return Engine {
                         material,
                         sampler,
@@ -878,8 +879,10 @@ pub fn sample_scalar_into<T: Real>(
                     let ucv = ucs.as_ref().map_or(0.5, |c| c[i]);
                     let s = sampler.sample(wo, ucv, DVec2::new(u1[i], u2[i]));
                     // A failed sample: zeros.
-                    let (v_wi, v_weight, v_pdf) =
-                        s.map_or((DVec3::ZERO, lobe::Rgb::ZERO, 0.0), |v| (v.wi, v.weight, v.pdf));
+                    let (v_wi, v_weight, v_pdf) = s
+                        .map_or((DVec3::ZERO, lobe::Rgb::ZERO, 0.0), |v| {
+                            (v.wi, v.weight, v.pdf)
+                        });
                     for c in 0..3 {
                         wi[c][i] = T::from_f64(v_wi[c]);
                         w[c][i] = T::from_f64(v_weight[c]);

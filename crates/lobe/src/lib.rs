@@ -90,6 +90,7 @@ pub mod strategy;
 pub mod tabulate;
 pub mod warp;
 
+pub use bsdf_strategy::BsdfStrategy;
 #[cfg(feature = "desc")]
 pub use desc::MaterialDesc;
 pub use error::Error;
@@ -101,5 +102,4 @@ pub use material::{BsdfSampler, Glossy, Material};
 pub use math::Rgb;
 pub use microfacet::{Microfacet, Ndf, Shadowing};
 pub use sample::{BsdfSample, Component, LobeSample, Scattering};
-pub use bsdf_strategy::BsdfStrategy;
 pub use strategy::Strategy;

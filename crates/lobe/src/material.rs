@@ -10,9 +10,9 @@
 //! balance heuristic), so `pdf` is always the density that `sample` draws from.
 
 use crate::math::Rgb;
+pub use crate::models::Glossy;
 use crate::models::lambert::CosineSampler;
 use crate::models::{Bxdf, GlossySampler, Lambert, Lobes};
-pub use crate::models::Glossy;
 use crate::sample::{BsdfSample, Component, Scattering};
 use crate::{BsdfStrategy, Error, warp};
 use glam::{DVec2, DVec3};
@@ -176,7 +176,11 @@ impl Material {
             Err(reason) => Err(Error::Unsupported {
                 strategy: strategy.name().into(),
                 reason,
-                available: self.strategies().into_iter().map(BsdfStrategy::name).collect(),
+                available: self
+                    .strategies()
+                    .into_iter()
+                    .map(BsdfStrategy::name)
+                    .collect(),
             }),
         }
     }

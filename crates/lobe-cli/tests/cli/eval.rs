@@ -273,7 +273,12 @@ fn failed_samples_give_null() {
     let wo = dir(1.45, 0.0);
     let u = (0..64 * 64)
         .map(|k| DVec2::new((k % 64) as f64 / 64.0, (k / 64) as f64 / 64.0))
-        .find(|&u| m.sampler(BsdfStrategy::Brdf).unwrap().sample(wo, 0.5, u).is_none())
+        .find(|&u| {
+            m.sampler(BsdfStrategy::Brdf)
+                .unwrap()
+                .sample(wo, 0.5, u)
+                .is_none()
+        })
         .expect("a failed brdf sample at grazing wo");
     let input = format!(
         "{{\"wo\":{},\"u\":[{},{}],\"strategy\":\"brdf\"}}\n",

@@ -114,7 +114,6 @@ impl VecKernel for LectureParams {
     }
 }
 
-
 /// A level with its token.
 #[derive(Debug, Clone, Copy)]
 pub(crate) enum Backend {

@@ -282,7 +282,9 @@ fn eval_pdf_lanes<const MODE: u8>(
 /// lobe); without, the table's strategy directly (`uc` unread).
 pub(crate) fn sample_block(k: &MeasuredKernel, inp: SampleIn<'_>, out: SampleOut<'_, '_>) {
     if let Some((m, s)) = &k.mixture {
-        let sampler = m.sampler(*s).expect("the strategy was checked when the kernel was made");
+        let sampler = m
+            .sampler(*s)
+            .expect("the strategy was checked when the kernel was made");
         return sample_lanes(inp, out, |wo, u, uc| {
             sampler.sample(wo, uc, u).map(|x| (x.wi, x.f, x.pdf))
         });
@@ -308,7 +310,9 @@ pub(crate) fn eval_pdf_block(k: &MeasuredKernel, mode: u8, inp: EvalIn<'_>, out:
         };
     }
     if let Some((m, s)) = &k.mixture {
-        let sampler = m.sampler(*s).expect("the strategy was checked when the kernel was made");
+        let sampler = m
+            .sampler(*s)
+            .expect("the strategy was checked when the kernel was made");
         return by_mode!(|wo, wi| sampler.eval_pdf(wo, wi));
     }
     let d = k.data;
@@ -521,7 +525,11 @@ pub(super) mod tests {
                 let mut valid = 0;
                 for k in 0..n {
                     let o = d(&wo, k);
-                    let r = m.sampler(s).unwrap().sample(o, uc[k].into(), DVec2::new(u1[k].into(), u2[k].into()));
+                    let r = m.sampler(s).unwrap().sample(
+                        o,
+                        uc[k].into(),
+                        DVec2::new(u1[k].into(), u2[k].into()),
+                    );
                     match r {
                         None => assert_eq!(out.valid[k], 0, "{name} {s} #{k}"),
                         Some(r) => {

@@ -385,7 +385,13 @@ mod tests {
         let wo = DVec3::new(0.5, 0.0, 0.75f64.sqrt());
         let steps = Steps(std::sync::Mutex::new((0, 0)));
         let h = projected_histograms(
-            &lambert().sampler(BsdfStrategy::Cosine).unwrap(), wo, 200_000, 3, 16, &steps);
+            &lambert().sampler(BsdfStrategy::Cosine).unwrap(),
+            wo,
+            200_000,
+            3,
+            16,
+            &steps,
+        );
         assert_eq!(h.res, 16);
         assert_eq!((h.observed.len(), h.expected.len()), (256, 256));
         let (so, se): (f64, f64) = (h.observed.iter().sum(), h.expected.iter().sum());
@@ -394,7 +400,13 @@ mod tests {
         assert_eq!(*steps.0.lock().unwrap(), (200_000, 200_000));
         // The same seed gives the same counts.
         let again = projected_histograms(
-            &lambert().sampler(BsdfStrategy::Cosine).unwrap(), wo, 200_000, 3, 16, &());
+            &lambert().sampler(BsdfStrategy::Cosine).unwrap(),
+            wo,
+            200_000,
+            3,
+            16,
+            &(),
+        );
         assert_eq!(again, h);
     }
 

@@ -55,8 +55,7 @@ pub fn warp_test(
     progress: &dyn Progress,
 ) -> WarpTest {
     const STEP: u64 = 1 << 16;
-    let histograms =
-        projected_histograms(sampler, wo, config.samples, config.seed, res, progress);
+    let histograms = projected_histograms(sampler, wo, config.samples, config.seed, res, progress);
     progress.start("chi-square", config.samples as u64);
     let drawn = AtomicU64::new(0);
     let integrating = AtomicBool::new(false);
@@ -70,8 +69,7 @@ pub fn warp_test(
         },
         |wi| {
             // The first pdf call starts the cubature of the expected counts.
-            if !integrating.load(Ordering::Relaxed) && !integrating.swap(true, Ordering::Relaxed)
-            {
+            if !integrating.load(Ordering::Relaxed) && !integrating.swap(true, Ordering::Relaxed) {
                 progress.start("chi-square: expected", 0);
             }
             sampler.pdf(wo, wi)

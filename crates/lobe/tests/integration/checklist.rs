@@ -59,7 +59,12 @@ const ROWS: &[Row] = &[
     },
     Row {
         model: "measured",
-        examples: || vec![*super::measured::ggx_merl(), *super::measured::beckmann_rgl()],
+        examples: || {
+            vec![
+                *super::measured::ggx_merl(),
+                *super::measured::beckmann_rgl(),
+            ]
+        },
         chi2_test: "fn chi2_of_the_rgl_warps",
         readme_row: "| Measured",
     },
@@ -87,7 +92,12 @@ fn every_model_has_its_row() {
             r.model
         );
         for m in (r.examples)() {
-            assert_eq!(m.model_name(), r.model, "an example of {} is not one", r.model);
+            assert_eq!(
+                m.model_name(),
+                r.model,
+                "an example of {} is not one",
+                r.model
+            );
         }
     }
 }
@@ -111,9 +121,13 @@ fn every_strategy_of_every_model_is_batched() {
             }
         }
         assert!(
-            [BsdfStrategy::Uniform, BsdfStrategy::Cosine, BsdfStrategy::Brdf]
-                .iter()
-                .all(|s| reached.contains(s)),
+            [
+                BsdfStrategy::Uniform,
+                BsdfStrategy::Cosine,
+                BsdfStrategy::Brdf
+            ]
+            .iter()
+            .all(|s| reached.contains(s)),
             "the examples of {} miss a strategy every model has",
             r.model
         );

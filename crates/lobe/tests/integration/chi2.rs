@@ -182,7 +182,12 @@ fn chi2_catches_a_wrong_pdf() {
     // The lecture's density over half vectors, used as if it were over wi.
     let r = chi2_test(
         &Chi2Config::default(),
-        |uc, u| m.sampler(BsdfStrategy::Brdf).unwrap().sample(wo, uc, u).map(|x| x.wi),
+        |uc, u| {
+            m.sampler(BsdfStrategy::Brdf)
+                .unwrap()
+                .sample(wo, uc, u)
+                .map(|x| x.wi)
+        },
         |wi| {
             let h = (wo + wi).normalize();
             if wi.z > 0.0 {

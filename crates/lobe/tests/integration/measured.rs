@@ -207,7 +207,12 @@ fn chi2_of_the_tabulated_sampler() {
             let o = wo(theta);
             let r = chi2_test(
                 &cfg,
-                |uc, u| m.sampler(BsdfStrategy::Brdf).unwrap().sample(o, uc, u).map(|s| s.wi),
+                |uc, u| {
+                    m.sampler(BsdfStrategy::Brdf)
+                        .unwrap()
+                        .sample(o, uc, u)
+                        .map(|s| s.wi)
+                },
                 |wi| m.sampler(BsdfStrategy::Brdf).unwrap().pdf(o, wi),
             );
             eprintln!(
@@ -242,7 +247,11 @@ fn sampled_pdf_is_the_pdf_of_the_pair() {
         for _ in 0..20_000 {
             let o = dir_of(rng.random::<f64>() * 89.0, rng.random::<f64>() * 360.0);
             let u = DVec2::new(rng.random(), rng.random());
-            let Some(s) = m.sampler(BsdfStrategy::Brdf).unwrap().sample(o, rng.random(), u) else {
+            let Some(s) = m
+                .sampler(BsdfStrategy::Brdf)
+                .unwrap()
+                .sample(o, rng.random(), u)
+            else {
                 continue;
             };
             n += 1;
@@ -650,7 +659,12 @@ fn chi2_of_the_rgl_warps() {
         let o = dir_of(theta, 30.0);
         let r = chi2_test(
             &cfg,
-            |uc, u| m.sampler(BsdfStrategy::Vndf).unwrap().sample(o, uc, u).map(|s| s.wi),
+            |uc, u| {
+                m.sampler(BsdfStrategy::Vndf)
+                    .unwrap()
+                    .sample(o, uc, u)
+                    .map(|s| s.wi)
+            },
             |wi| m.sampler(BsdfStrategy::Vndf).unwrap().pdf(o, wi),
         );
         eprintln!(

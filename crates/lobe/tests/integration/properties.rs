@@ -139,7 +139,9 @@ fn lambert_furnace_is_exact() {
         for s in [BsdfStrategy::Cosine, BsdfStrategy::Brdf] {
             let x = c
                 .material
-                .sampler(s).unwrap().sample(wo, rng.random(), DVec2::new(rng.random(), rng.random()))
+                .sampler(s)
+                .unwrap()
+                .sample(wo, rng.random(), DVec2::new(rng.random(), rng.random()))
                 .unwrap();
             assert!(
                 (x.weight - Rgb::new(0.2, 0.5, 0.9)).abs().max_element() < 1e-12,
@@ -212,9 +214,11 @@ fn every_strategy_is_unbiased() {
         let mut rng = Pcg64::seed_from_u64(1000 + i as u64);
         let mut mom = Moments::default();
         for _ in 0..200_000 {
-            let x = c
-                .material
-                .sampler(*s).unwrap().sample(wo, rng.random(), DVec2::new(rng.random(), rng.random()));
+            let x = c.material.sampler(*s).unwrap().sample(
+                wo,
+                rng.random(),
+                DVec2::new(rng.random(), rng.random()),
+            );
             mom.push(x.map_or(0.0, |x| luminance(x.weight)));
         }
         // The quadrature is good to ~1e-7 relative: fold that into the
