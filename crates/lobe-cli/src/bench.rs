@@ -312,7 +312,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         None => {
             let m = Material::load(GGX_02).context("default material")?;
             for s in parse_strategies(args.strategy.as_deref().unwrap_or_default())? {
-                rows.push((GGX_02.to_string(), m, s));
+                rows.push((GGX_02.to_string(), m.clone(), s));
             }
         }
         Some(text) => {
@@ -322,7 +322,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
                 None => m.strategies(),
             };
             for s in strategies {
-                rows.push((text.clone(), m, s));
+                rows.push((text.clone(), m.clone(), s));
             }
         }
     }

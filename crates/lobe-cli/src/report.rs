@@ -322,7 +322,7 @@ fn build(model: &Model, value: f64) -> Result<Material> {
                 .and_then(|d| d.build())
                 .map_err(|e| anyhow!("report material {json}: {e}"))
         }
-        Source::Given(m) => Ok(*m),
+        Source::Given(m) => Ok(m.clone()),
     }
 }
 

@@ -417,7 +417,7 @@ fn check_uniform<'a, T: Real>(
 }
 
 /// How one call runs.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone)]
 pub struct Engine<'m> {
     pub material: &'m Material,
     /// The strategy, resolved for the material (the scalar f64 path).
@@ -738,7 +738,7 @@ pub fn sample32_into(
     uc: Option<&In1<'_>>,
     out: SampleSlices<'_, f32>,
 ) -> Result<(), BadInput> {
-    let Some(b) = e.batch else {
+    let Some(b) = &e.batch else {
         return sample_scalar_into::<f32>(e, wo, u, uc, out);
     };
     let n = wo.rows();
@@ -987,7 +987,7 @@ pub fn eval_pdf32_into(
     wi: &In2<'_>,
     out: EvalSlices<'_, f32>,
 ) -> Result<(), BadInput> {
-    let Some(b) = e.batch else {
+    let Some(b) = &e.batch else {
         return eval_pdf_scalar_into::<f32>(e, wo, wi, out);
     };
     let n = wo.rows();

@@ -17,8 +17,9 @@ use crate::sample::{BsdfSample, Component, Scattering};
 use crate::{BsdfStrategy, Error, warp};
 use glam::{DVec2, DVec3};
 
-/// A material: `f = diffuse.albedo/π + glossy`.
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// A material: `f = diffuse.albedo/π + glossy`. Cloning it is cheap: a
+/// measured table is shared, not copied.
+#[derive(Debug, Clone, PartialEq)]
 pub struct Material {
     pub diffuse: Lambert,
     pub glossy: Glossy,
@@ -146,7 +147,7 @@ impl Material {
     /// How `strategy` draws for this material: the one place a strategy is
     /// turned into samplers (`uniform` and `cosine` here, the others by the
     /// lobes' own tables, [`Bxdf::sampler`]).
-    fn draw(&self, strategy: BsdfStrategy) -> Result<Draw, String> {
+    fn draw(&self, strategy: BsdfStrategy) -> Result<Draw<'_>, String> {
         match strategy {
             BsdfStrategy::Uniform => Ok(Draw::Uniform),
             BsdfStrategy::Cosine => Ok(Draw::Cosine),
@@ -158,7 +159,7 @@ impl Material {
                 }
                 // The glossy lobe's sampler; the diffuse term (if any) is
                 // cosine sampled whatever the strategy.
-                g => Ok(Draw::Lobes(g.sampler(strategy)?, CosineSampler)),
+                ref g => Ok(Draw::Lobes(g.sampler(strategy)?, CosineSampler)),
             },
         }
     }
@@ -228,14 +229,14 @@ impl crate::desc::MaterialDesc {
 
 /// How a [`BsdfSampler`] draws: resolved once from its strategy.
 #[derive(Debug, Clone, Copy, PartialEq)]
-enum Draw {
+enum Draw<'m> {
     /// Uniform over the hemisphere, whatever the lobes.
     Uniform,
     /// Cosine-weighted, whatever the lobes.
     Cosine,
     /// The glossy lobe by its sampler, the diffuse term by cosine sampling,
     /// one of them chosen by `uc` with the lobes' albedo hints.
-    Lobes(GlossySampler, CosineSampler),
+    Lobes(GlossySampler<'m>, CosineSampler),
 }
 
 /// A strategy resolved for one material ([`Material::sampler`]): it draws
@@ -244,7 +245,7 @@ enum Draw {
 pub struct BsdfSampler<'m> {
     material: &'m Material,
     strategy: BsdfStrategy,
-    draw: Draw,
+    draw: Draw<'m>,
 }
 
 impl<'m> BsdfSampler<'m> {

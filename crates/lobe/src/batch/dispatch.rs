@@ -23,7 +23,7 @@ const MAX_LANES: usize = 32;
 
 /// What a [`super::BatchSampler`] runs: the model's parameters and the
 /// instance of its kernel, chosen once in `BatchSampler::new`.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub(crate) enum Kernel {
     /// Cook-Torrance with distribution `ndf` and strategy `strat` (the
     /// kernel's const parameters).

@@ -33,12 +33,12 @@ const BRDF: u8 = 2;
 const VNDF: u8 = 3;
 
 /// A measured table and a strategy, as a [`super::BatchSampler`] runs them.
-#[derive(Clone, Copy)]
+#[derive(Clone)]
 pub(crate) struct MeasuredKernel {
-    data: &'static MeasuredData,
+    data: std::sync::Arc<MeasuredData>,
     strat: u8,
     /// With a diffuse term: the material and strategy, run lane by lane
-    /// through [`Material::sample`] and [`Material::eval_pdf`] (the
+    /// through the material's [`crate::BsdfSampler`] (the
     /// mixture: `uc` chooses the lobe, the pdf is the mixture density, `f`
     /// the sum).
     mixture: Option<(Material, BsdfStrategy)>,
@@ -52,7 +52,7 @@ impl std::fmt::Debug for MeasuredKernel {
             self.data.path,
             self.data.table.format(),
             self.strat,
-            self.mixture.map(|(m, _)| m.diffuse.albedo)
+            self.mixture.as_ref().map(|(m, _)| m.diffuse.albedo)
         )
     }
 }
@@ -60,10 +60,10 @@ impl std::fmt::Debug for MeasuredKernel {
 impl PartialEq for MeasuredKernel {
     /// The same table (read once per file) and strategy.
     fn eq(&self, other: &Self) -> bool {
-        std::ptr::eq(self.data, other.data)
+        std::sync::Arc::ptr_eq(&self.data, &other.data)
             && self.strat == other.strat
-            && self.mixture.map(|(m, _)| m.diffuse.albedo)
-                == other.mixture.map(|(m, _)| m.diffuse.albedo)
+            && self.mixture.as_ref().map(|(m, _)| m.diffuse.albedo)
+                == other.mixture.as_ref().map(|(m, _)| m.diffuse.albedo)
     }
 }
 
@@ -72,7 +72,7 @@ impl MeasuredKernel {
     /// `strategy` (which the caller has checked applies: `Material::check`).
     pub(crate) fn new(
         m: &Material,
-        lobe: Measured,
+        lobe: &Measured,
         strategy: BsdfStrategy,
     ) -> Option<MeasuredKernel> {
         let strat = match (strategy, &lobe.data.table) {
@@ -83,15 +83,17 @@ impl MeasuredKernel {
             _ => return None,
         };
         Some(MeasuredKernel {
-            data: lobe.data,
+            data: lobe.data.clone(),
             strat,
-            mixture: m.has_diffuse().then_some((*m, strategy)),
+            mixture: m.has_diffuse().then(|| (m.clone(), strategy)),
         })
     }
 
     /// Whether `sample` reads `uc` ([`Material::chooses_lobe`]).
     pub(crate) fn chooses_lobe(&self) -> bool {
-        self.mixture.is_some_and(|(m, s)| m.chooses_lobe(s))
+        self.mixture
+            .as_ref()
+            .is_some_and(|(m, s)| m.chooses_lobe(*s))
     }
 }
 
@@ -289,7 +291,7 @@ pub(crate) fn sample_block(k: &MeasuredKernel, inp: SampleIn<'_>, out: SampleOut
             sampler.sample(wo, uc, u).map(|x| (x.wi, x.f, x.pdf))
         });
     }
-    let d = k.data;
+    let d: &MeasuredData = &k.data;
     match k.strat {
         UNIFORM => sample_lanes(inp, out, |wo, u, _| sample_one::<UNIFORM>(d, wo, u)),
         COSINE => sample_lanes(inp, out, |wo, u, _| sample_one::<COSINE>(d, wo, u)),
@@ -315,7 +317,7 @@ pub(crate) fn eval_pdf_block(k: &MeasuredKernel, mode: u8, inp: EvalIn<'_>, out:
             .expect("the strategy was checked when the kernel was made");
         return by_mode!(|wo, wi| sampler.eval_pdf(wo, wi));
     }
-    let d = k.data;
+    let d: &MeasuredData = &k.data;
     macro_rules! by_strat {
         ($s:ident) => {
             match mode {
@@ -402,14 +404,14 @@ pub(super) mod tests {
         // The same tables with a diffuse term: the two-lobe mixture, `uc`
         // choosing the lobe where the strategy samples both.
         let with_kd = |m: &Material| {
-            let mut m = *m;
+            let mut m = m.clone();
             m.diffuse = crate::models::Lambert::new(Rgb::new(0.3, 0.2, 0.1)).unwrap();
             m
         };
         let cases = [
-            cases[0],
-            cases[1],
-            cases[2],
+            cases[0].clone(),
+            cases[1].clone(),
+            cases[2].clone(),
             ("merl-nearest + kd", with_kd(&cases[0].1)),
             ("rgl + kd", with_kd(&cases[2].1)),
         ];

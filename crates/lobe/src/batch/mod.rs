@@ -598,7 +598,8 @@ impl EvalPdfBuffers {
 }
 
 /// A material and strategy prepared for the batch kernels at one level.
-#[derive(Debug, Clone, Copy)]
+/// Cloning it is cheap (a measured table is shared, not copied).
+#[derive(Debug, Clone)]
 pub struct BatchSampler {
     kernel: Kernel,
     strategy: BsdfStrategy,
@@ -634,7 +635,7 @@ impl BatchSampler {
     /// lobe and the strategy samples them: `Material::chooses_lobe`).
     #[must_use]
     pub fn chooses_lobe(&self) -> bool {
-        match self.kernel {
+        match &self.kernel {
             Kernel::CookTorrance { p, .. } => p.two_lobes,
             Kernel::Measured(k) => k.chooses_lobe(),
             Kernel::Lecture { p, .. } => p.two_lobes,
@@ -879,8 +880,8 @@ fn kernel_for(m: &Material, strategy: BsdfStrategy) -> Result<Kernel, BatchError
     let kd = m.diffuse.albedo;
     let kd_pi = c3(kd * crate::math::INV_PI);
     let kd_lum = crate::math::luminance(kd) as f32;
-    let lobe = match m.glossy {
-        Glossy::CookTorrance(lobe) => lobe,
+    let lobe = match &m.glossy {
+        Glossy::CookTorrance(lobe) => *lobe,
         Glossy::None => {
             // A Lambertian material: cosine-weighted (uniform for uniform).
             let strat = if strategy == BsdfStrategy::Uniform {

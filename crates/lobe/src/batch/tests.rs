@@ -869,7 +869,7 @@ fn batch_errors_name_the_slice_and_the_unsupported() {
     assert!(unsupported(&blinn, BsdfStrategy::Vndf).contains("ggx or beckmann"));
     let two_lobes = Material {
         diffuse: crate::models::Lambert::new(Rgb::splat(0.3)).unwrap(),
-        ..m
+        ..m.clone()
     };
     let b2 = BatchSampler::with_level(&two_lobes, BsdfStrategy::Vndf, SimdLevel::Scalar).unwrap();
     assert!(b2.chooses_lobe());

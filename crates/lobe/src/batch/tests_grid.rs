@@ -586,7 +586,7 @@ fn grid_chi2_batch_pdf() {
         let phong = Glossy::Phong(Phong::new(Rgb::ONE, 20.0, true).unwrap());
         let blinn = Glossy::BlinnPhong(BlinnPhong::new(Rgb::ONE, 60.0, true).unwrap());
         for (name, g, kd) in [
-            ("phong n=20", phong, Rgb::ZERO),
+            ("phong n=20", phong.clone(), Rgb::ZERO),
             ("phong n=20", phong, Rgb::new(0.5, 0.3, 0.2)),
             ("blinn-phong n=60", blinn, Rgb::ZERO),
         ] {
@@ -767,7 +767,7 @@ fn grid_every_supported_combination_builds() {
     let (mut built, mut missing) = (0usize, Vec::new());
     for g in glossies {
         for kd in [Rgb::ZERO, Rgb::splat(0.3)] {
-            let m = match Material::with_diffuse(kd, g) {
+            let m = match Material::with_diffuse(kd, g.clone()) {
                 Ok(m) => m,
                 Err(_) => continue,
             };

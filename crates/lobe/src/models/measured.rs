@@ -8,10 +8,12 @@
 //!
 //! (This table is [`PARAMS`]; a test checks that they agree.)
 //!
-//! A table is read once per process (per file, size, modification time and
-//! interpolation), stored as `f32`, and shared by every material that names
-//! it: the lobe holds a `&'static` reference to it, so that [`Measured`]
-//! (and a material) stay `Copy`. The tables are never freed.
+//! A table is read once while any material holds it (per file, size,
+//! modification time and interpolation), stored as `f32`, and shared by
+//! every material that names it: the lobe holds an `Arc` of it, so that
+//! cloning a [`Measured`] (and a material) is a reference count, and the
+//! table is freed with the last material that holds it (the cache keeps
+//! only weak references).
 //!
 //! * MERL ([`merl`]): RGB per (θh, θd, φd) entry, nearest or trilinear; a
 //!   missing entry (negative in the file) reflects nothing.
@@ -36,7 +38,7 @@ use crate::{BsdfStrategy, Error};
 use glam::{DVec2, DVec3};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
-use std::sync::{Mutex, OnceLock};
+use std::sync::{Arc, Mutex, OnceLock, Weak};
 
 pub mod merl;
 pub mod rgl;
@@ -186,9 +188,9 @@ impl MeasuredData {
 }
 
 /// The measured lobe: a shared table.
-#[derive(Clone, Copy)]
+#[derive(Clone)]
 pub struct Measured {
-    pub data: &'static MeasuredData,
+    pub data: Arc<MeasuredData>,
 }
 
 impl std::fmt::Debug for Measured {
@@ -206,19 +208,19 @@ impl std::fmt::Debug for Measured {
 impl PartialEq for Measured {
     /// The same table (the same file, read once).
     fn eq(&self, other: &Self) -> bool {
-        std::ptr::eq(self.data, other.data)
+        Arc::ptr_eq(&self.data, &other.data)
     }
 }
 
 type CacheKey = (PathBuf, u64, Option<std::time::SystemTime>, Interpolation);
 
-fn cache() -> &'static Mutex<HashMap<CacheKey, &'static MeasuredData>> {
-    static CACHE: OnceLock<Mutex<HashMap<CacheKey, &'static MeasuredData>>> = OnceLock::new();
+fn cache() -> &'static Mutex<HashMap<CacheKey, Weak<MeasuredData>>> {
+    static CACHE: OnceLock<Mutex<HashMap<CacheKey, Weak<MeasuredData>>>> = OnceLock::new();
     CACHE.get_or_init(|| Mutex::new(HashMap::new()))
 }
 
 impl Measured {
-    /// Read (once per process) the table at `path`; `interpolation` is for
+    /// Read (once while a material holds it) the table at `path`; `interpolation` is for
     /// MERL tables (default nearest) and must be `None` for RGL files.
     pub fn load(path: &Path, interpolation: Option<Interpolation>) -> crate::error::Result<Measured> {
         let name = path.display().to_string();
@@ -228,17 +230,19 @@ impl Measured {
         let key = (canonical, meta.len(), meta.modified().ok(), key_interp);
         // Held while reading: two threads asking for one file read it once.
         let mut map = cache().lock().unwrap_or_else(std::sync::PoisonError::into_inner);
-        if let Some(d) = map.get(&key) {
-            return Ok(Measured { data: d });
+        if let Some(data) = map.get(&key).and_then(Weak::upgrade) {
+            return Ok(Measured { data });
         }
         let t0 = std::time::Instant::now();
         let bytes = std::fs::read(path).map_err(|e| Error::file(&name, format!("cannot read: {e}")))?;
         let m = Self::from_bytes_timed(&bytes, path, interpolation, t0)?;
-        map.insert(key, m.data);
+        // Tables no material holds any more leave the cache.
+        map.retain(|_, d| d.strong_count() > 0);
+        map.insert(key, Arc::downgrade(&m.data));
         Ok(m)
     }
 
-    /// A table from a file's bytes (not cached; the table is never freed).
+    /// A table from a file's bytes (not cached).
     pub fn from_bytes(
         bytes: &[u8],
         path: &Path,
@@ -271,7 +275,7 @@ impl Measured {
             read,
         );
         Ok(Measured {
-            data: Box::leak(Box::new(data)),
+            data: Arc::new(data),
         })
     }
 

@@ -32,7 +32,7 @@ pub use lambert::Lambert;
 /// value of the model's own type; `sample` and `pdf` take that value and
 /// never see a strategy it does not have. The caller guarantees `wo.z > 0`
 /// (and `wi.z > 0` for `eval` and `pdf`).
-pub trait Bxdf: Copy {
+pub trait Bxdf {
     /// The model's samplers: one value per strategy it has (an enum, or a
     /// unit struct where it has one).
     type Sampler: Copy + fmt::Debug + PartialEq;
@@ -279,7 +279,7 @@ pub fn names(sep: &str) -> String {
 
 /// A material's lobes, as a model builds them from a description: a
 /// Lambertian term and at most one glossy lobe. `Material` is made of them.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct Lobes {
     pub diffuse: Lambert,
     pub glossy: Glossy,
@@ -348,7 +348,7 @@ macro_rules! glossy_models {
 
         /// The glossy lobe of a material (static dispatch). `None` reflects
         /// nothing.
-        #[derive(Debug, Clone, Copy, PartialEq)]
+        #[derive(Debug, Clone, PartialEq)]
         pub enum Glossy {
             None,
             $($ty($ty)),*
@@ -358,9 +358,9 @@ macro_rules! glossy_models {
         /// what a material's sampler draws the glossy lobe with. `None`
         /// draws nothing.
         #[derive(Debug, Clone, Copy, PartialEq)]
-        pub enum GlossySampler {
+        pub enum GlossySampler<'m> {
             None,
-            $($ty($ty, <$ty as Bxdf>::Sampler)),*
+            $($ty(&'m $ty, <$ty as Bxdf>::Sampler)),*
         }
 
         impl Glossy {
@@ -375,10 +375,10 @@ macro_rules! glossy_models {
 
             /// The lobe's sampler for `strategy` ([`Bxdf::sampler`]), or why
             /// it has none.
-            pub fn sampler(&self, strategy: BsdfStrategy) -> Result<GlossySampler, String> {
+            pub fn sampler(&self, strategy: BsdfStrategy) -> Result<GlossySampler<'_>, String> {
                 match self {
                     Glossy::None => Err("no glossy lobe".into()),
-                    $(Glossy::$ty(l) => Ok(GlossySampler::$ty(*l, l.sampler(strategy)?))),*
+                    $(Glossy::$ty(l) => Ok(GlossySampler::$ty(l, l.sampler(strategy)?))),*
                 }
             }
 
@@ -412,7 +412,7 @@ macro_rules! glossy_models {
             }
         }
 
-        impl GlossySampler {
+        impl GlossySampler<'_> {
             /// [`Bxdf::sample`].
             #[inline]
             #[must_use]

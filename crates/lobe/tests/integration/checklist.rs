@@ -61,8 +61,8 @@ const ROWS: &[Row] = &[
         model: "measured",
         examples: || {
             vec![
-                *super::measured::ggx_merl(),
-                *super::measured::beckmann_rgl(),
+                super::measured::ggx_merl().clone(),
+                super::measured::beckmann_rgl().clone(),
             ]
         },
         chi2_test: "fn chi2_of_the_rgl_warps",

@@ -27,7 +27,7 @@ fn run(cases: Vec<Case>) {
         .par_iter()
         .flat_map_iter(|&(c, s, theta)| {
             let mut failures = Vec::new();
-            let m = c.material;
+            let m = &c.material;
             let wo = common::wo(theta);
             let t0 = std::time::Instant::now();
             let r = chi2_test(

@@ -330,14 +330,43 @@ fn tabulated_sampling_beats_cosine_on_a_glossy_table() {
     }
 }
 
+/// A table lives as long as a material holds it: the cache keeps it only
+/// while it is in use, so a process that loads many files (a server) does
+/// not keep every table it ever read.
+#[test]
+fn a_table_is_freed_with_the_last_material_that_holds_it() {
+    let weak_data = |m: &Material| match &m.glossy {
+        Glossy::Measured(x) => std::sync::Arc::downgrade(&x.data),
+        _ => panic!("not measured"),
+    };
+    let a = merl_material(GLOSSY, "freed.binary", "linear");
+    let b = merl_material(GLOSSY, "freed.binary", "linear");
+    let c = a.clone();
+    let w = weak_data(&a);
+    assert!(std::sync::Arc::ptr_eq(
+        &w.upgrade().unwrap(),
+        &weak_data(&b).upgrade().unwrap()
+    ));
+    drop((a, b));
+    assert!(w.upgrade().is_some(), "a clone still holds the table");
+    drop(c);
+    assert!(w.upgrade().is_none(), "the table outlived every material");
+    // Named again, it is read again.
+    let d = merl_material(GLOSSY, "freed.binary", "linear");
+    assert!(weak_data(&d).upgrade().is_some());
+}
+
 #[test]
 fn the_table_is_shared_and_only_the_listed_strategies_apply() {
     let a = merl_material(GGX, "ggx.binary", "nearest");
-    let b = *ggx_merl();
-    let (Glossy::Measured(x), Glossy::Measured(y)) = (a.glossy, b.glossy) else {
+    let b = ggx_merl();
+    let (Glossy::Measured(x), Glossy::Measured(y)) = (&a.glossy, &b.glossy) else {
         panic!("not measured")
     };
-    assert!(std::ptr::eq(x.data, y.data), "one file, one table");
+    assert!(
+        std::sync::Arc::ptr_eq(&x.data, &y.data),
+        "one file, one table"
+    );
     assert_eq!(
         a.strategies(),
         vec![
