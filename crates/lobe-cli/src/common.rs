@@ -200,6 +200,44 @@ pub fn warn_energy_gain(m: &lobe::Material, what: &str) {
     }
 }
 
+/// Per-sample standard deviation, relative to the mean, below which a
+/// measured variance is rounding and not noise: such an estimator is exact
+/// (every sample gives the integral, as BRDF sampling of a Lambert surface
+/// under a constant light does), and its variance, its slope and any ratio
+/// against it are printed as exact, not as the rounding's numbers.
+pub const EXACT_RELATIVE_SD: f64 = 1e-10;
+
+/// Whether a per-sample `variance` of an estimate of `mean` is zero up to
+/// rounding ([`EXACT_RELATIVE_SD`]).
+#[must_use]
+pub fn is_exact(variance: f64, mean: f64) -> bool {
+    variance <= (EXACT_RELATIVE_SD * mean).powi(2)
+}
+
+/// Whether a table row is exact ([`is_exact`] of its luminance).
+#[must_use]
+pub fn row_is_exact(row: &lobe::experiment::table::Row) -> bool {
+    is_exact(
+        row.variance,
+        lobe::math::luminance(lobe::Rgb::from_array(row.mean)),
+    )
+}
+
+/// The rows of `t` whose variance is rounding ([`row_is_exact`]) with their
+/// variance and standard error set to 0 and no variance reduction or
+/// efficiency (both infinite), so that tables and JSON print exact values,
+/// not the rounding's (a variance of 3e-33, a reduction of 7e31×).
+pub fn zero_exact_rows(t: &mut lobe::experiment::table::Table) {
+    for row in &mut t.strategies {
+        if row_is_exact(row) {
+            row.variance = 0.0;
+            row.stderr = [0.0; 3];
+            row.variance_reduction = None;
+            row.efficiency = None;
+        }
+    }
+}
+
 /// A progress bar on stderr, hidden with `--quiet` (indicatif hides it by
 /// itself when stderr is not a terminal).
 pub fn progress(len: u64, message: &str, quiet: bool) -> ProgressBar {

@@ -124,6 +124,24 @@ pub fn plot_series(curves: &[Curve]) -> Vec<Series> {
         .collect()
 }
 
+/// The curves whose every RMSE is rounding (at most
+/// [`crate::common::EXACT_RELATIVE_SD`] of the `target`) with their RMSE set
+/// to 0 and no slope: an exact estimator, printed as `exact`, not as the
+/// slope of its rounding (0.001).
+pub fn zero_exact_curves(curves: &mut [Curve], target: f64) {
+    for c in curves {
+        if c.points
+            .iter()
+            .all(|p| p.1 <= crate::common::EXACT_RELATIVE_SD * target.abs())
+        {
+            for p in &mut c.points {
+                p.1 = 0.0;
+            }
+            c.slope = None;
+        }
+    }
+}
+
 /// The CSV text: `strategy,sequence,n,rmse,slope`, one line per curve and N.
 #[must_use]
 pub fn csv(curves: &[Curve]) -> String {
@@ -205,7 +223,7 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
     }
     let series = setup.series();
     let bar = Bar::new(args.quiet);
-    let curves = curves(
+    let mut curves = curves(
         &m,
         &sp,
         &light,
@@ -219,6 +237,7 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
         &bar,
     )?;
     bar.finish();
+    zero_exact_curves(&mut curves, target);
     if let Some(c) = curves
         .iter()
         .find(|c| c.points.iter().any(|p| !p.1.is_finite()))
