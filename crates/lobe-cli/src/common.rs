@@ -200,6 +200,55 @@ pub fn warn_energy_gain(m: &lobe::Material, what: &str) {
     }
 }
 
+/// What `mis`, the default technique, is: the one description of every help
+/// text that names it ([`technique_help`], `lobe render --help`).
+pub const MIS_DESCRIPTION: &str = "adaptive MIS, the default: each sample draws one BSDF direction (vndf where the material has it, else brdf) and one light direction, and gives both to BSDF sampling, to the balance heuristic or to light sampling, whichever a pilot of its own samples finds of least variance (in a render: per pixel, from the pilots of the 7 × 7 pixels around it; deeper bounces use the balance heuristic)";
+
+/// What a technique of [`Strategy::names`](lobe::estimator::Strategy::names)
+/// is, in a few words; `None` for a name this list does not know (a test
+/// checks that every accepted name has one).
+#[must_use]
+pub fn technique_description(name: &str) -> Option<&'static str> {
+    Some(match name {
+        "uniform" => "uniform over the hemisphere (the baseline)",
+        "cosine" => "cosine-weighted hemisphere",
+        "brdf" => {
+            "the lecture's importance sampling (Phong's lobe, Blinn-Phong's half vector, Cook-Torrance's D(h) cos θh)"
+        }
+        "vndf" => "visible normals (Heitz 2018; GGX and Beckmann)",
+        "spherical-caps" => "visible normals by spherical caps (Dupuy and Benyoub 2023; GGX)",
+        "bounded-vndf" => "bounded VNDF (Eto and Tokuyoshi 2023; GGX)",
+        "light" => "light sampling alone (the environment map's or the light's own distribution)",
+        "mis" => MIS_DESCRIPTION,
+        "mis-balance" => {
+            "multi-sample MIS with the balance heuristic: one BSDF and one light sample, both weighted"
+        }
+        "mis-power" => "multi-sample MIS with the power heuristic",
+        "mis-one" => {
+            "one-sample MIS with the balance heuristic: one draw, BSDF or light at even odds"
+        }
+        "mis-power-one" => "one-sample MIS with the power heuristic",
+        _ => return None,
+    })
+}
+
+/// Every technique name with its description ([`technique_description`]):
+/// the one text of `--strategy` in `estimate`, `converge`, `render` and
+/// `compare`.
+#[must_use]
+pub fn technique_help() -> String {
+    lobe::estimator::Strategy::names()
+        .split(", ")
+        .map(|n| {
+            format!(
+                "{n}: {}",
+                technique_description(n).unwrap_or("(no description)")
+            )
+        })
+        .collect::<Vec<_>>()
+        .join("; ")
+}
+
 /// Per-sample standard deviation, relative to the mean, below which a
 /// measured variance is rounding and not noise: such an estimator is exact
 /// (every sample gives the integral, as BRDF sampling of a Lambert surface
@@ -324,4 +373,17 @@ pub fn output_base(
     let mut s = stem.to_owned();
     s.push(suffix);
     Ok(PathBuf::from(s))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_technique_has_a_description() {
+        for n in lobe::estimator::Strategy::names().split(", ") {
+            assert!(technique_description(n).is_some(), "{n}");
+        }
+        assert!(technique_help().contains(MIS_DESCRIPTION));
+    }
 }

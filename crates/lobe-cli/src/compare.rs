@@ -85,8 +85,8 @@ pub struct CompareArgs {
 /// The help of `--strategy`: every accepted name.
 fn strategy_help() -> String {
     format!(
-        "Comma-separated strategies: {} (default: brdf, light, mis, and vndf when an object's material has it)",
-        Strategy::names()
+        "Comma-separated techniques (default: brdf, light, mis, and vndf when an object's material has it). {}",
+        crate::common::technique_help()
     )
 }
 

@@ -77,9 +77,9 @@ pub struct EstimateArgs {
 #[must_use]
 pub fn strategy_help() -> String {
     format!(
-        "`all` or a comma-separated list of: {} (all: {}). mis (the default MIS) gives each sample's draws to BSDF sampling, to the balance heuristic or to light sampling, whichever a pilot of its own samples says has the least variance; mis-balance and mis-power are multi-sample MIS with those heuristics; mis-one and mis-power-one one-sample MIS",
-        Strategy::names(),
-        lobe::strategy::ALL_MEANS
+        "`all` or a comma-separated list of techniques (all: {}). {}",
+        lobe::strategy::ALL_MEANS,
+        crate::common::technique_help()
     )
 }
 

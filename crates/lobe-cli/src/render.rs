@@ -20,8 +20,7 @@ use std::time::Instant;
                   environment map (the only light), seen by a pinhole camera. Each camera ray's hit \
                   estimates the reflected radiance with the chosen technique exactly as `lobe estimate` \
                   does, plus a shadow ray: a BSDF sampling strategy, `light` (environment-map sampling) \
-                  or MIS (`mis`: balance heuristic, `mis-power`: power heuristic; one BSDF sample, by \
-                  vndf where the material has it else brdf, and one light sample). A BSDF strategy that \
+                  or MIS (see --strategy; `mis`, the default, is adaptive MIS). A BSDF strategy that \
                   does not apply to an object's material (vndf on a Phong sphere, say) falls back to \
                   brdf for that object, with a note. max_depth > 1 in the scene adds path tracing.\n\n\
                   Writes NAME.exr (linear RGB, 32-bit float) and NAME.png (scaled by 2^--exposure, \
@@ -117,7 +116,7 @@ Scene file (TOML; unknown keys are errors; paths are relative to the scene file)
 
   [render]             # every key optional
   spp = 64
-  strategy = \"mis\"
+  strategy = \"mis\"     # a --strategy name; default mis (adaptive MIS)
   seed = 1
   sequence = \"sobol\"   # sobol (default), stratified or independent
   max_depth = 1        # 1 = direct lighting; more adds bounces
@@ -135,8 +134,8 @@ Examples:
 /// The help of `--strategy`: every accepted name.
 fn strategy_help() -> String {
     format!(
-        "One of: {} (overrides the scene's render.strategy)",
-        Strategy::names()
+        "One technique (overrides the scene's render.strategy; default mis). {}",
+        crate::common::technique_help()
     )
 }
 

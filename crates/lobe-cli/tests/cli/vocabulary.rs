@@ -234,3 +234,34 @@ fn sobol_standard_errors_say_how() {
     let e = common::one_line_error(&o);
     assert!(e.contains("--replicas 16"), "{e}");
 }
+
+/// Issue 41: one description of `mis` (the adaptive MIS, the default) in
+/// every help that names it, the same words everywhere; none calls it the
+/// balance heuristic (that is `mis-balance`).
+#[test]
+fn every_help_describes_mis_the_same_way() {
+    let mut texts = Vec::new();
+    for cmd in ["estimate", "converge", "render", "compare"] {
+        let help = ok(&lobe(&[cmd, "--help"]));
+        let start = help
+            .find("mis: adaptive MIS, the default")
+            .unwrap_or_else(|| panic!("lobe {cmd} --help does not describe mis:\n{help}"));
+        let text: String = help[start..]
+            .split(';')
+            .next()
+            .unwrap()
+            .split_whitespace()
+            .collect::<Vec<_>>()
+            .join(" ");
+        texts.push(text);
+        assert!(
+            !help.contains("`mis`: balance heuristic"),
+            "lobe {cmd} --help"
+        );
+        assert!(
+            help.contains("mis-balance: multi-sample MIS with the balance heuristic"),
+            "lobe {cmd} --help"
+        );
+    }
+    assert!(texts.iter().all(|t| t == &texts[0]), "{texts:#?}");
+}
