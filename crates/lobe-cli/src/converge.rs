@@ -41,7 +41,7 @@ pub const MAX_EXP: u32 = 20;
                   and prints the slopes.",
     after_help = "Examples:\n  \
                   lobe converge --material '{\"type\":\"phong\",\"exponent\":10}' --theta 30 --light beam:8 \\\n      \
-                  --strategy cosine,brdf --out conv/phong\n  \
+                  --strategy cosine,brdf --max-exp 12 --out conv/phong\n  \
                   lobe converge --material @examples/ggx.toml --theta 75 --sequence independent,sobol --runs 16 --max-exp 12 --out ggx75"
 )]
 pub struct ConvergeArgs {

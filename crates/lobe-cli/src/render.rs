@@ -128,7 +128,7 @@ Examples:
   lobe render examples/scene.toml
   lobe render examples/scene.toml --spp 16 --strategy light --out light-16
   lobe render examples/scene.toml --threads 1 --seed 7 --quiet
-  lobe render examples/scene.toml --spp 4 --time 10 --sequence sobol
+  lobe render examples/scene.toml --spp 4 --time 2 --sequence sobol
   lobe render examples/scene.toml --spp 16 --spp-allocation variance";
 
 /// The help of `--strategy`: every accepted name.

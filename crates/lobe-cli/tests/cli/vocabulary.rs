@@ -265,3 +265,32 @@ fn every_help_describes_mis_the_same_way() {
     }
     assert!(texts.iter().all(|t| t == &texts[0]), "{texts:#?}");
 }
+
+/// Issue 41: the examples a user starts from do not warn (examples/ggx.toml
+/// gained energy at grazing views: kd added to a full specular lobe).
+#[test]
+fn the_example_materials_do_not_warn() {
+    for m in ["@examples/ggx.toml", "@examples/gold.toml"] {
+        for cmd in [
+            vec![
+                "estimate",
+                "-m",
+                m,
+                "-n",
+                "1024",
+                "--strategy",
+                "brdf",
+                "-q",
+            ],
+            vec!["estimate", "-m", m, "-n", "1024", "--theta", "85", "-q"],
+        ] {
+            let o = lobe(&cmd);
+            ok(&o);
+            assert!(
+                o.stderr.is_empty(),
+                "{cmd:?}: {}",
+                String::from_utf8_lossy(&o.stderr)
+            );
+        }
+    }
+}
