@@ -335,6 +335,61 @@ impl Progress for Bar {
     }
 }
 
+/// Prepares the output directory `dir` of `flag` before any work: creates
+/// it (and its parents) when missing, and checks that a file can be
+/// written in it. The one check of every command's outputs, so that a
+/// long computation is never lost to a path it cannot write.
+pub fn prepare_output_dir(flag: &str, dir: &Path) -> Result<()> {
+    let shown = if dir.as_os_str().is_empty() {
+        Path::new(".")
+    } else {
+        dir
+    };
+    if shown.exists() && !shown.is_dir() {
+        bail!("{flag} {}: is a file, not a directory", shown.display());
+    }
+    std::fs::create_dir_all(shown).map_err(|e| {
+        anyhow!(
+            "{flag} {}: cannot create the directory: {e}",
+            shown.display()
+        )
+    })?;
+    let probe = shown.join(format!(".lobe-write-probe-{}", std::process::id()));
+    std::fs::write(&probe, b"").map_err(|e| {
+        anyhow!(
+            "{flag} {}: cannot write in the directory: {e}",
+            shown.display()
+        )
+    })?;
+    let _ = std::fs::remove_file(&probe);
+    Ok(())
+}
+
+/// Prepares the output files `files` of `flag` before any work: their
+/// directories as [`prepare_output_dir`] does, and none of them an existing
+/// directory.
+pub fn prepare_output_files(flag: &str, files: &[PathBuf]) -> Result<()> {
+    for f in files {
+        if f.is_dir() {
+            bail!("{flag}: {} is a directory, not a file name", f.display());
+        }
+        prepare_output_dir(flag, f.parent().unwrap_or(Path::new("")))?;
+    }
+    Ok(())
+}
+
+/// The SIMD level `LOBE_SIMD` asks for, checked before any work: an unknown
+/// name or a level this CPU lacks is an error naming the variable (not a
+/// note of a fallback deep in the render).
+pub fn check_simd_env() -> Result<()> {
+    lobe::batch::SimdLevel::from_env().map(|_| ()).map_err(|e| {
+        anyhow!(
+            "LOBE_SIMD={}: {e}",
+            std::env::var("LOBE_SIMD").unwrap_or_default()
+        )
+    })
+}
+
 /// `base` with `.ext` appended (keeping any dots already in the name).
 #[must_use]
 pub fn with_ext(base: &Path, ext: &str) -> PathBuf {

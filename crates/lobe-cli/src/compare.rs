@@ -929,6 +929,10 @@ pub fn run(args: &CompareArgs) -> Result<()> {
         &["png", "json"],
         "-compare",
     )?;
+    crate::common::prepare_output_files(
+        "--out",
+        &["png", "json"].map(|e| crate::common::with_ext(&base, e)),
+    )?;
     let scene = load_scene(&args.scene)?;
     let methods = methods.unwrap_or_else(|| default_methods(&scene));
     let spp = args

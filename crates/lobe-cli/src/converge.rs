@@ -203,6 +203,10 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
         );
     }
     let sequences = parse_sequences(&args.sequence)?;
+    crate::common::prepare_output_files(
+        "--out",
+        &["csv", "svg", "png"].map(|e| with_ext(&args.out, e)),
+    )?;
     let m = crate::common::load_material(&args.material)?;
     let wo = args.view.wo()?;
     let light = args.light.light()?;
@@ -249,10 +253,6 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
         );
     }
 
-    if let Some(dir) = args.out.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir)
-            .with_context(|| format!("--out: cannot create the directory {}", dir.display()))?;
-    }
     let csv_path = with_ext(&args.out, "csv");
     std::fs::write(&csv_path, csv(&curves))
         .with_context(|| format!("cannot write {}", csv_path.display()))?;

@@ -14,7 +14,7 @@ use crate::common::Bar;
 use crate::compare::{
     FigureSpec, Label, print_table, run_with_progress, summary, write_grid, write_json,
 };
-use anyhow::{Context, Result};
+use anyhow::Result;
 use clap::Args;
 use glam::DVec3;
 use lobe::estimator::Strategy;
@@ -118,6 +118,7 @@ const TOUR: [(&str, &str); 4] = [
 pub fn run(args: &DemoArgs) -> Result<()> {
     let t0 = Instant::now();
     let plan = DemoSizes::new(args.quick);
+    crate::common::prepare_output_dir("--out", &args.out)?;
     tour(&plan, args.quiet)?;
     showcase(&plan, &args.out, args.quiet)?;
     println!(
@@ -350,8 +351,6 @@ fn showcase(plan: &DemoSizes, dir: &Path, quiet: bool) -> Result<()> {
         settings.spp, settings.max_depth
     );
     println!("is MIS at {} spp.", settings.reference_spp);
-    std::fs::create_dir_all(dir)
-        .with_context(|| format!("{}: cannot create the directory", dir.display()))?;
     let cmp = run_with_progress(&scene, &settings, quiet);
     let png = dir.join("showcase.png");
     let json = dir.join("showcase.json");

@@ -55,6 +55,9 @@ pub fn run(args: &FitArgs) -> Result<()> {
     if args.model != "cook-torrance" {
         bail!("--model: only cook-torrance can be fitted");
     }
+    if let Some(p) = &args.plot {
+        crate::common::prepare_output_files("--plot", std::slice::from_ref(p))?;
+    }
     let lobe = Measured::load(&args.file, None).context("FILE")?;
     eprintln!("{}", lobe.summary());
     let m = lobe::Material::with_diffuse(lobe::Rgb::ZERO, lobe::Glossy::Measured(lobe))?;

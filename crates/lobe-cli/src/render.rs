@@ -142,6 +142,10 @@ fn strategy_help() -> String {
 /// Run `lobe render`.
 pub fn run(args: &RenderArgs) -> Result<()> {
     let base = crate::common::output_base(args.out.as_deref(), &args.scene, &["exr", "png"], "")?;
+    crate::common::prepare_output_files(
+        "--out",
+        &["exr", "png", "spp.png"].map(|e| crate::common::with_ext(&base, e)),
+    )?;
     if !args.exposure.is_finite() || args.exposure.abs() > 64.0 {
         bail!(
             "--exposure {}: must be a number of stops in [-64, 64]",

@@ -388,8 +388,7 @@ pub fn run(args: &ReportArgs) -> Result<()> {
     let start = Instant::now();
     let settings = ReportSizes::new(args.quick);
     let dir = &args.out;
-    std::fs::create_dir_all(dir)
-        .with_context(|| format!("--out: cannot create the directory {}", dir.display()))?;
+    crate::common::prepare_output_dir("--out", dir)?;
     let models = if args.materials.is_empty() {
         models()
     } else {

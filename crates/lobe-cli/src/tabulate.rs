@@ -40,6 +40,7 @@ pub struct TabulateArgs {
 }
 
 pub fn run(args: &TabulateArgs) -> Result<()> {
+    crate::common::prepare_output_files("--out", std::slice::from_ref(&args.out))?;
     let m = crate::common::load_material(&args.material)?;
     let format = match args.format.as_str() {
         "merl" => Format::Merl,
