@@ -244,13 +244,9 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         // Passes until the time is up: no known length.
         "{msg:>12} {spinner} {human_pos} samples, {per_sec}, {elapsed}"
     } else {
-        "{msg:>12} [{wide_bar}] {human_pos}/{human_len} samples, {per_sec}, {elapsed}<{eta}"
+        "{msg:>12} [{wide_bar}] {human_pos}/{human_len} samples, {per_sec}, {elapsed}<{eta_left}"
     };
-    pb.set_style(
-        indicatif::ProgressStyle::with_template(template)
-            .expect("progress template is valid")
-            .progress_chars("=> "),
-    );
+    pb.set_style(crate::common::progress_style(template));
     let t0 = Instant::now();
     let image = match budget {
         None => render(&scene, &opts, |n| pb.inc(n)),

@@ -408,3 +408,36 @@ fn outputs_are_checked_before_the_work_the_same_way_everywhere() {
     let e = common::one_line_error(&o);
     assert!(e.starts_with("lobe: error: LOBE_SIMD=neon: "), "{e}");
 }
+
+/// Issue 41: a long render is not silent when stderr is not a terminal
+/// (here a pipe): plain progress lines, the first one not nonsense.
+#[test]
+fn a_render_shows_progress_lines_off_a_terminal() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let out = Path::new(env!("CARGO_TARGET_TMPDIR")).join("progress-41");
+    let o = Command::new(env!("CARGO_BIN_EXE_lobe"))
+        .args([
+            "render",
+            "examples/scene.toml",
+            "--spp",
+            "512",
+            "--spp-allocation",
+            "uniform",
+        ])
+        .arg("--out")
+        .arg(&out)
+        .current_dir(&root)
+        .env("LOBE_PROGRESS_EVERY", "0.1")
+        .env("RAYON_NUM_THREADS", "1")
+        .output()
+        .unwrap();
+    assert!(o.status.success());
+    let e = String::from_utf8_lossy(&o.stderr);
+    let lines: Vec<&str> = e
+        .lines()
+        .filter(|l| l.starts_with("lobe: rendering "))
+        .collect();
+    assert!(!lines.is_empty(), "{e}");
+    assert!(lines[0].contains("% (") && lines[0].contains(" of "), "{e}");
+    assert!(!e.contains("3w") && !e.contains("weeks"), "{e}");
+}
