@@ -179,7 +179,12 @@ fn vs_uniform_for_a_narrow_lobe() {
     let uniform = out.lines().find(|l| l.starts_with("uniform ")).unwrap();
     assert!(uniform.contains("unreliable"), "{out}");
     let vndf = out.lines().find(|l| l.starts_with("vndf ")).unwrap();
-    assert!(vndf.contains("e") && vndf.contains("x "), "{vndf}");
+    // (Issue 41: its per-sample spread is below 1e-10 of the mean, G2/G1 of
+    // a near-mirror, so it is printed as exact, not as a 1e20x ratio.)
+    assert!(
+        (vndf.contains("e") && vndf.contains("x ")) || vndf.contains(" exact "),
+        "{vndf}"
+    );
     for l in out.lines() {
         assert!(
             !l.split_whitespace()
