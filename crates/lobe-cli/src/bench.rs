@@ -344,7 +344,11 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     let inputs = Inputs::new(args.samples);
     let msps = |d: Duration| args.samples as f64 / d.as_secs_f64() / 1e6;
     let mut results = Vec::new();
+    // Progress: three timings per row (on a terminal a bar; otherwise a
+    // line every few seconds).
+    let bar = crate::common::progress(3 * rows.len() as u64, "timing", false);
     for ((text, m, s), b) in rows.iter().zip(&samplers) {
+        bar.set_message(format!("timing {s}"));
         let job = |mode| Job {
             mode,
             m,
@@ -354,9 +358,12 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         };
         let full = time(job(Mode::SampleEvalPdf), args.threads, args.reps);
         let sample = time(job(Mode::Sample), args.threads, args.reps);
+        bar.inc(2);
         let scalar = time(job(Mode::Scalar), args.threads, args.reps);
+        bar.inc(1);
         results.push((text.as_str(), *s, msps(full), msps(sample), msps(scalar)));
     }
+    bar.finish_and_clear();
     let level = level.map_or("none", |l| l.name());
     let cpu = cpu_model();
     if args.json {

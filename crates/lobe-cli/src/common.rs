@@ -200,22 +200,194 @@ pub fn warn_energy_gain(m: &lobe::Material, what: &str) {
     }
 }
 
-/// A progress bar on stderr, hidden with `--quiet` (indicatif hides it by
-/// itself when stderr is not a terminal).
+/// What `mis`, the default technique, is: the one description of every help
+/// text that names it ([`technique_help`], `lobe render --help`).
+pub const MIS_DESCRIPTION: &str = "adaptive MIS, the default: each sample draws one BSDF direction (vndf where the material has it, else brdf) and one light direction, and gives both to BSDF sampling, to the balance heuristic or to light sampling, whichever a pilot of its own samples finds of least variance (in a render: per pixel, from the pilots of the 7 × 7 pixels around it; deeper bounces use the balance heuristic)";
+
+/// What a technique of [`Strategy::names`](lobe::estimator::Strategy::names)
+/// is, in a few words; `None` for a name this list does not know (a test
+/// checks that every accepted name has one).
+#[must_use]
+pub fn technique_description(name: &str) -> Option<&'static str> {
+    Some(match name {
+        "uniform" => "uniform over the hemisphere (the baseline)",
+        "cosine" => "cosine-weighted hemisphere",
+        "brdf" => {
+            "the lecture's importance sampling (Phong's lobe, Blinn-Phong's half vector, Cook-Torrance's D(h) cos θh)"
+        }
+        "vndf" => "visible normals (Heitz 2018; GGX and Beckmann)",
+        "spherical-caps" => "visible normals by spherical caps (Dupuy and Benyoub 2023; GGX)",
+        "bounded-vndf" => "bounded VNDF (Eto and Tokuyoshi 2023; GGX)",
+        "light" => "light sampling alone (the environment map's or the light's own distribution)",
+        "mis" => MIS_DESCRIPTION,
+        "mis-balance" => {
+            "multi-sample MIS with the balance heuristic: one BSDF and one light sample, both weighted"
+        }
+        "mis-power" => "multi-sample MIS with the power heuristic",
+        "mis-one" => {
+            "one-sample MIS with the balance heuristic: one draw, BSDF or light at even odds"
+        }
+        "mis-power-one" => "one-sample MIS with the power heuristic",
+        _ => return None,
+    })
+}
+
+/// Every technique name with its description ([`technique_description`]):
+/// the one text of `--strategy` in `estimate`, `converge`, `render` and
+/// `compare`.
+#[must_use]
+pub fn technique_help() -> String {
+    lobe::estimator::Strategy::names()
+        .split(", ")
+        .map(|n| {
+            format!(
+                "{n}: {}",
+                technique_description(n).unwrap_or("(no description)")
+            )
+        })
+        .collect::<Vec<_>>()
+        .join("; ")
+}
+
+/// Per-sample standard deviation, relative to the mean, below which a
+/// measured variance is rounding and not noise: such an estimator is exact
+/// (every sample gives the integral, as BRDF sampling of a Lambert surface
+/// under a constant light does), and its variance, its slope and any ratio
+/// against it are printed as exact, not as the rounding's numbers.
+pub const EXACT_RELATIVE_SD: f64 = 1e-10;
+
+/// Whether a per-sample `variance` of an estimate of `mean` is zero up to
+/// rounding ([`EXACT_RELATIVE_SD`]).
+#[must_use]
+pub fn is_exact(variance: f64, mean: f64) -> bool {
+    variance <= (EXACT_RELATIVE_SD * mean).powi(2)
+}
+
+/// Whether a table row is exact ([`is_exact`] of its luminance).
+#[must_use]
+pub fn row_is_exact(row: &lobe::experiment::table::Row) -> bool {
+    is_exact(
+        row.variance,
+        lobe::math::luminance(lobe::Rgb::from_array(row.mean)),
+    )
+}
+
+/// The rows of `t` whose variance is rounding ([`row_is_exact`]) with their
+/// variance and standard error set to 0 and no variance reduction or
+/// efficiency (both infinite), so that tables and JSON print exact values,
+/// not the rounding's (a variance of 3e-33, a reduction of 7e31×).
+pub fn zero_exact_rows(t: &mut lobe::experiment::table::Table) {
+    for row in &mut t.strategies {
+        if row_is_exact(row) {
+            row.variance = 0.0;
+            row.stderr = [0.0; 3];
+            row.variance_reduction = None;
+            row.efficiency = None;
+        }
+    }
+}
+
+/// Seconds between the plain progress lines written when stderr is not a
+/// terminal (a log, CI, a pipe), where indicatif draws nothing.
+pub const PLAIN_PROGRESS_EVERY_S: f64 = 5.0;
+
+/// The time left, or `?` until it can be told: before a second has passed
+/// or anything is done, indicatif's estimate is nonsense (`0s<3w`).
+fn eta_text(state: &indicatif::ProgressState) -> String {
+    let elapsed = state.elapsed().as_secs_f64();
+    let pos = state.pos();
+    match state.len() {
+        Some(len) if pos > 0 && elapsed >= 1.0 && len >= pos => {
+            let left = elapsed * (len - pos) as f64 / pos as f64;
+            format!(
+                "{}",
+                indicatif::HumanDuration(std::time::Duration::from_secs_f64(left))
+            )
+        }
+        _ => "?".to_string(),
+    }
+}
+
+/// The progress style of every bar: `{eta_left}` is [`eta_text`].
+pub fn progress_style(template: &str) -> ProgressStyle {
+    ProgressStyle::with_template(template)
+        .expect("progress template is valid")
+        .with_key(
+            "eta_left",
+            |state: &indicatif::ProgressState, w: &mut dyn std::fmt::Write| {
+                let _ = w.write_str(&eta_text(state));
+            },
+        )
+        .progress_chars("=> ")
+}
+
+/// A progress bar on stderr, hidden with `--quiet`. On a terminal
+/// indicatif draws it; otherwise (indicatif draws nothing there) a thread
+/// writes one plain line every [`PLAIN_PROGRESS_EVERY_S`] seconds while the
+/// bar lives: `lobe: rendering: 45% (1.2M of 2.6M), 12s, about 15s left`.
 pub fn progress(len: u64, message: &str, quiet: bool) -> ProgressBar {
     if quiet {
         return ProgressBar::hidden();
     }
     let pb = ProgressBar::new(len);
-    pb.set_style(
-        ProgressStyle::with_template(
-            "{msg:>20} [{wide_bar}] {human_pos}/{human_len} {elapsed}<{eta}",
-        )
-        .expect("progress template is valid")
-        .progress_chars("=> "),
-    );
+    pb.set_style(progress_style(
+        "{msg:>20} [{wide_bar}] {human_pos}/{human_len} {elapsed}<{eta_left}",
+    ));
     pb.set_message(message.to_string());
+    if !std::io::IsTerminal::is_terminal(&std::io::stderr()) {
+        plain_lines(&pb);
+    }
     pb
+}
+
+/// Writes a plain progress line of `pb` every [`PLAIN_PROGRESS_EVERY_S`]
+/// seconds until it is finished or dropped.
+pub fn plain_lines(pb: &ProgressBar) {
+    let weak = pb.downgrade();
+    // LOBE_PROGRESS_EVERY=SECONDS changes the interval (the tests use it).
+    let every = std::env::var("LOBE_PROGRESS_EVERY")
+        .ok()
+        .and_then(|v| v.parse::<f64>().ok())
+        .filter(|v| v.is_finite() && *v > 0.0)
+        .unwrap_or(PLAIN_PROGRESS_EVERY_S);
+    let every = std::time::Duration::from_secs_f64(every);
+    let _ = std::thread::Builder::new()
+        .name("lobe-progress".into())
+        .spawn(move || {
+            loop {
+                std::thread::sleep(every);
+                let Some(pb) = weak.upgrade() else { return };
+                if pb.is_finished() {
+                    return;
+                }
+                let state = format!(
+                    "{} {}",
+                    pb.message(),
+                    match pb.length() {
+                        Some(len) if len > 0 => format!(
+                            "{:.0}% ({} of {})",
+                            100.0 * pb.position() as f64 / len as f64,
+                            indicatif::HumanCount(pb.position()),
+                            indicatif::HumanCount(len)
+                        ),
+                        _ => format!("{}", indicatif::HumanCount(pb.position())),
+                    }
+                );
+                let elapsed = indicatif::HumanDuration(pb.elapsed());
+                let left = match pb.length() {
+                    Some(len) if pb.position() > 0 && len >= pb.position() => {
+                        let e = pb.elapsed().as_secs_f64();
+                        let left = e * (len - pb.position()) as f64 / pb.position() as f64;
+                        format!(
+                            ", about {} left",
+                            indicatif::HumanDuration(std::time::Duration::from_secs_f64(left))
+                        )
+                    }
+                    _ => String::new(),
+                };
+                eprintln!("lobe: {}: {elapsed}{left}", state.trim());
+            }
+        });
 }
 
 /// A [`Progress`] shown as an indicatif bar on stderr (hidden with
@@ -246,6 +418,61 @@ impl Progress for Bar {
     fn advance(&self, n: u64) {
         self.0.inc(n);
     }
+}
+
+/// Prepares the output directory `dir` of `flag` before any work: creates
+/// it (and its parents) when missing, and checks that a file can be
+/// written in it. The one check of every command's outputs, so that a
+/// long computation is never lost to a path it cannot write.
+pub fn prepare_output_dir(flag: &str, dir: &Path) -> Result<()> {
+    let shown = if dir.as_os_str().is_empty() {
+        Path::new(".")
+    } else {
+        dir
+    };
+    if shown.exists() && !shown.is_dir() {
+        bail!("{flag} {}: is a file, not a directory", shown.display());
+    }
+    std::fs::create_dir_all(shown).map_err(|e| {
+        anyhow!(
+            "{flag} {}: cannot create the directory: {e}",
+            shown.display()
+        )
+    })?;
+    let probe = shown.join(format!(".lobe-write-probe-{}", std::process::id()));
+    std::fs::write(&probe, b"").map_err(|e| {
+        anyhow!(
+            "{flag} {}: cannot write in the directory: {e}",
+            shown.display()
+        )
+    })?;
+    let _ = std::fs::remove_file(&probe);
+    Ok(())
+}
+
+/// Prepares the output files `files` of `flag` before any work: their
+/// directories as [`prepare_output_dir`] does, and none of them an existing
+/// directory.
+pub fn prepare_output_files(flag: &str, files: &[PathBuf]) -> Result<()> {
+    for f in files {
+        if f.is_dir() {
+            bail!("{flag}: {} is a directory, not a file name", f.display());
+        }
+        prepare_output_dir(flag, f.parent().unwrap_or(Path::new("")))?;
+    }
+    Ok(())
+}
+
+/// The SIMD level `LOBE_SIMD` asks for, checked before any work: an unknown
+/// name or a level this CPU lacks is an error naming the variable (not a
+/// note of a fallback deep in the render).
+pub fn check_simd_env() -> Result<()> {
+    lobe::batch::SimdLevel::from_env().map(|_| ()).map_err(|e| {
+        anyhow!(
+            "LOBE_SIMD={}: {e}",
+            std::env::var("LOBE_SIMD").unwrap_or_default()
+        )
+    })
 }
 
 /// `base` with `.ext` appended (keeping any dots already in the name).
@@ -286,4 +513,17 @@ pub fn output_base(
     let mut s = stem.to_owned();
     s.push(suffix);
     Ok(PathBuf::from(s))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_technique_has_a_description() {
+        for n in lobe::estimator::Strategy::names().split(", ") {
+            assert!(technique_description(n).is_some(), "{n}");
+        }
+        assert!(technique_help().contains(MIS_DESCRIPTION));
+    }
 }

@@ -30,11 +30,20 @@ use std::path::{Path, PathBuf};
 #[command(
     about = "Compare strategies on a scene at equal samples and equal time, with error maps",
     long_about = "Render a scene file (the format of `lobe render --help`) with each strategy twice: at \
-                  equal samples (every strategy at --spp) and at equal time (every strategy with as many \
-                  samples per pixel as fit in the time mis took at --spp, or the slowest strategy when mis \
-                  is not compared; each strategy's equal-samples render is the pilot that measures its \
-                  time per sample). A reference is rendered with mis at --reference-spp, from an \
-                  independent seed.\n\n\
+                  equal samples (every strategy at --spp) and at equal time (every strategy with the \
+                  samples per pixel that make its render take the time mis took at max(--spp, 32) spp (more when that is under 50 ms), \
+                  or the slowest strategy when mis is not compared, within 3%: each is rendered again, \
+                  up to 4 times, with the spp its earlier renders' times point to). Times are of the \
+                  render alone: every strategy is first rendered once untimed (the start-up: threads, \
+                  tables, memory), and a render under 0.1 s is timed as the fastest of 3 runs. The \
+                  budget is at least 32 spp because whole samples per pixel cannot make small budgets \
+                  equal (at 4 spp one sample is 25%). A reference is rendered with mis-balance at \
+                  --reference-spp, from an independent seed.\n\n\
+                  The RMSE of BSDF sampling (brdf, vndf) under the built-in sky is a few fireflies': \
+                  a rare sample that finds the small, bright sun puts most of the squared error into \
+                  one pixel (the `worst px` column), so its RMSE changes several-fold with --seed (on \
+                  examples/scene.toml at 4 spp, seeds 1 to 8: brdf 1.2 to 28, vndf 1.2 to 26, the \
+                  same mean); the table says when this is so.\n\n\
                   Writes NAME.png, one figure: the reference, and for each strategy and each row (equal \
                   samples, equal time) the render (tone-mapped as `lobe render`'s PNG) with its per-pixel \
                   error map: the relative error of luminance |Y - Y_ref| / (Y_ref + eps), eps = 1% of the \
@@ -73,8 +82,6 @@ pub struct CompareArgs {
     /// Samples per pixel of the mis reference (default: 16 × spp, at least 1024)
     #[arg(long, value_name = "R", value_parser = crate::common::spp_u32)]
     pub reference_spp: Option<u32>,
-    /// Comma-separated strategies (default: brdf, light, mis, and vndf when
-    /// an object's material has it); `--strategies` is an old name of it
     #[arg(long = "strategy", alias = "strategies", value_name = "LIST", help = strategy_help())]
     pub strategies: Option<String>,
     /// No progress bars and no notes
@@ -85,8 +92,9 @@ pub struct CompareArgs {
 /// The help of `--strategy`: every accepted name.
 fn strategy_help() -> String {
     format!(
-        "Comma-separated strategies: {} (default: brdf, light, mis, and vndf when an object's material has it)",
-        Strategy::names()
+        "Comma-separated techniques (default: {}). {}",
+        lobe_render::compare::DEFAULT_METHODS,
+        crate::common::technique_help()
     )
 }
 
@@ -759,6 +767,9 @@ pub struct ShotJson {
     pub spp: u32,
     pub time_s: f64,
     pub rmse: f64,
+    /// The share of the squared error (RMSE²) in the worst pixel
+    /// ([`worst_pixel_share`]).
+    pub worst_pixel_share: f64,
 }
 
 #[derive(Debug, Clone, Serialize)]
@@ -791,7 +802,7 @@ pub struct Summary {
     pub figure: FigureInfo,
 }
 
-fn shots_json(shots: &[Shot]) -> Vec<ShotJson> {
+fn shots_json(shots: &[Shot], reference: &Shot) -> Vec<ShotJson> {
     shots
         .iter()
         .map(|s| ShotJson {
@@ -799,9 +810,28 @@ fn shots_json(shots: &[Shot]) -> Vec<ShotJson> {
             spp: s.spp,
             time_s: s.time_s,
             rmse: s.rmse,
+            worst_pixel_share: worst_pixel_share(s, reference),
         })
         .collect()
 }
+
+/// The share of a render's squared error against the reference (the sum
+/// over pixels of |render − reference|², RMSE² up to a constant) that is in
+/// its worst pixel: near 1, the RMSE is one firefly's (0 for no error).
+#[must_use]
+pub fn worst_pixel_share(s: &Shot, reference: &Shot) -> f64 {
+    let (mut sum, mut worst) = (0.0f64, 0.0f64);
+    for (p, r) in s.image.pixels.iter().zip(&reference.image.pixels) {
+        let e = (*p - *r).length_squared();
+        sum += e;
+        worst = worst.max(e);
+    }
+    if sum > 0.0 { worst / sum } else { 0.0 }
+}
+
+/// Above this [`worst_pixel_share`], a render's RMSE is called a firefly's
+/// in the printed table.
+pub const FIREFLY_SHARE: f64 = 0.25;
 
 /// The numbers of a comparison, for NAME.json.
 #[must_use]
@@ -820,8 +850,11 @@ pub fn summary(scene: &str, s: &CompareSettings, cmp: &Comparison, figure: Figur
             time_s: r.time_s,
             seed: cmp.reference_seed,
         },
-        equal_samples: shots_json(&cmp.equal_samples),
-        equal_time: cmp.equal_time.as_ref().map(|e| shots_json(&e.shots)),
+        equal_samples: shots_json(&cmp.equal_samples, &cmp.reference),
+        equal_time: cmp
+            .equal_time
+            .as_ref()
+            .map(|e| shots_json(&e.shots, &cmp.reference)),
         time_budget_s: cmp.equal_time.as_ref().map(|e| e.budget_s),
         time_budget_from: cmp.equal_time.as_ref().map(|e| e.budget_from.clone()),
         rmse: "root mean square over all pixels and the three channels of (render - reference), linear RGB",
@@ -845,21 +878,39 @@ pub fn print_table(cmp: &Comparison) {
         r.spp,
         fmt_time(r.time_s)
     );
+    let mut fireflies: Vec<String> = Vec::new();
     for (heading, shots) in sections(cmp) {
         println!("{heading}");
         println!(
-            "  {:<15} {:>8} {:>10} {:>12}",
-            "strategy", "spp", "time", "RMSE"
+            "  {:<15} {:>8} {:>10} {:>12} {:>10}",
+            "strategy", "spp", "time", "RMSE", "worst px"
         );
         for s in shots {
+            let share = worst_pixel_share(s, r);
+            if share > FIREFLY_SHARE && !fireflies.contains(&s.method.name()) {
+                fireflies.push(s.method.name());
+            }
             println!(
-                "  {:<15} {:>8} {:>10} {:>12}",
+                "  {:<15} {:>8} {:>10} {:>12} {:>9.0}%",
                 s.method.name(),
                 s.spp,
                 fmt_time(s.time_s),
-                sig3(s.rmse)
+                sig3(s.rmse),
+                100.0 * share
             );
         }
+    }
+    println!(
+        "time: of the render alone, after an untimed warm-up (the fastest of {} runs below {}); worst px: the share of the squared error in the worst pixel",
+        lobe_render::compare::SHORT_RENDER_RUNS,
+        fmt_time(lobe_render::compare::SHORT_RENDER_S)
+    );
+    if !fireflies.is_empty() {
+        println!(
+            "{}: one pixel holds more than {:.0}% of the squared error: a firefly, a rare sample of a large weight (BSDF sampling that found the small, bright sun; light sampling that found a sharp highlight). Such an RMSE changes several-fold with --seed; do not rank these strategies by one seed",
+            fireflies.join(", "),
+            100.0 * FIREFLY_SHARE
+        );
     }
 }
 
@@ -877,6 +928,10 @@ pub fn run(args: &CompareArgs) -> Result<()> {
         &args.scene,
         &["png", "json"],
         "-compare",
+    )?;
+    crate::common::prepare_output_files(
+        "--out",
+        &["png", "json"].map(|e| crate::common::with_ext(&base, e)),
     )?;
     let scene = load_scene(&args.scene)?;
     let methods = methods.unwrap_or_else(|| default_methods(&scene));

@@ -41,7 +41,7 @@ pub const MAX_EXP: u32 = 20;
                   and prints the slopes.",
     after_help = "Examples:\n  \
                   lobe converge --material '{\"type\":\"phong\",\"exponent\":10}' --theta 30 --light beam:8 \\\n      \
-                  --strategy cosine,brdf --out conv/phong\n  \
+                  --strategy cosine,brdf --max-exp 12 --out conv/phong\n  \
                   lobe converge --material @examples/ggx.toml --theta 75 --sequence independent,sobol --runs 16 --max-exp 12 --out ggx75"
 )]
 pub struct ConvergeArgs {
@@ -124,6 +124,24 @@ pub fn plot_series(curves: &[Curve]) -> Vec<Series> {
         .collect()
 }
 
+/// The curves whose every RMSE is rounding (at most
+/// [`crate::common::EXACT_RELATIVE_SD`] of the `target`) with their RMSE set
+/// to 0 and no slope: an exact estimator, printed as `exact`, not as the
+/// slope of its rounding (0.001).
+pub fn zero_exact_curves(curves: &mut [Curve], target: f64) {
+    for c in curves {
+        if c.points
+            .iter()
+            .all(|p| p.1 <= crate::common::EXACT_RELATIVE_SD * target.abs())
+        {
+            for p in &mut c.points {
+                p.1 = 0.0;
+            }
+            c.slope = None;
+        }
+    }
+}
+
 /// The CSV text: `strategy,sequence,n,rmse,slope`, one line per curve and N.
 #[must_use]
 pub fn csv(curves: &[Curve]) -> String {
@@ -185,6 +203,10 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
         );
     }
     let sequences = parse_sequences(&args.sequence)?;
+    crate::common::prepare_output_files(
+        "--out",
+        &["csv", "svg", "png"].map(|e| with_ext(&args.out, e)),
+    )?;
     let m = crate::common::load_material(&args.material)?;
     let wo = args.view.wo()?;
     let light = args.light.light()?;
@@ -205,7 +227,7 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
     }
     let series = setup.series();
     let bar = Bar::new(args.quiet);
-    let curves = curves(
+    let mut curves = curves(
         &m,
         &sp,
         &light,
@@ -219,6 +241,7 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
         &bar,
     )?;
     bar.finish();
+    zero_exact_curves(&mut curves, target);
     if let Some(c) = curves
         .iter()
         .find(|c| c.points.iter().any(|p| !p.1.is_finite()))
@@ -230,10 +253,6 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
         );
     }
 
-    if let Some(dir) = args.out.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir)
-            .with_context(|| format!("--out: cannot create the directory {}", dir.display()))?;
-    }
     let csv_path = with_ext(&args.out, "csv");
     std::fs::write(&csv_path, csv(&curves))
         .with_context(|| format!("cannot write {}", csv_path.display()))?;

@@ -14,7 +14,7 @@ use crate::common::Bar;
 use crate::compare::{
     FigureSpec, Label, print_table, run_with_progress, summary, write_grid, write_json,
 };
-use anyhow::{Context, Result};
+use anyhow::Result;
 use clap::Args;
 use glam::DVec3;
 use lobe::estimator::Strategy;
@@ -118,6 +118,7 @@ const TOUR: [(&str, &str); 4] = [
 pub fn run(args: &DemoArgs) -> Result<()> {
     let t0 = Instant::now();
     let plan = DemoSizes::new(args.quick);
+    crate::common::prepare_output_dir("--out", &args.out)?;
     tour(&plan, args.quiet)?;
     showcase(&plan, &args.out, args.quiet)?;
     println!(
@@ -136,9 +137,13 @@ fn tour(plan: &DemoSizes, quiet: bool) -> Result<()> {
     );
     println!("so L_o is the directional albedo. Each strategy gets {n} samples; the reference is");
     println!(
-        "adaptive quadrature. 'vs uniform' is uniform's variance over this strategy's: how many"
+        "adaptive quadrature. 'vs uniform' is uniform's exact variance (by quadrature, printed"
     );
-    println!("times fewer samples it needs for the same noise.\n");
+    println!(
+        "beside the reference) over this strategy's measured variance (the 'variance' column):"
+    );
+    println!("how many times fewer samples it needs for the same noise. Uniform's own row is its");
+    println!("measured variance against the exact one, so it is near, not at, 1.0x.\n");
     for (label, json) in TOUR {
         let m = MaterialDesc::from_json(json)?.build()?;
         let techniques: Vec<Strategy> = m
@@ -148,7 +153,7 @@ fn tour(plan: &DemoSizes, quiet: bool) -> Result<()> {
             .map(Strategy::from)
             .collect();
         let bar = Bar::new(quiet);
-        let table = run_table(
+        let mut table = run_table(
             &m,
             &lobe::estimator::ShadingPoint::local(wo),
             &light,
@@ -162,24 +167,37 @@ fn tour(plan: &DemoSizes, quiet: bool) -> Result<()> {
             &SystemClock::new(),
         )?;
         bar.finish();
+        crate::common::zero_exact_rows(&mut table);
+        let u = &table.uniform_variance;
         println!(
-            "{label}: reference {:.5}",
-            luminance(Rgb::from_array(table.reference))
+            "{label}: reference {:.5}, uniform's exact variance {}",
+            luminance(Rgb::from_array(table.reference)),
+            if u.reliable {
+                format!("{:.4e}", u.variance)
+            } else {
+                "unreliable (its quadrature did not converge)".to_string()
+            }
         );
         println!(
             "  {:<15} {:>10} {:>10} {:>11} {:>11}",
             "strategy", "estimate", "rel. err", "variance", "vs uniform"
         );
         for r in &table.strategies {
-            let red = r
-                .variance_reduction
-                .map_or("zero var".to_string(), |x| format!("{x:.1}x"));
+            let (variance, red) = if r.variance <= 0.0 {
+                ("0".to_string(), "exact".to_string())
+            } else {
+                (
+                    format!("{:.4e}", r.variance),
+                    r.variance_reduction
+                        .map_or("unreliable".to_string(), crate::estimate::format_ratio),
+                )
+            };
             println!(
-                "  {:<15} {:>10.5} {:>10.2e} {:>11.3e} {:>11}",
+                "  {:<15} {:>10.5} {:>10.2e} {:>11} {:>11}",
                 r.name,
                 luminance(Rgb::from_array(r.mean)),
                 r.relative_error,
-                r.variance,
+                variance,
                 red
             );
         }
@@ -333,8 +351,6 @@ fn showcase(plan: &DemoSizes, dir: &Path, quiet: bool) -> Result<()> {
         settings.spp, settings.max_depth
     );
     println!("is MIS at {} spp.", settings.reference_spp);
-    std::fs::create_dir_all(dir)
-        .with_context(|| format!("{}: cannot create the directory", dir.display()))?;
     let cmp = run_with_progress(&scene, &settings, quiet);
     let png = dir.join("showcase.png");
     let json = dir.join("showcase.json");

@@ -77,9 +77,9 @@ pub struct EstimateArgs {
 #[must_use]
 pub fn strategy_help() -> String {
     format!(
-        "`all` or a comma-separated list of: {} (all: {}). mis (the default MIS) gives each sample's draws to BSDF sampling, to the balance heuristic or to light sampling, whichever a pilot of its own samples says has the least variance; mis-balance and mis-power are multi-sample MIS with those heuristics; mis-one and mis-power-one one-sample MIS",
-        Strategy::names(),
-        lobe::strategy::ALL_MEANS
+        "`all` or a comma-separated list of techniques (all: {}). {}",
+        lobe::strategy::ALL_MEANS,
+        crate::common::technique_help()
     )
 }
 
@@ -164,7 +164,7 @@ pub fn run(args: &EstimateArgs) -> Result<()> {
     }
     let bar = Bar::new(args.quiet);
     let sp = args.light.shading_point(&light, wo)?;
-    let table = run_table_with(
+    let mut table = run_table_with(
         &m,
         &sp,
         &light,
@@ -191,6 +191,7 @@ pub fn run(args: &EstimateArgs) -> Result<()> {
             );
         }
     }
+    crate::common::zero_exact_rows(&mut table);
     if args.json {
         println!("{}", serde_json::to_string(&table)?);
     } else {
@@ -247,33 +248,60 @@ fn print_table(t: &Table, model: &str, wo: DVec3) {
         "time",
         "efficiency"
     );
+    let mut unreliable = false;
+    let mut exact = false;
     for r in &t.strategies {
         let red = if !r.variance_reliable {
+            unreliable = true;
             "unreliable".to_string()
         } else if r.variance <= 0.0 {
-            "zero var".to_string()
+            exact = true;
+            "exact".to_string()
+        } else if let Some(x) = r.variance_reduction {
+            format_ratio(x)
         } else {
-            r.variance_reduction
-                .map_or("unreliable".to_string(), format_ratio)
+            unreliable = true;
+            "unreliable".to_string()
         };
         let eff = r
             .efficiency
             .map_or("inf".to_string(), |x| format!("{x:.3e}"));
+        let variance = if r.variance <= 0.0 {
+            "0".to_string()
+        } else {
+            format!("{:.4e}", r.variance)
+        };
         println!(
-            "{:<15} {:>26} {:>26} {:>10.2e} {:>11.4e} {:>10} {:>8.3}s {:>11}",
+            "{:<15} {:>26} {:>26} {:>10.2e} {:>11} {:>10} {:>8.3}s {:>11}",
             r.name,
             rgb(r.mean),
             rgb(r.stderr),
             r.relative_error,
-            r.variance,
+            variance,
             red,
             r.time_s,
             eff
         );
     }
-    println!(
-        "\nvariance: per sample, of the luminance of f·L·cos/p; vs uniform: uniform's exact variance / this one (unreliable: the estimate is more than 6 std. errors from the reference, so its variance is not to be trusted); efficiency: 1/(variance × time)"
+    println!("\n{}", legend(unreliable, exact));
+}
+
+/// The notes under the table: always what the columns are; what
+/// `unreliable` and `exact` mean only when a row says so.
+fn legend(unreliable: bool, exact: bool) -> String {
+    let mut s = String::from(
+        "variance: per sample, of the luminance of f·L·cos/p; vs uniform: uniform's exact variance / this one; efficiency: 1/(variance × time)",
     );
+    if exact {
+        s.push_str(&format!(
+            "\nexact: zero variance up to rounding (per-sample std. dev. below {:e} of the mean): every sample gives the integral",
+            crate::common::EXACT_RELATIVE_SD
+        ));
+    }
+    if unreliable {
+        s.push_str("\nunreliable: the estimate is more than 6 std. errors from the reference (or uniform's exact variance did not converge), so the ratio is not to be trusted");
+    }
+    s
 }
 
 /// `N/R` as printed: one number when the replicas are equal, else a range.

@@ -18,10 +18,12 @@ use lobe::models::measured::Measured;
                   at the centres of a subset of MERL's (θh, θd, φd) entries (every θh, every \
                   6th θd, every 12th φd), by Nelder-Mead. Prints the fitted material as \
                   --material accepts it and the error E (with --json: one JSON object).",
-    after_help = "Examples:\n  \
+    after_help = "Examples (the tabulate lines write the measured files the fits read):\n  \
+                  lobe tabulate --material @examples/gold.toml --format merl --out gold.binary\n  \
                   lobe fit gold.binary --model cook-torrance\n  \
-                  lobe fit paint.bsdf --model cook-torrance --distribution beckmann --json\n  \
-                  lobe fit gold.binary --fresnel conductor --anisotropic"
+                  lobe fit gold.binary --fresnel conductor --anisotropic\n  \
+                  lobe tabulate --material '{\"type\":\"cook-torrance\",\"distribution\":\"beckmann\",\"alpha\":0.3,\"kd\":0.2,\"ks\":0.8}' --format rgl --out paint.bsdf\n  \
+                  lobe fit paint.bsdf --model cook-torrance --distribution beckmann --json"
 )]
 pub struct FitArgs {
     /// The measured file (MERL .binary or RGL .bsdf, recognised by content).
@@ -52,6 +54,9 @@ pub struct FitArgs {
 pub fn run(args: &FitArgs) -> Result<()> {
     if args.model != "cook-torrance" {
         bail!("--model: only cook-torrance can be fitted");
+    }
+    if let Some(p) = &args.plot {
+        crate::common::prepare_output_files("--plot", std::slice::from_ref(p))?;
     }
     let lobe = Measured::load(&args.file, None).context("FILE")?;
     eprintln!("{}", lobe.summary());

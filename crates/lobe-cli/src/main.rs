@@ -62,7 +62,7 @@ fn main() -> ExitCode {
     // before any large block exists.
     ALLOCATOR.use_huge_pages(std::env::args_os().nth(1).is_some_and(|a| a == "render"));
     let cli = Cli::parse();
-    let result = match cli.command {
+    let result = common::check_simd_env().and_then(|()| match cli.command {
         Command::Demo(args) => demo::run(&args),
         Command::Eval(args) => eval::run(&args),
         Command::Estimate(args) => estimate::run(&args),
@@ -74,7 +74,7 @@ fn main() -> ExitCode {
         Command::Bench(args) => bench::run(&args),
         Command::Tabulate(args) => tabulate::run(&args),
         Command::Fit(args) => fit::run(&args),
-    };
+    });
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {

@@ -146,7 +146,7 @@ pub fn run(args: &PlotArgs) -> Result<()> {
             bail!("--res {}: must be between 1 and {MAX_RES}", args.res);
         }
     }
-    prepare_dir(&args.out)?;
+    crate::common::prepare_output_dir("--out", &args.out)?;
 
     let label = material_label(&args.material, &material);
     let view = view_label(args, wo);
@@ -205,18 +205,6 @@ pub fn run(args: &PlotArgs) -> Result<()> {
             }
         }
     }
-    Ok(())
-}
-
-/// Creates `dir` and checks that a file can be written in it, before any
-/// long computation.
-fn prepare_dir(dir: &Path) -> Result<()> {
-    std::fs::create_dir_all(dir)
-        .with_context(|| format!("--out {}: cannot create the directory", dir.display()))?;
-    let probe = dir.join(format!(".component-plot-probe-{}", std::process::id()));
-    std::fs::write(&probe, b"")
-        .with_context(|| format!("--out {}: cannot write in the directory", dir.display()))?;
-    let _ = std::fs::remove_file(&probe);
     Ok(())
 }
 

@@ -20,8 +20,7 @@ use std::time::Instant;
                   environment map (the only light), seen by a pinhole camera. Each camera ray's hit \
                   estimates the reflected radiance with the chosen technique exactly as `lobe estimate` \
                   does, plus a shadow ray: a BSDF sampling strategy, `light` (environment-map sampling) \
-                  or MIS (`mis`: balance heuristic, `mis-power`: power heuristic; one BSDF sample, by \
-                  vndf where the material has it else brdf, and one light sample). A BSDF strategy that \
+                  or MIS (see --strategy; `mis`, the default, is adaptive MIS). A BSDF strategy that \
                   does not apply to an object's material (vndf on a Phong sphere, say) falls back to \
                   brdf for that object, with a note. max_depth > 1 in the scene adds path tracing.\n\n\
                   Writes NAME.exr (linear RGB, 32-bit float) and NAME.png (scaled by 2^--exposure, \
@@ -117,7 +116,7 @@ Scene file (TOML; unknown keys are errors; paths are relative to the scene file)
 
   [render]             # every key optional
   spp = 64
-  strategy = \"mis\"
+  strategy = \"mis\"     # a --strategy name; default mis (adaptive MIS)
   seed = 1
   sequence = \"sobol\"   # sobol (default), stratified or independent
   max_depth = 1        # 1 = direct lighting; more adds bounces
@@ -129,20 +128,24 @@ Examples:
   lobe render examples/scene.toml
   lobe render examples/scene.toml --spp 16 --strategy light --out light-16
   lobe render examples/scene.toml --threads 1 --seed 7 --quiet
-  lobe render examples/scene.toml --spp 4 --time 10 --sequence sobol
+  lobe render examples/scene.toml --spp 4 --time 2 --sequence sobol
   lobe render examples/scene.toml --spp 16 --spp-allocation variance";
 
 /// The help of `--strategy`: every accepted name.
 fn strategy_help() -> String {
     format!(
-        "One of: {} (overrides the scene's render.strategy)",
-        Strategy::names()
+        "One technique (overrides the scene's render.strategy; default mis). {}",
+        crate::common::technique_help()
     )
 }
 
 /// Run `lobe render`.
 pub fn run(args: &RenderArgs) -> Result<()> {
     let base = crate::common::output_base(args.out.as_deref(), &args.scene, &["exr", "png"], "")?;
+    crate::common::prepare_output_files(
+        "--out",
+        &["exr", "png", "spp.png"].map(|e| crate::common::with_ext(&base, e)),
+    )?;
     if !args.exposure.is_finite() || args.exposure.abs() > 64.0 {
         bail!(
             "--exposure {}: must be a number of stops in [-64, 64]",
@@ -241,13 +244,9 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         // Passes until the time is up: no known length.
         "{msg:>12} {spinner} {human_pos} samples, {per_sec}, {elapsed}"
     } else {
-        "{msg:>12} [{wide_bar}] {human_pos}/{human_len} samples, {per_sec}, {elapsed}<{eta}"
+        "{msg:>12} [{wide_bar}] {human_pos}/{human_len} samples, {per_sec}, {elapsed}<{eta_left}"
     };
-    pb.set_style(
-        indicatif::ProgressStyle::with_template(template)
-            .expect("progress template is valid")
-            .progress_chars("=> "),
-    );
+    pb.set_style(crate::common::progress_style(template));
     let t0 = Instant::now();
     let image = match budget {
         None => render(&scene, &opts, |n| pb.inc(n)),

@@ -389,8 +389,7 @@ pub fn run(args: &ReportArgs) -> Result<()> {
     let start = Instant::now();
     let settings = ReportSizes::new(args.quick);
     let dir = &args.out;
-    std::fs::create_dir_all(dir)
-        .with_context(|| format!("--out: cannot create the directory {}", dir.display()))?;
+    crate::common::prepare_output_dir("--out", dir)?;
     let models = if args.materials.is_empty() {
         models()
     } else {
@@ -566,7 +565,7 @@ fn run_job(
                 .map(|(_, _, t)| luminance(Rgb::from_array(t.reference)))
                 .ok_or_else(|| anyhow!("no table for the figure's configuration"))?;
             let series = convergence_series(m);
-            let curves = curves(
+            let mut curves = curves(
                 m,
                 &lobe::estimator::ShadingPoint::local(wo),
                 &light,
@@ -579,6 +578,7 @@ fn run_job(
                 },
                 &(),
             )?;
+            converge::zero_exact_curves(&mut curves, target);
             let file = format!("{}-convergence.png", model.id);
             let title = format!(
                 "{}, light: white furnace: RMSE of {} runs",
@@ -831,7 +831,7 @@ fn strategy_cell(name: &str) -> String {
 
 /// Whether a row's variance is zero up to rounding (relative to its mean²).
 fn exact(row: &Row) -> bool {
-    row.variance <= 1e-20 * lum(row.mean).powi(2)
+    crate::common::row_is_exact(row)
 }
 
 /// Uniform's variance over this row's; `None` for a zero variance.

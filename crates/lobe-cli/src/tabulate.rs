@@ -19,7 +19,7 @@ use lobe::tabulate::{self, Format, RglResolution};
                   elevations uniform in [0°, 89°], a --grid × --grid grid.",
     after_help = "Examples:\n  \
                   lobe tabulate --material '{\"type\":\"cook-torrance\",\"alpha\":0.2}' --format rgl --out ggx.bsdf\n  \
-                  lobe tabulate --material @gold.toml --format merl --out gold.binary"
+                  lobe tabulate --material @examples/gold.toml --format merl --out gold.binary"
 )]
 pub struct TabulateArgs {
     /// The material (JSON, @FILE.json or @FILE.toml).
@@ -40,6 +40,7 @@ pub struct TabulateArgs {
 }
 
 pub fn run(args: &TabulateArgs) -> Result<()> {
+    crate::common::prepare_output_files("--out", std::slice::from_ref(&args.out))?;
     let m = crate::common::load_material(&args.material)?;
     let format = match args.format.as_str() {
         "merl" => Format::Merl,

@@ -9,11 +9,10 @@
 //!   luminance `|Y − Y_ref| / (Y_ref + ε)`, with `ε` ([`error_epsilon`]) 1 %
 //!   of the reference's mean luminance (so that black pixels do not divide
 //!   by zero).
-//! * **Equal time**: the budget is the time of `mis` at equal samples (of
-//!   the slowest method when `mis` is not compared). Each method's
-//!   equal-samples render is its pilot: its time per sample per pixel gives
-//!   the spp that fit in the budget (at least 1), and the method is rendered
-//!   again with that spp.
+//! * **Equal time**: the budget is the time of `mis` (of the slowest method
+//!   when `mis` is not compared) at `max(spp, MIN_EQUAL_TIME_SPP)`, measured
+//!   without start-up; each method is rendered with the spp that bring its
+//!   time within [`EQUAL_TIME_TOLERANCE`] of it ([`run_comparison`]).
 //! * **Reference**: [`REFERENCE_METHOD`] at the reference spp, with the
 //!   bitwise complement of the seed ([`reference_seed`]), so that its
 //!   samples are independent of the compared renders' (the same seed would
@@ -89,8 +88,11 @@ pub struct Comparison {
     pub equal_time: Option<EqualTime>,
 }
 
-/// The default methods for `scene`: brdf, vndf (when an object's material
-/// has it), light and mis.
+/// [`default_methods`] in words, for help texts.
+pub const DEFAULT_METHODS: &str =
+    "brdf, vndf (when an object's material has it), light, mis-balance, mis-power and mis";
+
+/// The default methods for `scene` ([`DEFAULT_METHODS`]).
 #[must_use]
 pub fn default_methods(scene: &Scene) -> Vec<Strategy> {
     let mut v = vec![Strategy::Bsdf(BsdfStrategy::Brdf)];
@@ -156,11 +158,54 @@ fn label(method: Strategy, spp: u32, what: &str) -> String {
     }
 }
 
+/// The equal-time budget is the time of a render of at least this many
+/// samples per pixel: below it, whole samples per pixel cannot make the
+/// times equal within [`EQUAL_TIME_TOLERANCE`] (at 4 spp one sample more
+/// or less is 25 %; at 32 spp, with the slowest method at 20, 2.5 %).
+pub const MIN_EQUAL_TIME_SPP: u32 = 32;
+
+/// The equal-time budget is at least this many seconds: a shorter render's
+/// time is mostly the machine's noise (10 to 20 % at 10 ms on a loaded
+/// machine), and its spp are raised until it is not.
+pub const MIN_EQUAL_TIME_S: f64 = 0.05;
+
+/// How close to the budget an equal-time render's time is brought (as a
+/// fraction of the budget), within [`EQUAL_TIME_TRIES`] renders.
+pub const EQUAL_TIME_TOLERANCE: f64 = 0.03;
+
+/// Most renders of one method to bring its time within
+/// [`EQUAL_TIME_TOLERANCE`] of the budget; the closest is kept.
+pub const EQUAL_TIME_TRIES: usize = 4;
+
+/// A render shorter than this is timed as the fastest of
+/// [`SHORT_RENDER_RUNS`] runs (the same image each time): a short render's
+/// single time is mostly the machine's noise.
+pub const SHORT_RENDER_S: f64 = 0.1;
+
+/// Runs of a render shorter than [`SHORT_RENDER_S`].
+pub const SHORT_RENDER_RUNS: usize = 3;
+
 /// Renders every method at equal samples (and at equal time when
 /// `s.equal_time`), then the reference, and measures each render's RMSE
 /// against the reference. Each render is one progress task (see
 /// [`render_one`]); the times come from `clock`, and only the equal-time
 /// spp depend on them.
+///
+/// Times are measured without start-up: every method is first rendered
+/// once at 1 spp, untimed (progress task `warm-up`: the threads, the
+/// lazily built tables, the first touch of memory), and a render shorter
+/// than [`SHORT_RENDER_S`] is timed as the fastest of [`SHORT_RENDER_RUNS`]
+/// runs.
+///
+/// Equal time: the budget is the time of `mis` (the slowest method when
+/// `mis` is not compared) at `max(spp, MIN_EQUAL_TIME_SPP)`, or at more spp
+/// when that takes less than [`MIN_EQUAL_TIME_S`]. Each other
+/// method starts from the spp its equal-samples render's time per spp
+/// gives, and is rendered again with the spp of the least-squares line
+/// through its (spp, time) points so far (a render's time is a start-up of its own,
+/// the pilots, plus a cost per sample) until its time is within
+/// [`EQUAL_TIME_TOLERANCE`] of the budget, at most [`EQUAL_TIME_TRIES`]
+/// renders; the render closest to the budget is kept.
 #[must_use]
 pub fn run_comparison(
     scene: &Scene,
@@ -169,17 +214,28 @@ pub fn run_comparison(
     clock: &dyn Clock,
 ) -> Comparison {
     let spp = s.spp.max(1);
+    let opts = |method: Strategy, spp: u32, seed: u64| RenderOptions {
+        spp: spp.into(),
+        strategy: method,
+        seed,
+        sequence: s.sequence,
+        max_depth: s.max_depth,
+        threads: s.threads,
+        ..RenderOptions::default()
+    };
+    for &m in &s.methods {
+        let _ = render_one(scene, &opts(m, 1, s.seed), "warm-up", progress, &NoClock);
+    }
     let shot = |method: Strategy, spp: u32, seed: u64, what: &str| {
-        let opts = RenderOptions {
-            spp: spp.into(),
-            strategy: method,
-            seed,
-            sequence: s.sequence,
-            max_depth: s.max_depth,
-            threads: s.threads,
-            ..RenderOptions::default()
-        };
-        render_one(scene, &opts, &label(method, spp, what), progress, clock)
+        let o = opts(method, spp, seed);
+        let mut first = render_one(scene, &o, &label(method, spp, what), progress, clock);
+        if what != "reference" && first.time_s < SHORT_RENDER_S {
+            for _ in 1..SHORT_RENDER_RUNS {
+                let again = render_one(scene, &o, &label(method, spp, what), progress, clock);
+                first.time_s = first.time_s.min(again.time_s);
+            }
+        }
+        first
     };
     let equal_samples: Vec<Shot> = s
         .methods
@@ -187,29 +243,79 @@ pub fn run_comparison(
         .map(|&m| shot(m, spp, s.seed, ""))
         .collect();
     let equal_time = s.equal_time.then(|| {
-        let mis = equal_samples.iter().find(|x| x.method == Strategy::MIS);
-        let (budget_s, budget_from) = match mis {
-            Some(x) => (x.time_s, format!("the time of mis at {spp} spp")),
+        let budget_spp = spp.max(MIN_EQUAL_TIME_SPP);
+        let (k, why) = match equal_samples.iter().position(|x| x.method == Strategy::MIS) {
+            Some(k) => (k, ""),
             None => {
-                let slowest = equal_samples
-                    .iter()
-                    .max_by(|a, b| a.time_s.total_cmp(&b.time_s))
+                let k = (0..equal_samples.len())
+                    .max_by(|&a, &b| equal_samples[a].time_s.total_cmp(&equal_samples[b].time_s))
                     .expect("at least one method");
-                (
-                    slowest.time_s,
-                    format!("the time of {} at {spp} spp, the slowest", slowest.method),
-                )
+                (k, ", the slowest")
             }
         };
+        let budget_method = equal_samples[k].method;
+        let mut budget_spp = budget_spp;
+        let mut budget_shot = if budget_spp == spp {
+            equal_samples[k].clone()
+        } else {
+            shot(budget_method, budget_spp, s.seed, "eq. time")
+        };
+        for _ in 0..EQUAL_TIME_TRIES {
+            if budget_shot.time_s >= MIN_EQUAL_TIME_S || f64::from(budget_spp) >= MAX_EQUAL_TIME_SPP
+            {
+                break;
+            }
+            let scale = 1.1 * MIN_EQUAL_TIME_S / budget_shot.time_s.max(1e-9);
+            budget_spp = (f64::from(budget_spp) * scale)
+                .ceil()
+                .clamp(f64::from(budget_spp) + 1.0, MAX_EQUAL_TIME_SPP) as u32;
+            budget_shot = shot(budget_method, budget_spp, s.seed, "eq. time");
+        }
+        let budget_s = budget_shot.time_s;
+        let mut budget_from = format!("the time of {budget_method} at {budget_spp} spp{why}");
+        if budget_spp != spp {
+            budget_from.push_str(&format!(
+                "; at least {MIN_EQUAL_TIME_SPP} spp and {} ms, so that whole samples per pixel and the clock can make the times equal",
+                MIN_EQUAL_TIME_S * 1e3
+            ));
+        }
         let shots = equal_samples
             .iter()
-            .map(|pilot| {
-                let per_spp = pilot.time_s.max(1e-9) / f64::from(spp);
-                let n = (budget_s / per_spp).round().clamp(1.0, MAX_EQUAL_TIME_SPP) as u32;
-                if n == spp {
-                    return pilot.clone();
+            .enumerate()
+            .map(|(i, pilot)| {
+                if i == k {
+                    return budget_shot.clone();
                 }
-                shot(pilot.method, n, s.seed, "eq. time")
+                let mut tried: Vec<Shot> = vec![pilot.clone()];
+                let per_spp = pilot.time_s.max(1e-9) / f64::from(spp);
+                let mut n = (budget_s / per_spp).round();
+                for _ in 0..EQUAL_TIME_TRIES {
+                    let n_u = n.clamp(1.0, MAX_EQUAL_TIME_SPP) as u32;
+                    if tried.iter().any(|t| t.spp == n_u) {
+                        break;
+                    }
+                    let x = shot(pilot.method, n_u, s.seed, "eq. time");
+                    let (n1, t1) = (f64::from(x.spp), x.time_s);
+                    tried.push(x);
+                    if (t1 / budget_s - 1.0).abs() <= EQUAL_TIME_TOLERANCE {
+                        break;
+                    }
+                    // The line `a + b·spp` through the points so far (least
+                    // squares; the secant of two): `b` is the cost per spp
+                    // without the start-up `a`.
+                    n = match line_fit(&tried) {
+                        Some((a, b)) if b > 0.0 => ((budget_s - a) / b).round(),
+                        _ => (n1 * budget_s / t1.max(1e-12)).round(),
+                    };
+                }
+                tried
+                    .into_iter()
+                    .min_by(|a, b| {
+                        (a.time_s - budget_s)
+                            .abs()
+                            .total_cmp(&(b.time_s - budget_s).abs())
+                    })
+                    .expect("the pilot at least")
             })
             .collect();
         EqualTime {
@@ -232,6 +338,31 @@ pub fn run_comparison(
         shot.rmse = rmse(&shot.image, &r);
     }
     cmp
+}
+
+/// Least-squares line `time = a + b · spp` through the shots; `None` when
+/// they do not span two spp.
+fn line_fit(shots: &[Shot]) -> Option<(f64, f64)> {
+    let k = shots.len() as f64;
+    let mx = shots.iter().map(|s| f64::from(s.spp)).sum::<f64>() / k;
+    let my = shots.iter().map(|s| s.time_s).sum::<f64>() / k;
+    let sxx: f64 = shots.iter().map(|s| (f64::from(s.spp) - mx).powi(2)).sum();
+    let sxy: f64 = shots
+        .iter()
+        .map(|s| (f64::from(s.spp) - mx) * (s.time_s - my))
+        .sum();
+    (sxx > 0.0).then(|| {
+        let b = sxy / sxx;
+        (my - b * mx, b)
+    })
+}
+
+/// A clock that never moves: the warm-up renders are not timed.
+struct NoClock;
+impl Clock for NoClock {
+    fn now(&self) -> std::time::Duration {
+        std::time::Duration::ZERO
+    }
 }
 
 impl Comparison {

@@ -279,3 +279,41 @@ fn many_curves_get_a_panel_per_sequence() {
         assert!(svg.contains(text), "{text:?} is not in the SVG");
     }
 }
+
+/// Issue 41: a zero-variance estimator's curve is `exact` with an empty
+/// slope and RMSE 0, not the slope of its rounding (0.001).
+#[test]
+fn a_zero_variance_estimator_has_no_slope() {
+    let dir = scratch("exact");
+    let prefix = dir.join("lambert");
+    let o = lobe(
+        &[
+            "converge",
+            "-m",
+            r#"{"type":"lambert"}"#,
+            "--strategy",
+            "brdf,uniform",
+            "--sequence",
+            "independent",
+            "--max-exp",
+            "8",
+            "--runs",
+            "4",
+            "--out",
+            prefix.to_str().unwrap(),
+            "-q",
+        ],
+        None,
+    );
+    assert_ok(&o);
+    let out = String::from_utf8_lossy(&o.stdout);
+    let brdf = out.lines().find(|l| l.starts_with("brdf ")).unwrap();
+    assert_eq!(brdf.split_whitespace().nth(1), Some("exact"), "{out}");
+    let uniform = out.lines().find(|l| l.starts_with("uniform ")).unwrap();
+    let s: f64 = uniform.split_whitespace().nth(1).unwrap().parse().unwrap();
+    assert!(s < -0.3, "{out}");
+    let csv = std::fs::read_to_string(dir.join("lambert.csv")).unwrap();
+    for l in csv.lines().filter(|l| l.starts_with("brdf,")) {
+        assert!(l.ends_with(",0,"), "{l}");
+    }
+}

@@ -72,3 +72,45 @@ fn quick_demo_writes_the_showcase() {
         assert!(p.exists(), "{}", p.display());
     }
 }
+
+/// Issue 41: the tour's `vs uniform` is uniform's exact variance over the
+/// printed variance, and the header says so: every ratio is reproduced from
+/// the printed numbers (uniform's exact variance beside the reference, the
+/// row's variance) to the printed precision.
+#[test]
+fn the_tour_ratio_is_the_printed_exact_variance_over_the_printed_one() {
+    let d = Path::new(env!("CARGO_TARGET_TMPDIR")).join("demo-ratio");
+    let o = Command::new(env!("CARGO_BIN_EXE_lobe"))
+        .args(["demo", "--quick", "--quiet", "--out", d.to_str().unwrap()])
+        .output()
+        .expect("run lobe");
+    assert!(o.status.success());
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        stdout.contains("'vs uniform' is uniform's exact variance"),
+        "{stdout}"
+    );
+    let mut exact = None;
+    let mut checked = 0;
+    for line in stdout
+        .lines()
+        .take_while(|l| !l.starts_with("brdf is the lecture"))
+    {
+        if let Some((_, v)) = line.split_once(", uniform's exact variance ") {
+            exact = Some(v.trim().parse::<f64>().unwrap());
+            continue;
+        }
+        let w: Vec<&str> = line.split_whitespace().collect();
+        if w.len() == 5 && w[4].ends_with('x') {
+            let variance: f64 = w[3].parse().unwrap();
+            let ratio: f64 = w[4].trim_end_matches('x').parse().unwrap();
+            let want = exact.unwrap() / variance;
+            assert!(
+                (ratio - want).abs() <= 1e-3 * want + 0.05,
+                "{line}: {ratio} against {want}\n{stdout}"
+            );
+            checked += 1;
+        }
+    }
+    assert!(checked >= 8, "{checked}\n{stdout}");
+}

@@ -160,3 +160,86 @@ fn bad_input_is_one_line_and_non_zero() {
         );
     }
 }
+
+/// Issue 41: the `unreliable` note is printed only when a row is unreliable
+/// (uniform sampling of a very narrow lobe with few samples misses it).
+#[test]
+fn the_unreliable_note_only_when_a_row_is_unreliable() {
+    let note = "unreliable: the estimate";
+    let smooth = lobe(
+        &[
+            "estimate",
+            "-m",
+            r#"{"type":"phong","exponent":10}"#,
+            "-n",
+            "4096",
+            "-q",
+        ],
+        None,
+    );
+    assert!(smooth.status.success());
+    let out = String::from_utf8_lossy(&smooth.stdout);
+    assert!(!out.contains("unreliable"), "{out}");
+    let narrow = lobe(
+        &[
+            "estimate",
+            "-m",
+            r#"{"type":"phong","exponent":100000}"#,
+            "-n",
+            "64",
+            "--strategy",
+            "uniform,brdf",
+            "-q",
+        ],
+        None,
+    );
+    assert!(narrow.status.success());
+    let out = String::from_utf8_lossy(&narrow.stdout);
+    let uniform = out.lines().find(|l| l.starts_with("uniform ")).unwrap();
+    assert!(uniform.contains("unreliable"), "{out}");
+    assert!(out.contains(note), "{out}");
+}
+
+/// Issue 41: a zero-variance estimator (BRDF sampling of Lambert under a
+/// constant light: every sample is the albedo) prints a variance of 0 and
+/// `exact`, not the rounding's 3e-33 and 7.7e31x; the JSON says the same.
+#[test]
+fn a_zero_variance_estimator_is_exact() {
+    let args = [
+        "estimate",
+        "-m",
+        r#"{"type":"lambert"}"#,
+        "--strategy",
+        "uniform,brdf",
+        "-n",
+        "4096",
+        "-q",
+    ];
+    let o = lobe(&args, None);
+    assert!(o.status.success());
+    let out = String::from_utf8_lossy(&o.stdout);
+    let brdf: Vec<&str> = out
+        .lines()
+        .find(|l| l.starts_with("brdf "))
+        .unwrap()
+        .split_whitespace()
+        .collect();
+    // strategy, estimate, std. error, rel. err, variance, vs uniform, time, efficiency
+    assert_eq!(brdf[2], "0.000000", "{out}");
+    assert_eq!(brdf[4], "0", "{out}");
+    assert_eq!(brdf[5], "exact", "{out}");
+    assert!(
+        !out.contains("e31") && !out.contains("e32") && !out.contains("e33"),
+        "{out}"
+    );
+    assert!(out.contains("exact: zero variance up to rounding"), "{out}");
+    let mut args = args.to_vec();
+    args.push("--json");
+    let v: serde_json::Value = serde_json::from_slice(&lobe(&args, None).stdout).unwrap();
+    let row = &v["strategies"][1];
+    assert_eq!(row["name"], "brdf");
+    assert_eq!(row["variance"], 0.0);
+    assert!(row["variance_reduction"].is_null(), "{row}");
+    // Uniform's row is not exact.
+    assert!(v["strategies"][0]["variance"].as_f64().unwrap() > 0.1);
+}

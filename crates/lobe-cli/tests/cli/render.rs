@@ -307,3 +307,137 @@ fn huge_spp_is_accepted_or_refused_clearly() {
         "{e}"
     );
 }
+
+/// Issue 41: every command checks its outputs the same way, before the
+/// work: a missing folder is created (render and compare refused it, and
+/// render only after rendering), a file in the way of a folder is a
+/// one-line error at once; a bad LOBE_SIMD is one error naming it.
+#[test]
+fn outputs_are_checked_before_the_work_the_same_way_everywhere() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let d = Path::new(env!("CARGO_TARGET_TMPDIR")).join("outputs-41");
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    let run = |args: &[&str]| {
+        Command::new(env!("CARGO_BIN_EXE_lobe"))
+            .args(args)
+            .current_dir(&root)
+            .output()
+            .unwrap()
+    };
+    let new = |name: &str| d.join("missing").join(name).display().to_string();
+    let cases: Vec<(Vec<String>, Vec<&str>)> = vec![
+        (
+            [
+                "render",
+                "examples/scene.toml",
+                "--spp",
+                "1",
+                "-q",
+                "--out",
+                &new("r"),
+            ]
+            .map(String::from)
+            .to_vec(),
+            vec!["r.exr", "r.png"],
+        ),
+        (
+            [
+                "compare",
+                "examples/scene.toml",
+                "--spp",
+                "1",
+                "--reference-spp",
+                "2",
+                "--strategy",
+                "brdf",
+                "-q",
+                "--out",
+                &new("c"),
+            ]
+            .map(String::from)
+            .to_vec(),
+            vec!["c.png", "c.json"],
+        ),
+        (
+            [
+                "converge",
+                "-m",
+                r#"{"type":"lambert"}"#,
+                "--max-exp",
+                "2",
+                "--runs",
+                "1",
+                "-q",
+                "--out",
+                &new("v"),
+            ]
+            .map(String::from)
+            .to_vec(),
+            vec!["v.csv"],
+        ),
+    ];
+    std::fs::write(d.join("file"), b"").unwrap();
+    for (args, files) in cases {
+        let a: Vec<&str> = args.iter().map(String::as_str).collect();
+        let o = run(&a);
+        assert!(
+            o.status.success(),
+            "{a:?}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        for f in files {
+            assert!(d.join("missing").join(f).is_file(), "{a:?}: {f}");
+        }
+        // A file where the folder should be: refused at once, in one line.
+        let blocked: Vec<String> = args
+            .iter()
+            .map(|w| w.replace("/missing/", "/file/"))
+            .collect();
+        let b: Vec<&str> = blocked.iter().map(String::as_str).collect();
+        let t0 = std::time::Instant::now();
+        let e = common::one_line_error(&run(&b));
+        assert!(e.contains("is a file, not a directory"), "{b:?}: {e}");
+        assert!(t0.elapsed().as_secs_f64() < 5.0);
+    }
+    let o = Command::new(env!("CARGO_BIN_EXE_lobe"))
+        .args(["estimate", "-m", r#"{"type":"lambert"}"#, "-n", "64", "-q"])
+        .env("LOBE_SIMD", "neon")
+        .output()
+        .unwrap();
+    let e = common::one_line_error(&o);
+    assert!(e.starts_with("lobe: error: LOBE_SIMD=neon: "), "{e}");
+}
+
+/// Issue 41: a long render is not silent when stderr is not a terminal
+/// (here a pipe): plain progress lines, the first one not nonsense.
+#[test]
+fn a_render_shows_progress_lines_off_a_terminal() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let out = Path::new(env!("CARGO_TARGET_TMPDIR")).join("progress-41");
+    let o = Command::new(env!("CARGO_BIN_EXE_lobe"))
+        .args([
+            "render",
+            "examples/scene.toml",
+            "--spp",
+            "512",
+            "--spp-allocation",
+            "uniform",
+        ])
+        .arg("--out")
+        .arg(&out)
+        .current_dir(&root)
+        .env("LOBE_PROGRESS_EVERY", "0.1")
+        .env("RAYON_NUM_THREADS", "1")
+        .output()
+        .unwrap();
+    assert!(o.status.success());
+    let e = String::from_utf8_lossy(&o.stderr);
+    let lines: Vec<&str> = e
+        .lines()
+        .filter(|l| l.starts_with("lobe: rendering "))
+        .collect();
+    assert!(!lines.is_empty(), "{e}");
+    assert!(lines[0].contains("% (") && lines[0].contains(" of "), "{e}");
+    assert!(!e.contains("3w") && !e.contains("weeks"), "{e}");
+}

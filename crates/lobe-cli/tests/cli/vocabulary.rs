@@ -179,7 +179,12 @@ fn vs_uniform_for_a_narrow_lobe() {
     let uniform = out.lines().find(|l| l.starts_with("uniform ")).unwrap();
     assert!(uniform.contains("unreliable"), "{out}");
     let vndf = out.lines().find(|l| l.starts_with("vndf ")).unwrap();
-    assert!(vndf.contains("e") && vndf.contains("x "), "{vndf}");
+    // (Issue 41: its per-sample spread is below 1e-10 of the mean, G2/G1 of
+    // a near-mirror, so it is printed as exact, not as a 1e20x ratio.)
+    assert!(
+        (vndf.contains("e") && vndf.contains("x ")) || vndf.contains(" exact "),
+        "{vndf}"
+    );
     for l in out.lines() {
         assert!(
             !l.split_whitespace()
@@ -233,4 +238,64 @@ fn sobol_standard_errors_say_how() {
     ]);
     let e = common::one_line_error(&o);
     assert!(e.contains("--replicas 16"), "{e}");
+}
+
+/// Issue 41: one description of `mis` (the adaptive MIS, the default) in
+/// every help that names it, the same words everywhere; none calls it the
+/// balance heuristic (that is `mis-balance`).
+#[test]
+fn every_help_describes_mis_the_same_way() {
+    let mut texts = Vec::new();
+    for cmd in ["estimate", "converge", "render", "compare"] {
+        let help = ok(&lobe(&[cmd, "--help"]));
+        let start = help
+            .find("mis: adaptive MIS, the default")
+            .unwrap_or_else(|| panic!("lobe {cmd} --help does not describe mis:\n{help}"));
+        let text: String = help[start..]
+            .split(';')
+            .next()
+            .unwrap()
+            .split_whitespace()
+            .collect::<Vec<_>>()
+            .join(" ");
+        texts.push(text);
+        assert!(
+            !help.contains("`mis`: balance heuristic"),
+            "lobe {cmd} --help"
+        );
+        assert!(
+            help.contains("mis-balance: multi-sample MIS with the balance heuristic"),
+            "lobe {cmd} --help"
+        );
+    }
+    assert!(texts.iter().all(|t| t == &texts[0]), "{texts:#?}");
+}
+
+/// Issue 41: the examples a user starts from do not warn (examples/ggx.toml
+/// gained energy at grazing views: kd added to a full specular lobe).
+#[test]
+fn the_example_materials_do_not_warn() {
+    for m in ["@examples/ggx.toml", "@examples/gold.toml"] {
+        for cmd in [
+            vec![
+                "estimate",
+                "-m",
+                m,
+                "-n",
+                "1024",
+                "--strategy",
+                "brdf",
+                "-q",
+            ],
+            vec!["estimate", "-m", m, "-n", "1024", "--theta", "85", "-q"],
+        ] {
+            let o = lobe(&cmd);
+            ok(&o);
+            assert!(
+                o.stderr.is_empty(),
+                "{cmd:?}: {}",
+                String::from_utf8_lossy(&o.stderr)
+            );
+        }
+    }
 }
