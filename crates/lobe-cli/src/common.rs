@@ -200,15 +200,15 @@ pub fn warn_energy_gain(m: &lobe::Material, what: &str) {
     }
 }
 
-/// What `mis`, the default technique, is: the one description of every help
-/// text that names it ([`technique_help`], `lobe render --help`).
+/// What `mis`, the default strategy, is: the one description of every help
+/// text that names it ([`strategy_help`], `lobe render --help`).
 pub const MIS_DESCRIPTION: &str = "adaptive MIS, the default: each sample draws one BSDF direction (vndf where the material has it, else brdf) and one light direction, and gives both to BSDF sampling, to the balance heuristic or to light sampling, whichever a pilot of its own samples finds of least variance (in a render: per pixel, from the pilots of the 7 × 7 pixels around it; deeper bounces use the balance heuristic)";
 
-/// What a technique of [`Strategy::names`](lobe::estimator::Strategy::names)
+/// What a strategy of [`Strategy::names`](lobe::estimator::Strategy::names)
 /// is, in a few words; `None` for a name this list does not know (a test
 /// checks that every accepted name has one).
 #[must_use]
-pub fn technique_description(name: &str) -> Option<&'static str> {
+pub fn strategy_description(name: &str) -> Option<&'static str> {
     Some(match name {
         "uniform" => "uniform over the hemisphere (the baseline)",
         "cosine" => "cosine-weighted hemisphere",
@@ -232,17 +232,17 @@ pub fn technique_description(name: &str) -> Option<&'static str> {
     })
 }
 
-/// Every technique name with its description ([`technique_description`]):
+/// Every strategy name with its description ([`strategy_description`]):
 /// the one text of `--strategy` in `estimate`, `converge`, `render` and
 /// `compare`.
 #[must_use]
-pub fn technique_help() -> String {
+pub fn strategy_help() -> String {
     lobe::estimator::Strategy::names()
         .split(", ")
         .map(|n| {
             format!(
                 "{n}: {}",
-                technique_description(n).unwrap_or("(no description)")
+                strategy_description(n).unwrap_or("(no description)")
             )
         })
         .collect::<Vec<_>>()
@@ -522,8 +522,8 @@ mod tests {
     #[test]
     fn every_technique_has_a_description() {
         for n in lobe::estimator::Strategy::names().split(", ") {
-            assert!(technique_description(n).is_some(), "{n}");
+            assert!(strategy_description(n).is_some(), "{n}");
         }
-        assert!(technique_help().contains(MIS_DESCRIPTION));
+        assert!(strategy_help().contains(MIS_DESCRIPTION));
     }
 }

@@ -14,7 +14,7 @@ use clap::Args;
 use lobe::estimator::Strategy;
 use lobe::progress::SystemClock;
 use lobe_render::compare::{
-    CompareSettings, Comparison, LogScale, Shot, default_methods, default_reference_spp,
+    CompareSettings, Comparison, LogScale, Shot, default_reference_spp, default_strategies,
     error_epsilon, error_map, resample, run_comparison,
 };
 use lobe_render::{fallbacks, load_scene};
@@ -92,14 +92,14 @@ pub struct CompareArgs {
 /// The help of `--strategy`: every accepted name.
 fn strategy_help() -> String {
     format!(
-        "Comma-separated techniques (default: {}). {}",
-        lobe_render::compare::DEFAULT_METHODS,
-        crate::common::technique_help()
+        "Comma-separated strategies (default: {}). {}",
+        lobe_render::compare::DEFAULT_STRATEGIES,
+        crate::common::strategy_help()
     )
 }
 
-/// Parse `--strategy`: a comma-separated list of method names, each once.
-pub fn parse_methods(spec: &str) -> Result<Vec<Strategy>> {
+/// Parse `--strategy`: a comma-separated list of strategy names, each once.
+pub fn parse_strategies_list(spec: &str) -> Result<Vec<Strategy>> {
     let mut v = Vec::new();
     for name in spec.split(',').map(str::trim) {
         if name.is_empty() {
@@ -154,7 +154,7 @@ pub fn warn_nonfinite(cmp: &Comparison) {
         if s.image.stats.nonfinite > 0 {
             eprintln!(
                 "lobe: warning: {} at {} spp: {} path samples were not finite numbers and counted as 0",
-                s.method, s.spp, s.image.stats.nonfinite
+                s.strategy, s.spp, s.image.stats.nonfinite
             );
         }
     }
@@ -311,7 +311,7 @@ fn caption_lines(head: &str, tail: Option<&str>, width: i32) -> Vec<String> {
 
 fn shot_caption(s: &Shot) -> (String, Option<String>) {
     (
-        format!("{} · {} spp · {}", s.method, s.spp, fmt_time(s.time_s)),
+        format!("{} · {} spp · {}", s.strategy, s.spp, fmt_time(s.time_s)),
         Some(format!("RMSE {}", sig3(s.rmse))),
     )
 }
@@ -690,7 +690,7 @@ pub fn write_grid(path: &Path, spec: &FigureSpec) -> Result<FigureInfo> {
         caption(
             rx,
             ry,
-            &format!("{} · {} spp · {}", r.method, r.spp, fmt_time(r.time_s)),
+            &format!("{} · {} spp · {}", r.strategy, r.spp, fmt_time(r.time_s)),
             None,
         )?;
         let top = ry + g.caption_h();
@@ -806,7 +806,7 @@ fn shots_json(shots: &[Shot], reference: &Shot) -> Vec<ShotJson> {
     shots
         .iter()
         .map(|s| ShotJson {
-            strategy: s.method.name().to_string(),
+            strategy: s.strategy.name().to_string(),
             spp: s.spp,
             time_s: s.time_s,
             rmse: s.rmse,
@@ -845,7 +845,7 @@ pub fn summary(scene: &str, s: &CompareSettings, cmp: &Comparison, figure: Figur
         sequence: s.sequence.name(),
         max_depth: s.max_depth,
         reference: ReferenceJson {
-            strategy: r.method.name().to_string(),
+            strategy: r.strategy.name().to_string(),
             spp: r.spp,
             time_s: r.time_s,
             seed: cmp.reference_seed,
@@ -874,7 +874,7 @@ pub fn print_table(cmp: &Comparison) {
     let r = &cmp.reference;
     println!(
         "reference: {} at {} spp, {}",
-        r.method,
+        r.strategy,
         r.spp,
         fmt_time(r.time_s)
     );
@@ -887,12 +887,12 @@ pub fn print_table(cmp: &Comparison) {
         );
         for s in shots {
             let share = worst_pixel_share(s, r);
-            if share > FIREFLY_SHARE && !fireflies.contains(&s.method.name()) {
-                fireflies.push(s.method.name());
+            if share > FIREFLY_SHARE && !fireflies.contains(&s.strategy.name()) {
+                fireflies.push(s.strategy.name());
             }
             println!(
                 "  {:<15} {:>8} {:>10} {:>12} {:>9.0}%",
-                s.method.name(),
+                s.strategy.name(),
                 s.spp,
                 fmt_time(s.time_s),
                 sig3(s.rmse),
@@ -922,7 +922,11 @@ pub fn run(args: &CompareArgs) -> Result<()> {
     if args.reference_spp == Some(0) {
         bail!("--reference-spp 0: at least 1 sample per pixel");
     }
-    let methods = args.strategies.as_deref().map(parse_methods).transpose()?;
+    let strategies = args
+        .strategies
+        .as_deref()
+        .map(parse_strategies_list)
+        .transpose()?;
     let base = crate::common::output_base(
         args.out.as_deref(),
         &args.scene,
@@ -934,13 +938,13 @@ pub fn run(args: &CompareArgs) -> Result<()> {
         &["png", "json"].map(|e| crate::common::with_ext(&base, e)),
     )?;
     let scene = load_scene(&args.scene)?;
-    let methods = methods.unwrap_or_else(|| default_methods(&scene));
+    let strategies = strategies.unwrap_or_else(|| default_strategies(&scene));
     let spp = args
         .spp
         .unwrap_or(u32::try_from(scene.options.spp).unwrap_or(u32::MAX))
         .max(1);
     let settings = CompareSettings {
-        methods,
+        strategies,
         spp,
         reference_spp: args
             .reference_spp
@@ -958,7 +962,7 @@ pub fn run(args: &CompareArgs) -> Result<()> {
         eprintln!("lobe: warning: {w}");
     }
     if !args.quiet {
-        for &m in &settings.methods {
+        for &m in &settings.strategies {
             for f in fallbacks(&scene, m) {
                 eprintln!(
                     "lobe: note: object {} ({}): {} does not apply to its material, using {}",

@@ -146,7 +146,7 @@ fn tour(plan: &DemoSizes, quiet: bool) -> Result<()> {
     println!("measured variance against the exact one, so it is near, not at, 1.0x.\n");
     for (label, json) in TOUR {
         let m = MaterialDesc::from_json(json)?.build()?;
-        let techniques: Vec<Strategy> = m
+        let strategies: Vec<Strategy> = m
             .strategies()
             .into_iter()
             .filter(|s| *s != BsdfStrategy::Cosine)
@@ -157,7 +157,7 @@ fn tour(plan: &DemoSizes, quiet: bool) -> Result<()> {
             &m,
             &lobe::estimator::ShadingPoint::local(wo),
             &light,
-            &techniques,
+            &strategies,
             TableSettings {
                 sequence: Sequence::Independent,
                 samples: n,
@@ -326,7 +326,7 @@ fn showcase_caption(s: &CompareSettings) -> Vec<String> {
 fn showcase(plan: &DemoSizes, dir: &Path, quiet: bool) -> Result<()> {
     let (scene, labels) = showcase_scene(plan.width, plan.height)?;
     let settings = CompareSettings {
-        methods: vec![
+        strategies: vec![
             Strategy::Bsdf(BsdfStrategy::Brdf),
             Strategy::Light,
             Strategy::MIS,
@@ -376,7 +376,7 @@ fn showcase(plan: &DemoSizes, dir: &Path, quiet: bool) -> Result<()> {
         .image
         .write_png(&renders[0], &lobe_render::ToneMap::default())?;
     for s in &cmp.equal_samples {
-        let p = dir.join(format!("{}.png", s.method.name()));
+        let p = dir.join(format!("{}.png", s.strategy.name()));
         s.image.write_png(&p, &lobe_render::ToneMap::default())?;
         renders.push(p);
     }

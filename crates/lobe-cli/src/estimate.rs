@@ -79,7 +79,7 @@ pub fn strategy_help() -> String {
     format!(
         "`all` or a comma-separated list of techniques (all: {}). {}",
         lobe::strategy::ALL_MEANS,
-        crate::common::technique_help()
+        crate::common::strategy_help()
     )
 }
 

@@ -135,7 +135,7 @@ Examples:
 fn strategy_help() -> String {
     format!(
         "One technique (overrides the scene's render.strategy; default mis). {}",
-        crate::common::technique_help()
+        crate::common::strategy_help()
     )
 }
 

@@ -434,14 +434,14 @@ pub fn run(args: &ReportArgs) -> Result<()> {
     for (model, mats) in models.iter().zip(&materials) {
         let mut v = Vec::new();
         for (&value, m) in model.values.iter().zip(mats) {
-            let techniques: Vec<Strategy> =
+            let strategies: Vec<Strategy> =
                 m.strategies().into_iter().map(Strategy::from).collect();
             for &theta in &THETAS {
                 let t = run_table(
                     m,
                     &lobe::estimator::ShadingPoint::local(view(theta)),
                     &light,
-                    &techniques,
+                    &strategies,
                     TableSettings {
                         sequence: Sequence::Independent,
                         samples: settings.samples,

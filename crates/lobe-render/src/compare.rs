@@ -1,4 +1,4 @@
-//! Comparisons of methods on one scene: renders at equal samples and at
+//! Comparisons of strategies on one scene: renders at equal samples and at
 //! equal time next to a high-spp reference, with their error metrics and
 //! error maps (the numbers of `lobe compare` and of `lobe demo`'s
 //! showcase; the figure is the caller's).
@@ -9,9 +9,9 @@
 //!   luminance `|Y − Y_ref| / (Y_ref + ε)`, with `ε` ([`error_epsilon`]) 1 %
 //!   of the reference's mean luminance (so that black pixels do not divide
 //!   by zero).
-//! * **Equal time**: the budget is the time of `mis` (of the slowest method
+//! * **Equal time**: the budget is the time of `mis` (of the slowest strategy
 //!   when `mis` is not compared) at `max(spp, MIN_EQUAL_TIME_SPP)`, measured
-//!   without start-up; each method is rendered with the spp that bring its
+//!   without start-up; each strategy is rendered with the spp that bring its
 //!   time within [`EQUAL_TIME_TOLERANCE`] of it ([`run_comparison`]).
 //! * **Reference**: [`REFERENCE_METHOD`] at the reference spp, with the
 //!   bitwise complement of the seed ([`reference_seed`]), so that its
@@ -30,7 +30,7 @@ use lobe::math::luminance;
 use lobe::progress::{Clock, Progress, timed};
 use serde::Serialize;
 
-/// The method of the reference render.
+/// The strategy of the reference render.
 pub const REFERENCE_METHOD: Strategy = Strategy::mis(Heuristic::Balance);
 
 /// Most samples per pixel an equal-time render may take.
@@ -39,7 +39,7 @@ pub const MAX_EQUAL_TIME_SPP: f64 = 1_048_576.0;
 /// What to compare and how.
 #[derive(Debug, Clone, PartialEq)]
 pub struct CompareSettings {
-    pub methods: Vec<Strategy>,
+    pub strategies: Vec<Strategy>,
     /// Samples per pixel at equal samples.
     pub spp: u32,
     pub reference_spp: u32,
@@ -56,7 +56,7 @@ pub struct CompareSettings {
 /// One render of a comparison.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Shot {
-    pub method: Strategy,
+    pub strategy: Strategy,
     pub spp: u32,
     /// Seconds the render took on the caller's clock.
     pub time_s: f64,
@@ -69,11 +69,11 @@ pub struct Shot {
 /// The equal-time row.
 #[derive(Debug, Clone, PartialEq)]
 pub struct EqualTime {
-    /// The time each method was given, in seconds.
+    /// The time each strategy was given, in seconds.
     pub budget_s: f64,
     /// Where the budget comes from, e.g. `the time of mis at 16 spp`.
     pub budget_from: String,
-    /// One shot per method, in the order of the equal-samples row. A shot
+    /// One shot per strategy, in the order of the equal-samples row. A shot
     /// whose spp equals the equal-samples spp is its pilot, not rendered
     /// again.
     pub shots: Vec<Shot>,
@@ -88,13 +88,13 @@ pub struct Comparison {
     pub equal_time: Option<EqualTime>,
 }
 
-/// [`default_methods`] in words, for help texts.
-pub const DEFAULT_METHODS: &str =
+/// [`default_strategies`] in words, for help texts.
+pub const DEFAULT_STRATEGIES: &str =
     "brdf, vndf (when an object's material has it), light, mis-balance, mis-power and mis";
 
-/// The default methods for `scene` ([`DEFAULT_METHODS`]).
+/// The default strategies for `scene` ([`DEFAULT_STRATEGIES`]).
 #[must_use]
-pub fn default_methods(scene: &Scene) -> Vec<Strategy> {
+pub fn default_strategies(scene: &Scene) -> Vec<Strategy> {
     let mut v = vec![Strategy::Bsdf(BsdfStrategy::Brdf)];
     if scene
         .objects
@@ -140,7 +140,7 @@ pub fn render_one(
     progress.start(label, pixels.saturating_mul(opts.spp));
     let (image, time_s) = timed(clock, || render(scene, opts, |n| progress.advance(n)));
     Shot {
-        method: opts.strategy,
+        strategy: opts.strategy,
         spp: u32::try_from(opts.spp).unwrap_or(u32::MAX),
         time_s,
         rmse: f64::NAN,
@@ -150,18 +150,18 @@ pub fn render_one(
 
 /// The progress label of a render: `brdf 16 spp`, `brdf 40 spp, eq. time`,
 /// `reference 1024 spp`.
-fn label(method: Strategy, spp: u32, what: &str) -> String {
+fn label(strategy: Strategy, spp: u32, what: &str) -> String {
     match what {
-        "" => format!("{method} {spp} spp"),
+        "" => format!("{strategy} {spp} spp"),
         "reference" => format!("reference {spp} spp"),
-        _ => format!("{method} {spp} spp, {what}"),
+        _ => format!("{strategy} {spp} spp, {what}"),
     }
 }
 
 /// The equal-time budget is the time of a render of at least this many
 /// samples per pixel: below it, whole samples per pixel cannot make the
 /// times equal within [`EQUAL_TIME_TOLERANCE`] (at 4 spp one sample more
-/// or less is 25 %; at 32 spp, with the slowest method at 20, 2.5 %).
+/// or less is 25 %; at 32 spp, with the slowest strategy at 20, 2.5 %).
 pub const MIN_EQUAL_TIME_SPP: u32 = 32;
 
 /// The equal-time budget is at least this many seconds: a shorter render's
@@ -173,7 +173,7 @@ pub const MIN_EQUAL_TIME_S: f64 = 0.05;
 /// fraction of the budget), within [`EQUAL_TIME_TRIES`] renders.
 pub const EQUAL_TIME_TOLERANCE: f64 = 0.03;
 
-/// Most renders of one method to bring its time within
+/// Most renders of one strategy to bring its time within
 /// [`EQUAL_TIME_TOLERANCE`] of the budget; the closest is kept.
 pub const EQUAL_TIME_TRIES: usize = 4;
 
@@ -185,22 +185,22 @@ pub const SHORT_RENDER_S: f64 = 0.1;
 /// Runs of a render shorter than [`SHORT_RENDER_S`].
 pub const SHORT_RENDER_RUNS: usize = 3;
 
-/// Renders every method at equal samples (and at equal time when
+/// Renders every strategy at equal samples (and at equal time when
 /// `s.equal_time`), then the reference, and measures each render's RMSE
 /// against the reference. Each render is one progress task (see
 /// [`render_one`]); the times come from `clock`, and only the equal-time
 /// spp depend on them.
 ///
-/// Times are measured without start-up: every method is first rendered
+/// Times are measured without start-up: every strategy is first rendered
 /// once at 1 spp, untimed (progress task `warm-up`: the threads, the
 /// lazily built tables, the first touch of memory), and a render shorter
 /// than [`SHORT_RENDER_S`] is timed as the fastest of [`SHORT_RENDER_RUNS`]
 /// runs.
 ///
-/// Equal time: the budget is the time of `mis` (the slowest method when
+/// Equal time: the budget is the time of `mis` (the slowest strategy when
 /// `mis` is not compared) at `max(spp, MIN_EQUAL_TIME_SPP)`, or at more spp
 /// when that takes less than [`MIN_EQUAL_TIME_S`]. Each other
-/// method starts from the spp its equal-samples render's time per spp
+/// strategy starts from the spp its equal-samples render's time per spp
 /// gives, and is rendered again with the spp of the least-squares line
 /// through its (spp, time) points so far (a render's time is a start-up of its own,
 /// the pilots, plus a cost per sample) until its time is within
@@ -214,51 +214,51 @@ pub fn run_comparison(
     clock: &dyn Clock,
 ) -> Comparison {
     let spp = s.spp.max(1);
-    let opts = |method: Strategy, spp: u32, seed: u64| RenderOptions {
+    let opts = |strategy: Strategy, spp: u32, seed: u64| RenderOptions {
         spp: spp.into(),
-        strategy: method,
+        strategy: strategy,
         seed,
         sequence: s.sequence,
         max_depth: s.max_depth,
         threads: s.threads,
         ..RenderOptions::default()
     };
-    for &m in &s.methods {
+    for &m in &s.strategies {
         let _ = render_one(scene, &opts(m, 1, s.seed), "warm-up", progress, &NoClock);
     }
-    let shot = |method: Strategy, spp: u32, seed: u64, what: &str| {
-        let o = opts(method, spp, seed);
-        let mut first = render_one(scene, &o, &label(method, spp, what), progress, clock);
+    let shot = |strategy: Strategy, spp: u32, seed: u64, what: &str| {
+        let o = opts(strategy, spp, seed);
+        let mut first = render_one(scene, &o, &label(strategy, spp, what), progress, clock);
         if what != "reference" && first.time_s < SHORT_RENDER_S {
             for _ in 1..SHORT_RENDER_RUNS {
-                let again = render_one(scene, &o, &label(method, spp, what), progress, clock);
+                let again = render_one(scene, &o, &label(strategy, spp, what), progress, clock);
                 first.time_s = first.time_s.min(again.time_s);
             }
         }
         first
     };
     let equal_samples: Vec<Shot> = s
-        .methods
+        .strategies
         .iter()
         .map(|&m| shot(m, spp, s.seed, ""))
         .collect();
     let equal_time = s.equal_time.then(|| {
         let budget_spp = spp.max(MIN_EQUAL_TIME_SPP);
-        let (k, why) = match equal_samples.iter().position(|x| x.method == Strategy::MIS) {
+        let (k, why) = match equal_samples.iter().position(|x| x.strategy == Strategy::MIS) {
             Some(k) => (k, ""),
             None => {
                 let k = (0..equal_samples.len())
                     .max_by(|&a, &b| equal_samples[a].time_s.total_cmp(&equal_samples[b].time_s))
-                    .expect("at least one method");
+                    .expect("at least one strategy");
                 (k, ", the slowest")
             }
         };
-        let budget_method = equal_samples[k].method;
+        let budget_strategy = equal_samples[k].strategy;
         let mut budget_spp = budget_spp;
         let mut budget_shot = if budget_spp == spp {
             equal_samples[k].clone()
         } else {
-            shot(budget_method, budget_spp, s.seed, "eq. time")
+            shot(budget_strategy, budget_spp, s.seed, "eq. time")
         };
         for _ in 0..EQUAL_TIME_TRIES {
             if budget_shot.time_s >= MIN_EQUAL_TIME_S || f64::from(budget_spp) >= MAX_EQUAL_TIME_SPP
@@ -269,10 +269,10 @@ pub fn run_comparison(
             budget_spp = (f64::from(budget_spp) * scale)
                 .ceil()
                 .clamp(f64::from(budget_spp) + 1.0, MAX_EQUAL_TIME_SPP) as u32;
-            budget_shot = shot(budget_method, budget_spp, s.seed, "eq. time");
+            budget_shot = shot(budget_strategy, budget_spp, s.seed, "eq. time");
         }
         let budget_s = budget_shot.time_s;
-        let mut budget_from = format!("the time of {budget_method} at {budget_spp} spp{why}");
+        let mut budget_from = format!("the time of {budget_strategy} at {budget_spp} spp{why}");
         if budget_spp != spp {
             budget_from.push_str(&format!(
                 "; at least {MIN_EQUAL_TIME_SPP} spp and {} ms, so that whole samples per pixel and the clock can make the times equal",
@@ -294,7 +294,7 @@ pub fn run_comparison(
                     if tried.iter().any(|t| t.spp == n_u) {
                         break;
                     }
-                    let x = shot(pilot.method, n_u, s.seed, "eq. time");
+                    let x = shot(pilot.strategy, n_u, s.seed, "eq. time");
                     let (n1, t1) = (f64::from(x.spp), x.time_s);
                     tried.push(x);
                     if (t1 / budget_s - 1.0).abs() <= EQUAL_TIME_TOLERANCE {

@@ -58,7 +58,7 @@
 //! Every number a sample uses comes from [`lobe::sequence::pair_point`] in
 //! its own dimension pair ([`dims`]): the position in the pixel, then per
 //! bounce the BSDF sample's direction and lobe choice, the light sample
-//! (multi-sample MIS gives each technique its own dimensions), the
+//! (multi-sample MIS gives each strategy its own dimensions), the
 //! continuation's direction and lobe choice, and Russian roulette. The
 //! pattern ([`RenderOptions::sequence`]) is `sobol` (Owen-scrambled,
 //! padded per pair) by default, or `stratified`, or `independent`. Pixel
@@ -186,7 +186,7 @@ pub mod dims {
 /// The first bounce of a pixel's samples under adaptive MIS.
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum FirstBounce {
-    /// As the estimator is (every technique but adaptive MIS; adaptive MIS
+    /// As the estimator is (every strategy but adaptive MIS; adaptive MIS
     /// at the balance heuristic).
     Plain,
     /// Adaptive MIS's pilot: the balance heuristic, recorded.

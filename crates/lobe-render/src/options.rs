@@ -1,4 +1,4 @@
-//! What to render with: samples per pixel, the technique, the seed, the
+//! What to render with: samples per pixel, the strategy, the seed, the
 //! sample sequence, the path
 //! depth and the thread count. A scene file's `[render]` table sets them
 //! ([`crate::scene`]); the renderer ([`crate::render()`]) reads them.
@@ -81,7 +81,7 @@ impl std::str::FromStr for SppAllocation {
 }
 
 /// Which loop renders: the batch (wavefront) loop on `lobe::batch`'s f32
-/// SIMD kernels where it covers the scene and the technique
+/// SIMD kernels where it covers the scene and the strategy
 /// ([`crate::integrator::batch_refusal`] says why not; the scalar loop
 /// renders it then), or the scalar f64 loop, the reference.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]

@@ -8,9 +8,8 @@ use lobe::estimator::{Heuristic, Strategy};
 use lobe::progress::{Clock, Progress};
 use lobe::{Material, Rgb};
 use lobe_render::compare::{
-    CompareSettings, EQUAL_TIME_TOLERANCE, LogScale, REFERENCE_METHOD, default_methods,
-    default_reference_spp, error_epsilon, error_map, reference_seed, resample, rmse,
-    run_comparison,
+    CompareSettings, EQUAL_TIME_TOLERANCE, LogScale, REFERENCE_METHOD, default_reference_spp,
+    default_strategies, error_epsilon, error_map, reference_seed, resample, rmse, run_comparison,
 };
 use lobe_render::{Camera, Image, Object, Scene};
 use std::sync::Mutex;
@@ -95,7 +94,7 @@ fn resample_preserves_a_constant_image() {
 /// A machine whose renders take a start-up of [`STARTUP`] seconds (at the
 /// first samples, inside the timed render) plus a
 /// cost per sample (cosine 0.01 s, mis 0.03 s, anything else 0.02 s),
-/// told by the progress tasks (their label names the method) and read by
+/// told by the progress tasks (their label names the strategy) and read by
 /// the clock: the model `a + b · spp` of a real render's time.
 #[derive(Default)]
 struct Machine(Mutex<MachineState>);
@@ -148,7 +147,7 @@ fn furnace() -> Scene {
 fn a_comparison_under_a_fake_clock() {
     let scene = furnace();
     assert_eq!(
-        default_methods(&scene),
+        default_strategies(&scene),
         [
             Strategy::Bsdf(BsdfStrategy::Brdf),
             Strategy::Light,
@@ -158,7 +157,7 @@ fn a_comparison_under_a_fake_clock() {
         ]
     );
     let settings = CompareSettings {
-        methods: vec![Strategy::Bsdf(BsdfStrategy::Cosine), Strategy::MIS],
+        strategies: vec![Strategy::Bsdf(BsdfStrategy::Cosine), Strategy::MIS],
         spp: 2,
         reference_spp: 16,
         seed: 9,
@@ -215,12 +214,12 @@ fn a_comparison_under_a_fake_clock() {
         assert!(
             (shot.time_s / et.budget_s - 1.0).abs() <= EQUAL_TIME_TOLERANCE,
             "{} {} s against {} s",
-            shot.method,
+            shot.strategy,
             shot.time_s,
             et.budget_s
         );
     }
-    assert_eq!(cmp.reference.method, REFERENCE_METHOD);
+    assert_eq!(cmp.reference.strategy, REFERENCE_METHOD);
     assert_eq!(cmp.reference.spp, 16);
     assert_eq!(cmp.reference_seed, reference_seed(9));
     assert_eq!(cmp.reference.rmse, 0.0);

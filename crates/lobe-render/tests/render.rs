@@ -1,5 +1,5 @@
 //! The renderer against answers known in closed form: the white furnace,
-//! agreement between techniques, thread-count independence, orientation,
+//! agreement between strategies, thread-count independence, orientation,
 //! and scene-file errors.
 
 use glam::DVec3;
@@ -82,7 +82,7 @@ fn white_furnace_every_method() {
     let px = covered(&scene, 0);
     assert!(px.len() > 150, "{} covered pixels", px.len());
     let allocations = Strategy::all().into_iter().flat_map(|m| {
-        // The variance allocation on the techniques whose pixels differ
+        // The variance allocation on the strategies whose pixels differ
         // in noise (every pixel of the exact ones has none).
         let variance = !matches!(m, Strategy::Bsdf(s) if s != BsdfStrategy::Uniform);
         std::iter::once((m, SppAllocation::Uniform))
@@ -224,7 +224,7 @@ fn smooth_env() -> EnvMap {
 
 #[test]
 fn techniques_agree_pixel_by_pixel() {
-    // Every technique estimates the same image: the per-pixel difference of
+    // Every strategy estimates the same image: the per-pixel difference of
     // two renders with different seeds has mean zero.
     let ggx = MaterialDesc::from_json(
         r#"{"type":"cook-torrance","distribution":"ggx","alpha":0.25,"kd":0.3}"#,
@@ -293,7 +293,7 @@ fn sphere_on_plane() -> (Scene, Vec<(usize, usize)>) {
 }
 
 /// Issue 10: the batch loop (f32 kernels, blocks of samples) against the
-/// scalar f64 loop, its reference, for every technique it covers. With the
+/// scalar f64 loop, its reference, for every strategy it covers. With the
 /// same seed both draw the same numbers, so the images agree to f32
 /// rounding; with different seeds the per-pixel differences have mean zero
 /// (within 4.5 standard errors). What the batch loop refuses is rendered
@@ -444,7 +444,7 @@ fn every_sequence_is_unbiased_and_qmc_has_less_error() {
     let best = by[0].min(by[1]);
     assert!(
         by[3] < 1.1 * best,
-        "mis {} vs the better technique {best}",
+        "mis {} vs the better strategy {best}",
         by[3]
     );
     assert!(

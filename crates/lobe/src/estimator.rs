@@ -75,14 +75,14 @@ impl Accumulator {
 }
 
 impl Strategy {
-    /// Validate this technique for `m` once, into an estimator of one
+    /// Validate this strategy for `m` once, into an estimator of one
     /// shading point; the error says why a BSDF strategy does not apply.
     pub fn for_material<'m>(&self, m: &'m Material) -> Result<ShadingEstimator<'m>, Error> {
         let sampler = match self.bsdf_strategy(m) {
             Some(s) => Some(m.sampler(s)?),
             None => None,
         };
-        let technique = match *self {
+        let strategy = match *self {
             Strategy::Mis(mis) => Strategy::Mis(Mis {
                 bsdf: sampler.map(|s| s.strategy()),
                 ..mis
@@ -90,7 +90,7 @@ impl Strategy {
             t => t,
         };
         Ok(ShadingEstimator {
-            strategy: technique,
+            strategy,
             material: m,
             sampler,
             allocation: Allocation::Balance,
@@ -165,7 +165,7 @@ pub struct ShadingEstimate {
     /// `f L cos / p`, MIS-weighted where MIS is used (cosine included);
     /// zero for failed samples.
     pub value: Rgb,
-    /// The first BSDF sample drawn, if the technique drew one.
+    /// The first BSDF sample drawn, if the strategy drew one.
     pub bsdf: Option<DrawnBsdf>,
 }
 
@@ -218,8 +218,8 @@ impl Allocation {
 /// * all to light: `(∫ g²/p_l − μ²) / n`;
 /// * balance: `∫ g²/q − n_b (∫ g p_b/q)² − n_l (∫ g p_c/q)²`.
 ///
-/// A direction with `g > 0` that a technique cannot draw (pdf 0) makes that
-/// technique's variance infinite. The light draws see what BSDF sampling
+/// A direction with `g > 0` that a strategy cannot draw (pdf 0) makes that
+/// strategy's variance infinite. The light draws see what BSDF sampling
 /// misses (a small sun), so a pilot does not mistake a heavy-tailed BSDF
 /// estimator for a good one.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -282,7 +282,7 @@ impl Pilot {
 
     /// The estimated per-sample variance of the luminance under each
     /// allocation, in the order of [`Allocation::ALL`], for counts
-    /// `(n_b, n_l)`; infinite where a technique cannot draw a direction
+    /// `(n_b, n_l)`; infinite where a strategy cannot draw a direction
     /// that carries light.
     #[must_use]
     pub fn variances(&self, n_b: u32, n_l: u32) -> [f64; 3] {
@@ -316,7 +316,7 @@ impl Pilot {
         }
     }
 
-    /// The allocation of least estimated variance; a single technique only
+    /// The allocation of least estimated variance; a single strategy only
     /// when it beats the balance heuristic by a margin (5%), and only when
     /// the pilot saw enough light to tell ([`Pilot::MIN_EFFECTIVE_DRAWS`]):
     /// balance is the defensive choice.
@@ -344,20 +344,20 @@ pub fn pilot_samples(n: usize) -> usize {
 }
 
 impl<'m> ShadingEstimator<'m> {
-    /// The technique, with its MIS BSDF strategy resolved.
+    /// The strategy, with its MIS BSDF strategy resolved.
     #[must_use]
     pub fn strategy(&self) -> Strategy {
         self.strategy
     }
 
-    /// The BSDF sampler the technique uses (none for light sampling).
+    /// The BSDF sampler the strategy uses (none for light sampling).
     #[must_use]
     pub fn sampler(&self) -> Option<BsdfSampler<'m>> {
         self.sampler
     }
 
     /// The allocation adaptive MIS uses (always `Balance` for any other
-    /// technique, where it means nothing).
+    /// strategy, where it means nothing).
     #[must_use]
     pub fn allocation(&self) -> Allocation {
         self.allocation
@@ -370,7 +370,7 @@ impl<'m> ShadingEstimator<'m> {
     }
 
     /// This estimator with adaptive MIS's draws given out by `a` (no
-    /// effect on any other technique).
+    /// effect on any other strategy).
     #[must_use]
     pub fn with_allocation(self, a: Allocation) -> Self {
         ShadingEstimator {
@@ -387,7 +387,7 @@ impl<'m> ShadingEstimator<'m> {
     /// [`pilot_samples`]`(plan.samples)` samples of its own (independent
     /// numbers, a seed apart from the plan's, not part of the estimate) and
     /// return this estimator with the allocation the pilot chose. Any other
-    /// technique is returned as it is.
+    /// strategy is returned as it is.
     #[must_use]
     pub fn prepare(&self, sp: &ShadingPoint, light: &Light, plan: &Plan) -> Self {
         let Strategy::Mis(mis) = self.strategy else {
@@ -410,7 +410,7 @@ impl<'m> ShadingEstimator<'m> {
 
     /// One sample of the multi-sample balance heuristic (adaptive MIS's
     /// pilot), recording in `pilot` what [`Pilot::choose`] needs. For a
-    /// technique that is not adaptive MIS, [`ShadingEstimator::estimate`].
+    /// strategy that is not adaptive MIS, [`ShadingEstimator::estimate`].
     #[must_use]
     pub fn estimate_pilot(
         &self,
@@ -445,7 +445,7 @@ impl<'m> ShadingEstimator<'m> {
     /// One estimate from `points`, [`Strategy::points_per_sample`] of them,
     /// each `[uc, u₁, u₂]`. Multi-sample MIS takes its `n_bsdf` BSDF points
     /// first, then its `n_light` light points (which use `u` only);
-    /// one-sample MIS chooses the technique with the point's `uc`.
+    /// one-sample MIS chooses the strategy with the point's `uc`.
     #[must_use]
     pub fn estimate(
         &self,
@@ -546,7 +546,7 @@ impl<'m> ShadingEstimator<'m> {
                     }
                 }
             }
-            (_, None) => unreachable!("a BSDF or MIS technique always has a sampler"),
+            (_, None) => unreachable!("a BSDF or MIS strategy always has a sampler"),
         };
         ShadingEstimate { value, bsdf: first }
     }
@@ -677,7 +677,7 @@ fn draw_bsdf(
 /// One light sample's value `f L cos · w / (n p_light)` from point `p`
 /// (its `u` only): zero for a failed sample (no sample, below the horizon,
 /// `f = 0`, occluded). `weight(p_light, p_bsdf)` gives the MIS weight `w`
-/// and the technique's count `n` (`p_bsdf` is 0 without `bsdf`); `f` and
+/// and the strategy's count `n` (`p_bsdf` is 0 without `bsdf`); `f` and
 /// `p_bsdf` come from one [`BsdfSampler::eval_pdf`].
 #[inline]
 #[allow(clippy::too_many_arguments)]
@@ -702,9 +702,9 @@ fn light_value(
     }
 }
 
-/// What one estimate is: a technique, a sequence, a number of samples and a
+/// What one estimate is: a strategy, a sequence, a number of samples and a
 /// seed. One sample of multi-sample MIS draws `n_bsdf + n_light` directions
-/// (as one sample per pixel of a renderer's MIS does); compare techniques of
+/// (as one sample per pixel of a renderer's MIS does); compare strategies of
 /// different cost by efficiency, 1/(variance × time).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Plan {
@@ -742,7 +742,7 @@ impl Plan {
 
 /// Estimate chunk by chunk, in order, on this thread. A caller with threads
 /// runs [`estimate_chunk`] for every chunk and merges them in chunk order,
-/// which gives the same numbers. The error says why the plan's technique
+/// which gives the same numbers. The error says why the plan's strategy
 /// does not apply to `m`.
 pub fn estimate(
     m: &Material,
@@ -758,7 +758,7 @@ pub fn estimate(
     Ok(acc)
 }
 
-/// The estimates of chunk `chunk` of `plan`, by `est` (the plan's technique
+/// The estimates of chunk `chunk` of `plan`, by `est` (the plan's strategy
 /// validated for the material, and for adaptive MIS
 /// [`ShadingEstimator::prepare`]d at this point).
 #[must_use]
@@ -786,7 +786,7 @@ pub fn estimate_chunk(
     } else {
         // Stratified or Sobol: point `t` of every sample comes from stream
         // `t`, an independently randomized sequence of `N` points, so each
-        // technique of MIS is as well distributed as it is alone.
+        // strategy of MIS is as well distributed as it is alone.
         let mut stream = vec![[0.0; 3]; len];
         for t in 0..k {
             sequence::fill(

@@ -7,7 +7,7 @@ use crate::Material;
 pub use crate::bsdf_strategy::BsdfStrategy;
 use crate::light::LightDistribution;
 
-/// How Multiple Importance Sampling weights its techniques (Veach 1997).
+/// How Multiple Importance Sampling weights its strategies (Veach 1997).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Heuristic {
     /// `w_t = n_t p_t / Σ n p`.
@@ -17,7 +17,7 @@ pub enum Heuristic {
 }
 
 impl Heuristic {
-    /// The weight of a technique whose (count-scaled) density is `a`
+    /// The weight of a strategy whose (count-scaled) density is `a`
     /// against another's `b`.
     #[inline]
     #[must_use]
@@ -30,9 +30,9 @@ impl Heuristic {
 }
 
 /// Multi-sample MIS draws `n_bsdf` and `n_light` samples for every estimate;
-/// one-sample MIS draws one, choosing the technique with probability
+/// one-sample MIS draws one, choosing the strategy with probability
 /// `n_t / (n_bsdf + n_light)`; adaptive MIS draws `n_bsdf + n_light`
-/// directions per estimate and gives them to the techniques as a pilot
+/// directions per estimate and gives them to the strategies as a pilot
 /// says is best ([`crate::estimator::Allocation`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum MisForm {
@@ -43,7 +43,7 @@ pub enum MisForm {
     /// of every allocation of the `n_bsdf + n_light` draws (all to BSDF
     /// sampling, the multi-sample balance heuristic with the given counts,
     /// all to light sampling) is estimated, and the least is used. Never
-    /// much worse than the better technique alone, keeping MIS's wins.
+    /// much worse than the better strategy alone, keeping MIS's wins.
     Adaptive,
 }
 
@@ -82,7 +82,7 @@ impl From<BsdfStrategy> for Strategy {
     }
 }
 
-/// The names of the techniques that are not BSDF strategies.
+/// The names of the strategies that are not BSDF strategies.
 pub const NON_BSDF_NAMES: [&str; 6] = [
     "light",
     "mis",
@@ -103,7 +103,7 @@ impl Strategy {
         n_light: 1,
     });
 
-    /// `mis-balance` or `mis-power`: one sample of each technique,
+    /// `mis-balance` or `mis-power`: one sample of each strategy,
     /// multi-sample, on the material's best BSDF strategy.
     #[must_use]
     pub const fn mis(heuristic: Heuristic) -> Self {
@@ -116,9 +116,9 @@ impl Strategy {
         })
     }
 
-    /// Every technique by name: the BSDF strategies, `light`, `mis`,
+    /// Every strategy by name: the BSDF strategies, `light`, `mis`,
     /// `mis-balance`, `mis-power`, `mis-one`, `mis-power-one` (MIS on the
-    /// material's best BSDF strategy, one sample of each technique).
+    /// material's best BSDF strategy, one sample of each strategy).
     #[must_use]
     pub fn all() -> Vec<Strategy> {
         let mut v: Vec<Strategy> = BsdfStrategy::ALL.into_iter().map(Strategy::Bsdf).collect();
@@ -171,7 +171,7 @@ impl Strategy {
         }
     }
 
-    /// The light distribution this technique draws light samples from: the
+    /// The light distribution this strategy draws light samples from: the
     /// plain one for light sampling alone, the MIS-compensated one inside
     /// MIS. The one place where that choice is made.
     #[must_use]
@@ -182,8 +182,8 @@ impl Strategy {
         }
     }
 
-    /// The BSDF strategy this technique samples `m` by, if any: its own for
-    /// a BSDF technique, the given or the material's best for MIS, none for
+    /// The BSDF strategy this strategy samples `m` by, if any: its own for
+    /// a BSDF strategy, the given or the material's best for MIS, none for
     /// light sampling.
     #[must_use]
     pub fn bsdf_strategy(&self, m: &Material) -> Option<BsdfStrategy> {
@@ -209,12 +209,12 @@ impl std::str::FromStr for Strategy {
     }
 }
 
-/// The techniques `all` stands for: every BSDF strategy that applies to the
+/// The strategies `all` stands for: every BSDF strategy that applies to the
 /// material, `light`, `mis`, `mis-balance`, `mis-power`.
 pub const ALL_MEANS: &str = "every BSDF strategy that applies, light, mis, mis-balance, mis-power";
 
 impl Strategy {
-    /// A list of technique names for material `m`, in order, without
+    /// A list of strategy names for material `m`, in order, without
     /// repeats: each name is a BSDF strategy (checked against `m`), `light`,
     /// or an MIS name of [`NON_BSDF_NAMES`], whose MIS combines light
     /// sampling with `mis_bsdf` at `n_bsdf` and `n_light` draws; `all` is

@@ -136,7 +136,7 @@ fn writes_the_grid_and_the_numbers() {
         help.contains("(default: brdf, vndf (when an object's material has it), light, mis-balance, mis-power and mis)"),
         "{help}"
     );
-    // MIS is no worse than the worse of its two techniques.
+    // MIS is no worse than the worse of its two strategies.
     assert!(
         rmse["mis"] <= rmse["brdf"].max(rmse["light"]),
         "RMSE: {rmse:?}"

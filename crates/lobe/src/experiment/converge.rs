@@ -1,7 +1,7 @@
-//! Convergence curves: how fast the error of each technique and sample
+//! Convergence curves: how fast the error of each strategy and sample
 //! sequence falls with the number of samples (what `lobe converge` plots).
 //!
-//! For every technique × sequence and every `N = 2^0 .. 2^K`, `R`
+//! For every strategy × sequence and every `N = 2^0 .. 2^K`, `R`
 //! independent estimates of the luminance of `L_o(wo)` are compared with a
 //! target (the quadrature reference); their root mean square error is the
 //! curve, and the slope of `log RMSE` against `log N` is fitted by least
@@ -39,7 +39,7 @@ pub struct CurveSettings {
     pub seed: u64,
 }
 
-/// The RMSE of one technique × sequence at every `N`.
+/// The RMSE of one strategy × sequence at every `N`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Curve {
     pub strategy: Strategy,
@@ -70,23 +70,23 @@ pub fn total_samples(series: usize, runs: usize, max_exp: u32) -> u64 {
     ((1u64 << (max_exp + 1)) - 1) * (series * runs) as u64
 }
 
-/// Every technique × sequence, technique-major.
+/// Every strategy × sequence, strategy-major.
 #[must_use]
-pub fn product(techniques: &[Strategy], sequences: &[Sequence]) -> Vec<(Strategy, Sequence)> {
-    techniques
+pub fn product(strategies: &[Strategy], sequences: &[Sequence]) -> Vec<(Strategy, Sequence)> {
+    strategies
         .iter()
         .flat_map(|&s| sequences.iter().map(move |&q| (s, q)))
         .collect()
 }
 
-/// RMSE curves of `series` (technique, sequence) against the luminance
+/// RMSE curves of `series` (strategy, sequence) against the luminance
 /// `target` of `L_o(wo) = ∫ f L cos dω` (cosine included), each over
 /// `settings.runs` runs at `N = 2^0 .. 2^max_exp`, with the slopes fitted
 /// over the upper half of the exponents.
 ///
 /// Progress: one task `converge` of [`total_samples`] steps (one per
 /// sample). The result depends only on the arguments, not on the thread
-/// count. The error says why a technique does not apply to `m`.
+/// count. The error says why a strategy does not apply to `m`.
 pub fn curves(
     m: &Material,
     sp: &ShadingPoint,

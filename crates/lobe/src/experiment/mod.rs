@@ -1,7 +1,7 @@
 //! Experiments: the numbers behind every table and figure of the `lobe`
 //! command line, as plain functions of plain values.
 //!
-//! * [`table`]: one shading point, every technique, against a quadrature
+//! * [`table`]: one shading point, every strategy, against a quadrature
 //!   reference (`lobe estimate`).
 //! * [`converge`]: RMSE against the number of samples, with fitted slopes
 //!   (`lobe converge`).
@@ -55,7 +55,7 @@ pub(crate) fn map_indices<T: Send>(n: usize, f: impl Fn(usize) -> T + Sync + Sen
 /// `parallel`) and merged in chunk order: the same numbers as the serial
 /// estimate, for any thread count. Calls `progress.advance(k)` after each
 /// chunk of `k` samples (it does not call `start`). The error says why the
-/// plan's technique does not apply to `m`.
+/// plan's strategy does not apply to `m`.
 pub fn estimate_chunked(
     m: &Material,
     sp: &ShadingPoint,

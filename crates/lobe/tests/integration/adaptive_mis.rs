@@ -1,6 +1,6 @@
 //! Adaptive MIS (`mis`, issue 10): never worse than its parts. Over a grid
 //! of materials, views and lights, the allocation a pilot chooses has an
-//! exact variance per draw at most 1.1× that of the better single technique
+//! exact variance per draw at most 1.1× that of the better single strategy
 //! (BSDF sampling by the material's best strategy, or light sampling),
 //! with every variance computed by quadrature, not from samples (a
 //! heavy-tailed estimator's sample variance can be far too small); and the
@@ -105,7 +105,7 @@ fn adaptive_mis_is_never_worse_than_its_parts() {
                     Allocation::Light => e.light,
                     Allocation::Balance => 2.0 * e.balance,
                 };
-                // Variances below rounding (a zero-variance technique) are 0.
+                // Variances below rounding (a zero-variance strategy) are 0.
                 let floor = 1e-12 * e.mu * e.mu;
                 let best = e.bsdf.min(e.light).max(floor);
                 let ratio = per_draw.max(floor) / best;
@@ -125,7 +125,7 @@ fn adaptive_mis_is_never_worse_than_its_parts() {
                 }
                 assert!(
                     per_draw <= 1.1 * best,
-                    "{case}: {ratio:.3}× the better technique"
+                    "{case}: {ratio:.3}× the better strategy"
                 );
             }
         }

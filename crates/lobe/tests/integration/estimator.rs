@@ -127,7 +127,7 @@ fn visible_normals_beat_d_cos_at_grazing_views() {
     assert!(v <= b, "vndf {v} > brdf {b}");
 }
 
-/// RMSE over `runs` seeds of a technique's luminance estimate with `n` samples.
+/// RMSE over `runs` seeds of a strategy's luminance estimate with `n` samples.
 fn rmse_of(
     m: &lobe::Material,
     light: &Light,
@@ -153,7 +153,7 @@ fn rmse_of(
 }
 
 /// Multi-sample MIS under Sobol and stratified points converges at the rate
-/// of its parts: each technique draws from its own randomized sequence
+/// of its parts: each strategy draws from its own randomized sequence
 /// (issue 8, item 2). Before, MIS took two consecutive points of one
 /// sequence and under Sobol was no better than independent sampling.
 #[test]

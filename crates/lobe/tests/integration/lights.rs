@@ -159,7 +159,7 @@ fn rmse(
 
 /// On a sky with a sun, MIS agrees with BSDF-only and light-only sampling,
 /// and at equal numbers of samples (one MIS sample draws one direction by
-/// each technique, as one sample per pixel does in a renderer) its RMSE is no worse than the
+/// each strategy, as one sample per pixel does in a renderer) its RMSE is no worse than the
 /// better of the two, for a rough and a shiny material.
 #[test]
 fn mis_is_as_good_as_the_better_technique_on_a_sunny_sky() {
@@ -214,7 +214,7 @@ fn mis_is_as_good_as_the_better_technique_on_a_sunny_sky() {
                     "{json} {h:?} {form:?}: RMSE mis {e_m:.3e}, bsdf {e_b:.3e}, light {e_l:.3e}"
                 );
                 // The claim is for `mis` and `mis-power` (multi-sample, one
-                // direction by each technique); the one-sample form draws one
+                // direction by each strategy); the one-sample form draws one
                 // direction in all and is only checked for agreement.
                 if form == MisForm::MultiSample && e_m > 1.1 * best {
                     failures.push(format!(
