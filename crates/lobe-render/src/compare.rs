@@ -216,7 +216,7 @@ pub fn run_comparison(
     let spp = s.spp.max(1);
     let opts = |strategy: Strategy, spp: u32, seed: u64| RenderOptions {
         spp: spp.into(),
-        strategy: strategy,
+        strategy,
         seed,
         sequence: s.sequence,
         max_depth: s.max_depth,
