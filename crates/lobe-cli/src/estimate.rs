@@ -2,12 +2,12 @@
 //! each strategy and measure its noise against a quadrature reference.
 
 use crate::common::{Bar, LightArgs, ViewArgs};
-use anyhow::{Result, bail};
+use anyhow::Result;
 use clap::Args;
 use glam::DVec3;
 use lobe::estimator::Strategy;
-use lobe::experiment::table::{StderrMethod, TableOptions};
-use lobe::experiment::table::{Table, TableSettings, run_table_with};
+use lobe::experiment::estimate::{EstimateSettings, MAX_MIS_SAMPLES, Setting, estimate_table};
+use lobe::experiment::table::{StderrMethod, Table};
 use lobe::progress::SystemClock;
 use lobe::sequence::Sequence;
 use lobe::{BsdfStrategy, Material};
@@ -99,17 +99,19 @@ pub fn parse_strategies(
         .map_err(|e| anyhow::anyhow!("--strategy: {e}"))
 }
 
-/// `B,L`: samples of BSDF and light sampling per MIS estimate.
+/// `B,L`: samples of BSDF and light sampling per MIS estimate (their
+/// range is checked with the other settings, [`EstimateSettings::check`]).
 pub fn parse_mis_samples(spec: &str) -> Result<(u32, u32)> {
-    let bad =
-        || anyhow::anyhow!("--mis-samples {spec}: expected two counts BSDF,LIGHT, each 1 to 64");
+    let bad = || {
+        anyhow::anyhow!(
+            "--mis-samples {spec}: expected two counts BSDF,LIGHT, each 1 to {MAX_MIS_SAMPLES}"
+        )
+    };
     let (a, b) = spec.split_once(',').ok_or_else(bad)?;
-    let a: u32 = a.trim().parse().map_err(|_| bad())?;
-    let b: u32 = b.trim().parse().map_err(|_| bad())?;
-    if !(1..=64).contains(&a) || !(1..=64).contains(&b) {
-        return Err(bad());
-    }
-    Ok((a, b))
+    Ok((
+        a.trim().parse().map_err(|_| bad())?,
+        b.trim().parse().map_err(|_| bad())?,
+    ))
 }
 
 pub fn parse_sequence(spec: &str) -> Result<Sequence> {
@@ -124,73 +126,33 @@ pub fn run(args: &EstimateArgs) -> Result<()> {
     let m = crate::common::load_material(&args.material)?;
     let wo = args.view.wo()?;
     let light = args.light.light()?;
-    if args.samples < 2 {
-        bail!(
-            "--samples {}: an estimate with a variance needs at least 2 samples",
-            args.samples
-        );
-    }
-    let mis_bsdf = match &args.mis_bsdf {
-        Some(name) => {
-            let s: BsdfStrategy = name.parse().map_err(|_| {
-                anyhow::anyhow!(
-                    "--mis-bsdf: unknown strategy `{name}`, expected one of: {}",
-                    BsdfStrategy::names()
-                )
-            })?;
-            m.check(s).map_err(|e| anyhow::anyhow!("--mis-bsdf: {e}"))?;
-            s
-        }
-        None => m.best_bsdf_strategy(),
+    let mis_samples = parse_mis_samples(&args.mis_samples)?;
+    let settings = EstimateSettings {
+        strategies: args.strategy.split(',').map(str::to_string).collect(),
+        mis_bsdf: args.mis_bsdf.clone(),
+        mis_samples,
+        samples: args.samples,
+        sequence: args.sequence.clone(),
+        seed: args.seed,
+        replicas: args.replicas,
     };
-    let (n_bsdf, n_light) = parse_mis_samples(&args.mis_samples)?;
-    let strategies = parse_strategies(&args.strategy, &m, mis_bsdf, n_bsdf, n_light)?;
-    let sequence = parse_sequence(&args.sequence)?;
-    if sequence != Sequence::Independent {
-        if args.replicas < 2 {
-            bail!(
-                "--replicas {}: a standard error from replicas needs at least 2 of them",
-                args.replicas
-            );
-        }
-        if args.samples < args.replicas {
-            bail!(
-                "--samples {}: under the {sequence} sequence the standard error comes from --replicas {} independently randomized replicas, so at least {} samples are needed",
-                args.samples,
-                args.replicas,
-                args.replicas
-            );
-        }
-    }
+    let flag = |s: Setting| match s {
+        Setting::Strategies => "--strategy",
+        Setting::MisBsdf => "--mis-bsdf",
+        Setting::MisSamples => "--mis-samples",
+        Setting::Samples => "--samples",
+        Setting::Sequence => "--sequence",
+        Setting::Replicas => "--replicas",
+    };
+    // Checked before the progress bar starts.
+    settings
+        .check(&m)
+        .map_err(|e| anyhow::anyhow!(e.named(flag)))?;
     let bar = Bar::new(args.quiet);
     let sp = args.light.shading_point(&light, wo)?;
-    let mut table = run_table_with(
-        &m,
-        &sp,
-        &light,
-        &strategies,
-        TableOptions {
-            settings: TableSettings {
-                sequence,
-                samples: args.samples,
-                seed: args.seed,
-            },
-            replicas: args.replicas,
-        },
-        &bar,
-        &SystemClock::new(),
-    )?;
+    let mut table = estimate_table(&m, &sp, &light, &settings, &bar, &SystemClock::new())
+        .map_err(|e| anyhow::anyhow!(e.named(flag)))?;
     bar.finish();
-    for row in &table.strategies {
-        if !row.mean.iter().chain(&row.stderr).all(|v| v.is_finite()) || !row.variance.is_finite() {
-            bail!(
-                "strategy {}: the estimate is not a finite number (mean {:?}, variance {})",
-                row.name,
-                row.mean,
-                row.variance
-            );
-        }
-    }
     crate::common::zero_exact_rows(&mut table);
     if args.json {
         println!("{}", serde_json::to_string(&table)?);

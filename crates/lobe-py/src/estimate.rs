@@ -1,13 +1,13 @@
 //! `lobe.estimate`: the table that `lobe estimate --json` prints, from the
-//! same library call ([`lobe::experiment::table::run_table_with`]), with the
+//! same library call ([`lobe::experiment::estimate::estimate_table`], which
+//! checks the settings as the CLI's), with the
 //! CLI's light syntax ([`lobe_render::light_spec`]) and strategy names.
 
 use glam::DVec3;
-use lobe::estimator::{ShadingPoint, Strategy};
-use lobe::experiment::table::{TableOptions, TableSettings, run_table_with};
+use lobe::estimator::ShadingPoint;
+use lobe::experiment::estimate::{EstimateSettings, Setting, estimate_table};
 use lobe::progress::SystemClock;
-use lobe::sequence::Sequence;
-use lobe::{BsdfStrategy, Frame, Light, Material};
+use lobe::{Frame, Light, Material};
 
 /// The settings of one call, as `lobe estimate`'s flags.
 #[derive(Debug, Clone)]
@@ -36,28 +36,6 @@ pub fn parse_light(spec: &str, frame: &Frame) -> Result<Light, String> {
     lobe_render::light_spec::parse_light("light", spec, frame).map(|p| p.light)
 }
 
-/// The techniques: `all` ([`lobe::strategy::ALL_MEANS`]) or names, each
-/// checked against the material ([`Strategy::parse_list`]).
-pub fn parse_strategies(
-    names: &[String],
-    m: &Material,
-    mis_bsdf: BsdfStrategy,
-    (n_bsdf, n_light): (u32, u32),
-) -> Result<Vec<Strategy>, String> {
-    let v = Strategy::parse_list(
-        names.iter().map(String::as_str),
-        m,
-        mis_bsdf,
-        n_bsdf,
-        n_light,
-    )
-    .map_err(|e| format!("strategies: {e}"))?;
-    if v.is_empty() {
-        return Err("strategies: the list is empty".into());
-    }
-    Ok(v)
-}
-
 /// Runs the table and returns it as the JSON text `lobe estimate --json`
 /// prints.
 pub fn estimate_json(m: &Material, a: &EstimateArgs) -> Result<String, String> {
@@ -83,12 +61,26 @@ pub fn estimate_json(m: &Material, a: &EstimateArgs) -> Result<String, String> {
             DVec3::new(r.sin(), 0.0, r.cos())
         }
     };
-    if a.samples < 2 {
-        return Err(format!(
-            "samples {}: an estimate with a variance needs at least 2 samples",
-            a.samples
-        ));
-    }
+    let settings = EstimateSettings {
+        strategies: a.strategies.clone(),
+        mis_bsdf: a.mis_bsdf.clone(),
+        mis_samples: a.mis_samples,
+        samples: a.samples,
+        sequence: a.sequence.clone(),
+        seed: a.seed,
+        replicas: a.replicas,
+    };
+    let keyword = |s: Setting| match s {
+        Setting::Strategies => "strategies",
+        Setting::MisBsdf => "mis_bsdf",
+        Setting::MisSamples => "mis_samples",
+        Setting::Samples => "samples",
+        Setting::Sequence => "sequence",
+        Setting::Replicas => "replicas",
+    };
+    // The settings are checked before the light is parsed (a map may take
+    // a while to load).
+    settings.check(m).map_err(|e| e.named(keyword))?;
     let frame = Frame::from_normal_tangent(a.normal, a.tangent).ok_or_else(|| {
         format!(
             "tangent {} is parallel to normal {} (or one is zero)",
@@ -96,56 +88,12 @@ pub fn estimate_json(m: &Material, a: &EstimateArgs) -> Result<String, String> {
         )
     })?;
     let light = parse_light(&a.light, &frame)?;
-    let mis_bsdf = match &a.mis_bsdf {
-        Some(name) => {
-            let s: BsdfStrategy = name.parse().map_err(|e| format!("mis_bsdf: {e}"))?;
-            m.check(s).map_err(|e| format!("mis_bsdf: {e}"))?;
-            s
-        }
-        None => m.best_bsdf_strategy(),
-    };
-    let (b, l) = a.mis_samples;
-    if !(1..=64).contains(&b) || !(1..=64).contains(&l) {
-        return Err(format!(
-            "mis_samples ({b}, {l}): expected two counts, each 1 to 64"
-        ));
-    }
-    let strategies = parse_strategies(&a.strategies, m, mis_bsdf, a.mis_samples)?;
-    let sequence: Sequence = a.sequence.parse().map_err(|_| {
-        format!(
-            "sequence: unknown sequence `{}`, expected independent, stratified or sobol",
-            a.sequence
-        )
-    })?;
     let sp = match light {
         Light::Env(_) => ShadingPoint { frame, wo },
         _ => ShadingPoint::local(wo),
     };
-    let table = run_table_with(
-        m,
-        &sp,
-        &light,
-        &strategies,
-        TableOptions {
-            settings: TableSettings {
-                sequence,
-                samples: a.samples,
-                seed: a.seed,
-            },
-            replicas: a.replicas,
-        },
-        &(),
-        &SystemClock::new(),
-    )
-    .map_err(|e| e.to_string())?;
-    for row in &table.strategies {
-        if !row.mean.iter().chain(&row.stderr).all(|v| v.is_finite()) || !row.variance.is_finite() {
-            return Err(format!(
-                "strategy {}: the estimate is not a finite number (mean {:?}, variance {})",
-                row.name, row.mean, row.variance
-            ));
-        }
-    }
+    let table = estimate_table(m, &sp, &light, &settings, &(), &SystemClock::new())
+        .map_err(|e| e.named(keyword))?;
     serde_json::to_string(&table).map_err(|e| e.to_string())
 }
 

@@ -2,7 +2,8 @@
 //! command line, as plain functions of plain values.
 //!
 //! * [`table`]: one shading point, every strategy, against a quadrature
-//!   reference (`lobe estimate`).
+//!   reference (`lobe estimate`); [`estimate`]: its settings, checked once
+//!   for every front end.
 //! * [`converge`]: RMSE against the number of samples, with fitted slopes
 //!   (`lobe converge`).
 //! * [`histogram`]: sample histograms and sample weights over the projected
@@ -23,6 +24,7 @@
 //! or without the feature and for any thread count.
 
 pub mod converge;
+pub mod estimate;
 pub mod histogram;
 pub mod polar;
 pub mod table;
