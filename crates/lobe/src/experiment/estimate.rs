@@ -52,7 +52,11 @@ pub struct SettingsError {
     pub setting: Option<Setting>,
     /// The value as given (empty where it says nothing more).
     pub value: String,
+    /// Why; where it names another setting, `{see}` stands for it
+    /// ([`SettingsError::see`], filled in by [`SettingsError::named`]).
     pub message: String,
+    /// The other setting the message names, with its value.
+    pub see: Option<(Setting, String)>,
 }
 
 impl SettingsError {
@@ -61,6 +65,7 @@ impl SettingsError {
             setting: Some(setting),
             value: value.to_string(),
             message: message.into(),
+            see: None,
         }
     }
 
@@ -68,10 +73,14 @@ impl SettingsError {
     /// spelling): `NAME VALUE: MESSAGE`, or `NAME: MESSAGE` without a value.
     #[must_use]
     pub fn named(&self, name: impl Fn(Setting) -> &'static str) -> String {
+        let message = match &self.see {
+            Some((s, v)) => self.message.replace("{see}", &format!("{} {v}", name(*s))),
+            None => self.message.clone(),
+        };
         match (self.setting, self.value.is_empty()) {
-            (Some(s), true) => format!("{}: {}", name(s), self.message),
-            (Some(s), false) => format!("{} {}: {}", name(s), self.value, self.message),
-            (None, _) => self.message.clone(),
+            (Some(s), true) => format!("{}: {message}", name(s)),
+            (Some(s), false) => format!("{} {}: {message}", name(s), self.value),
+            (None, _) => message,
         }
     }
 }
@@ -156,15 +165,18 @@ impl EstimateSettings {
                 ));
             }
             if self.samples < self.replicas {
-                return Err(SettingsError::new(
-                    Setting::Samples,
-                    self.samples,
-                    format!(
-                        "under the {sequence} sequence the standard error comes from {} \
-                         independently randomized replicas, so at least {} samples are needed",
-                        self.replicas, self.replicas
-                    ),
-                ));
+                return Err(SettingsError {
+                    see: Some((Setting::Replicas, self.replicas.to_string())),
+                    ..SettingsError::new(
+                        Setting::Samples,
+                        self.samples,
+                        format!(
+                            "under the {sequence} sequence the standard error comes from {{see}} \
+                             independently randomized replicas, so at least {} samples are needed",
+                            self.replicas
+                        ),
+                    )
+                });
             }
         }
         Ok(CheckedSettings {
@@ -205,12 +217,14 @@ pub fn estimate_table(
         setting: None,
         value: String::new(),
         message: e.to_string(),
+        see: None,
     })?;
     for row in &table.strategies {
         if !row.mean.iter().chain(&row.stderr).all(|v| v.is_finite()) || !row.variance.is_finite() {
             return Err(SettingsError {
                 setting: None,
                 value: String::new(),
+                see: None,
                 message: format!(
                     "strategy {}: the estimate is not a finite number (mean {:?}, variance {})",
                     row.name, row.mean, row.variance
@@ -292,5 +306,24 @@ mod tests {
             let text = e.named(|_| "SETTING");
             assert!(text.starts_with("SETTING"), "{text}");
         }
+        // A message that names another setting names it in the caller's words.
+        let e = EstimateSettings {
+            sequence: "sobol".into(),
+            samples: 8,
+            ..settings()
+        }
+        .check(&m)
+        .unwrap_err();
+        let text = e.named(|s| {
+            if s == Setting::Replicas {
+                "--replicas"
+            } else {
+                "--samples"
+            }
+        });
+        assert!(
+            text.starts_with("--samples 8: ") && text.contains("--replicas 16"),
+            "{text}"
+        );
     }
 }
