@@ -159,7 +159,11 @@ def estimate(
     balance heuristic or light sampling), ``mis-balance``, ``mis-power``,
     ``mis-one``, ``mis-power-one``). ``sequence``:
     ``independent``, ``stratified`` or ``sobol``. Each row's ``mean`` is the
-    estimate with the cosine included.
+    estimate with the cosine included; its ``stderr_reliable`` is false when
+    the sample's own tail says the standard error is not to be trusted
+    (``variance_rel_stderr``, the variance's estimated relative standard
+    error from the sample kurtosis, above 0.15: heavy-tailed weights, as
+    BSDF sampling under a sun; docs/statistics.md).
 
     >>> import lobe
     >>> t = lobe.estimate({"type": "phong", "exponent": 100}, theta=30, strategies=["uniform", "brdf"], samples=4096)

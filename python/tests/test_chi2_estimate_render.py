@@ -96,6 +96,7 @@ def test_estimate_returns_the_cli_table(lobe_exe):
     ref = t["reference"][0]
     for r in t["strategies"]:
         assert abs(r["mean"][0] - ref) < 6 * r["stderr"][0] + 1e-12
+        assert r["stderr_reliable"] is True and r["variance_rel_stderr"] < 0.15
     with pytest.raises(ValueError, match="does not apply"):
         lobe.estimate({"type": "phong"}, strategies=["vndf"], samples=100)
     with pytest.raises(ValueError, match="unknown light"):

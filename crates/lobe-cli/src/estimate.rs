@@ -225,6 +225,12 @@ fn print_table(t: &Table, model: &str, wo: DVec3) {
             unreliable = true;
             "unreliable".to_string()
         };
+        // `!`: the sample's own tail says the standard error is too small.
+        let se = if r.stderr_reliable {
+            rgb(r.stderr)
+        } else {
+            format!("{}!", rgb(r.stderr))
+        };
         let eff = r
             .efficiency
             .map_or("inf".to_string(), |x| format!("{x:.3e}"));
@@ -237,13 +243,31 @@ fn print_table(t: &Table, model: &str, wo: DVec3) {
             "{:<15} {:>26} {:>26} {:>10.2e} {:>11} {:>10} {:>8.3}s {:>11}",
             r.name,
             rgb(r.mean),
-            rgb(r.stderr),
+            se,
             r.relative_error,
             variance,
             red,
             r.time_s,
             eff
         );
+    }
+    if let Some(worst) = t
+        .strategies
+        .iter()
+        .filter(|r| !r.stderr_reliable)
+        .map(|r| r.variance_rel_stderr)
+        .max_by(f64::total_cmp)
+    {
+        if worst.is_nan() {
+            println!(
+                "\n!: fewer than 4 samples: the sample cannot tell whether its std. error is to be trusted (docs/statistics.md)"
+            );
+        } else {
+            println!(
+                "\n!: heavy-tailed weights: by the sample's kurtosis the variance's own relative std. error is {worst:.2} (above {}), so the std. error is likely too small and not to be trusted (docs/statistics.md)",
+                lobe::experiment::table::VARIANCE_REL_STDERR_MAX
+            );
+        }
     }
     println!("\n{}", legend(unreliable, exact));
 }

@@ -8,6 +8,8 @@ use crate::estimator::{Accumulator, Plan, ShadingPoint, Strategy};
 use crate::math::{Rgb, luminance};
 use crate::progress::{Clock, Progress, timed};
 use crate::sequence::{Sequence, replica_seed};
+use crate::stats::Moments;
+pub use crate::stats::ttest::VARIANCE_REL_STDERR_MAX;
 use crate::{Error, Light, Material};
 
 /// Relative tolerance of the quadrature reference of [`run_table`].
@@ -81,6 +83,18 @@ pub struct Row {
     /// sampled where the integrand lives, uniform sampling of a narrow lobe
     /// say, measures a variance far too small and misses the reference).
     pub variance_reliable: bool,
+    /// The estimated relative standard error of `variance`, from the
+    /// sample's kurtosis ([`Moments::variance_rel_stderr`]; over all the
+    /// samples, the replicas pooled): how much the variance leans on the
+    /// sample's few largest weights. NaN (`null` in JSON) with fewer than
+    /// four samples.
+    pub variance_rel_stderr: f64,
+    /// Whether the standard error is to be trusted as far as the sample
+    /// itself can tell: `variance_rel_stderr` is at most
+    /// [`VARIANCE_REL_STDERR_MAX`]. False under heavy-tailed weights (a
+    /// sun that the strategy seldom samples), where the standard error is
+    /// far too small and a `3σ` interval can miss the reference.
+    pub stderr_reliable: bool,
     /// The exact variance of uniform sampling ([`Table::uniform_variance`])
     /// over this one; `None` when this one is zero, or either variance is
     /// unreliable.
@@ -221,12 +235,13 @@ pub fn run_table_with(
                         seed,
                     };
                     let acc = estimate_chunked(m, sp, light, &plan, progress)?;
-                    (acc.mean(), acc.std_error(), acc.lum.variance())
+                    (acc.mean(), acc.std_error(), acc.lum)
                 }
                 Some(r) => replicated(m, sp, light, s, options.settings, r, progress)?,
             })
         });
-        let (mean, stderr, variance) = result?;
+        let (mean, stderr, lum) = result?;
+        let variance = lum.variance();
         let relative_error = if r_lum != 0.0 {
             (luminance(mean) - r_lum).abs() / r_lum.abs()
         } else {
@@ -243,6 +258,8 @@ pub fn run_table_with(
             relative_error,
             variance,
             variance_reliable,
+            variance_rel_stderr: lum.variance_rel_stderr(),
+            stderr_reliable: lum.stderr_reliable(),
             variance_reduction: (variance > 0.0 && exact_uniform.reliable && variance_reliable)
                 .then(|| exact_uniform.variance / variance),
             time_s,
@@ -264,7 +281,7 @@ pub fn run_table_with(
     })
 }
 
-/// `(mean, standard error, per-sample luminance variance)` of `s` from `r`
+/// `(mean, standard error, moments of the luminance of all the samples)` of `s` from `r`
 /// independently randomized replicas of the settings' sequence: the mean of
 /// the replica means and the spread of those means (see [`run_table_with`]).
 fn replicated(
@@ -275,7 +292,7 @@ fn replicated(
     settings: TableSettings,
     r: usize,
     progress: &dyn Progress,
-) -> Result<(Rgb, Rgb, f64), Error> {
+) -> Result<(Rgb, Rgb, Moments), Error> {
     let (base, extra) = (settings.samples / r, settings.samples % r);
     let parts = map_indices(r, |k| {
         let plan = Plan {
@@ -299,7 +316,7 @@ fn replicated(
         .iter()
         .fold(Rgb::ZERO, |a, &b| a + (b - mean) * (b - mean));
     let stderr = (ss / (rf * (rf - 1.0))).powf(0.5);
-    Ok((mean, stderr, all.lum.variance()))
+    Ok((mean, stderr, all.lum))
 }
 
 #[cfg(test)]
@@ -622,5 +639,70 @@ mod tests {
         assert!(v.variance_reliable, "{v:?}");
         let r = v.variance_reduction.unwrap();
         assert!(r > 1e6 && r.is_finite(), "{v:?}");
+    }
+
+    /// Under the built-in sky's sun, strategies that seldom sample the sun
+    /// have heavy-tailed weights: their rows are flagged, from the sample
+    /// alone (at several seeds); light sampling, which draws the sun, and
+    /// smooth cases (Lambert and GGX in the furnace) are not.
+    #[test]
+    fn heavy_tails_under_a_sun_flag_the_standard_error() {
+        use crate::Frame;
+        use std::sync::Arc;
+        let sky = Light::Env(Arc::new(crate::envmap::EnvMap::sky(256, 128, 35.0, 40.0)));
+        let ggx = crate::models::CookTorrance::new(
+            Rgb::ONE,
+            crate::Microfacet::new(crate::Ndf::Ggx, 0.3, 0.3).unwrap(),
+            crate::Shadowing::SmithCorrelated,
+            crate::Fresnel::None,
+        )
+        .unwrap();
+        let ggx = Material::with_diffuse(Rgb::ZERO, crate::Glossy::CookTorrance(ggx)).unwrap();
+        let lambert = Material::lambert(Rgb::splat(0.8)).unwrap();
+        let wo = DVec3::new(0.5, 0.0, 0.75f64.sqrt());
+        let up = ShadingPoint {
+            frame: Frame::from_normal_tangent(DVec3::Y, DVec3::X).unwrap(),
+            wo,
+        };
+        let bsdf = |s| Strategy::Bsdf(s);
+        let run = |m: &Material, sp: &ShadingPoint, light: &Light, s: &[Strategy], seed| {
+            let settings = TableSettings {
+                sequence: Sequence::Independent,
+                samples: 65_536,
+                seed,
+            };
+            run_table(m, sp, light, s, settings, &(), &Ticks(Mutex::new(0))).unwrap()
+        };
+        for seed in 1..=3 {
+            for (m, s) in [
+                (&lambert, [BsdfStrategy::Cosine, BsdfStrategy::Uniform]),
+                (&ggx, [BsdfStrategy::Vndf, BsdfStrategy::SphericalCaps]),
+            ] {
+                let t = run(
+                    m,
+                    &up,
+                    &sky,
+                    &[bsdf(s[0]), bsdf(s[1]), Strategy::Light],
+                    seed,
+                );
+                for r in &t.strategies[..2] {
+                    assert!(!r.stderr_reliable, "{seed} {}: {r:?}", r.name);
+                }
+                assert!(t.strategies[2].stderr_reliable, "{seed}: {t:?}");
+            }
+            let furnace = Light::Constant(Rgb::ONE);
+            let sp = ShadingPoint::local(wo);
+            for m in [&lambert, &ggx] {
+                let all: Vec<Strategy> = BsdfStrategy::ALL
+                    .iter()
+                    .filter(|&&s| m.check(s).is_ok())
+                    .map(|&s| bsdf(s))
+                    .collect();
+                let t = run(m, &sp, &furnace, &all, seed);
+                for r in &t.strategies {
+                    assert!(r.stderr_reliable, "{seed} {}: {r:?}", r.name);
+                }
+            }
+        }
     }
 }
