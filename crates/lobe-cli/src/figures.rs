@@ -80,8 +80,10 @@ pub fn convergence_plot(path: &Path, title: &str, series: &[Series]) -> Result<(
 
 /// Draws curves in the plane of incidence on one polar plot: the upper half
 /// disk, the angle θi measured from the normal (straight up), negative
-/// angles on the viewer's side (left), positive on the mirror side (right),
-/// with a ray toward the viewer at θi = −θo. Every curve is drawn on the
+/// angles on the mirror side (left), positive on the viewer's side (right),
+/// with a ray toward the viewer at θi = +θo: each direction on the side of
+/// its own `x`, as in the warp-test histogram and the weight heat map
+/// ([`lobe::experiment::polar::figure_xy`]). Every curve is drawn on the
 /// same radial scale (`scale`), so that a pdf can be read against the
 /// integrand `f·cos θi / albedo` (cosine included): where the pdf lies
 /// inside the integrand, samples are rare and their weights large. The
@@ -1027,7 +1029,7 @@ impl Figure for Polar<'_> {
         let y_hi = y_lo + f64::from(ah) / s;
         let mut chart = ChartBuilder::on(&area).build_cartesian_2d(-half_w..half_w, y_lo..y_hi)?;
 
-        let polar = |t: f64, r: f64| (r * t.sin(), r * t.cos());
+        let polar = lobe::experiment::polar::figure_xy;
         // Rings, rays and their labels.
         for (i, r) in [0.25, 0.5, 0.75, 1.0].into_iter().enumerate() {
             let ring: Vec<(f64, f64)> = (0..=180)
@@ -1079,26 +1081,26 @@ impl Figure for Polar<'_> {
         ))?;
         chart.draw_series([
             Text::new(
-                "viewer's side (θi < 0)",
+                "mirror side (θi < 0)",
                 (-0.55, -0.03),
                 text_style(13.0, DIM_TEXT, HPos::Center, VPos::Top),
             ),
             Text::new(
-                "mirror side (θi > 0)",
+                "viewer's side (θi > 0)",
                 (0.55, -0.03),
                 text_style(13.0, DIM_TEXT, HPos::Center, VPos::Top),
             ),
         ])?;
         // The ray toward the viewer.
         let theta_o = self.curves.wo.z.clamp(-1.0, 1.0).acos();
-        let view = polar(-theta_o, 1.0);
+        let view = polar(theta_o, 1.0);
         chart.draw_series(DashedLineSeries::new(
             [(0.0, 0.0), view],
             6,
             4,
             RGBColor(90, 90, 90).stroke_width(1),
         ))?;
-        let (vx, vy) = polar(-theta_o, 0.62);
+        let (vx, vy) = polar(theta_o, 0.62);
         chart.draw_series(std::iter::once(Text::new(
             "wo",
             (vx + 0.02, vy),

@@ -1206,7 +1206,7 @@ fn section(h: &mut String, model: &Model, r: &ModelResult, st: &ReportSizes) {
          divided by its integral (the ideal density, which would give zero variance) and the density \
          of each strategy, all in 1/sr on one logarithmic radial scale (four decades below the largest \
          value; the legend gives each curve's peak), so that the curves compare directly. The \
-         viewer is on the left, the mirror direction on the right. A good sampler has the shape of \
+         viewer is on the right, the mirror direction on the left, as in the histograms and weight maps. A good sampler has the shape of \
          the integrand: where its density is much lower than the integrand, the rare samples that \
          land there carry huge weights — the fireflies of a render. Uniform and cosine sampling \
          spread their samples over the whole hemisphere while the integrand lives in a narrow lobe.",

@@ -3,10 +3,14 @@
 //!
 //! The plane of incidence holds the normal (`+z`) and `wo`; a direction in
 //! it is given by its signed angle `θi ∈ [−π/2, π/2]` from the normal,
-//! negative on the viewer's side: `wi = (−sin θi cos φo, −sin θi sin φo,
+//! positive on the viewer's side: `wi = (sin θi cos φo, sin θi sin φo,
 //! cos θi)` where `φo` is the azimuth of `wo` (0 when `wo` is the normal).
-//! So with `wo = (sin θo, 0, cos θo)` the viewer is at `θi = −θo` and the
-//! mirror direction at `θi = +θo`.
+//! So with `wo = (sin θo, 0, cos θo)` the viewer is at `θi = +θo` and the
+//! mirror direction at `θi = −θo`, and `sin θi` is the direction's `x`:
+//! the figures draw a point at [`figure_xy`], the viewer on the right and
+//! the mirror side on the left, as the projected-hemisphere maps (the
+//! warp-test histogram, the weight heat map, `x` to the right) and the
+//! fit's incidence-plane plot ([`crate::fit::incidence_plane`]) do.
 //!
 //! Two kinds of curve share one unit, 1/sr, so they can be drawn over the
 //! same axes: the integrand of the furnace estimate divided by its integral,
@@ -96,6 +100,16 @@ pub fn angles(steps: usize) -> Vec<f64> {
         .collect()
 }
 
+/// Where a polar figure draws the point at signed angle `theta_i` (radians)
+/// and radius `r`: `(r sin θi, r cos θi)`, `x` to the right and the normal
+/// up, so that a direction lies on the side of its own `x` in the
+/// projected-hemisphere maps (for `wo` of azimuth 0): the mirror side on
+/// the left, the viewer on the right.
+#[must_use]
+pub fn figure_xy(theta_i: f64, r: f64) -> (f64, f64) {
+    (r * theta_i.sin(), r * theta_i.cos())
+}
+
 /// The unit direction at signed angle `theta_i` (radians) in the plane of
 /// incidence of `wo` (see the module documentation).
 #[must_use]
@@ -108,7 +122,7 @@ pub fn plane_direction(wo: DVec3, theta_i: f64) -> DVec3 {
         (1.0, 0.0)
     };
     let s = theta_i.sin();
-    DVec3::new(-s * cx, -s * cy, theta_i.cos()).normalize()
+    DVec3::new(s * cx, s * cy, theta_i.cos()).normalize()
 }
 
 /// The directional albedo `∫ f cos θi dω` at `wo` (luminance; the cosine is
@@ -195,7 +209,7 @@ pub fn default_strategies(m: &Material) -> Vec<BsdfStrategy> {
 }
 
 /// `2π ∫ v(θ) sin θ dθ` over `θ ∈ [0, π/2]` from the curve's points on one
-/// side (`side = 1.0` the mirror side, `−1.0` the viewer's side), by the
+/// side (`side = 1.0` the viewer's side, `−1.0` the mirror side), by the
 /// trapezoidal rule: the integral over the hemisphere of a curve that does
 /// not depend on the azimuth (any curve at `wo = +z` of an isotropic
 /// material, or uniform and cosine sampling).
@@ -293,12 +307,12 @@ mod tests {
             .copied()
             .fold((0.0, 0.0), |a, p| if p.1 > a.1 { p } else { a });
         assert!(
-            (t.to_degrees() - 50.0).abs() < 5.0,
+            (t.to_degrees() + 50.0).abs() < 5.0,
             "peak at {}°",
             t.to_degrees()
         );
-        // The plane of incidence holds wo at −θo.
-        let v = plane_direction(wo, -50f64.to_radians());
+        // The plane of incidence holds wo at +θo.
+        let v = plane_direction(wo, 50f64.to_radians());
         assert!((v - wo).length() < 1e-12, "{v} vs {wo}");
         let lambert = Material::lambert(Rgb::splat(0.5)).unwrap();
         assert!(curves(&lambert, wo, &[BsdfStrategy::Vndf], 10).is_err());
@@ -312,5 +326,54 @@ mod tests {
                 BsdfStrategy::BoundedVndf
             ]
         );
+    }
+
+    /// Issue 41: the polar figure and the warp-test histogram put the
+    /// mirror side on the same side. For a sharp Phong lobe at θo = 45°
+    /// (wo toward +x), the polar curve's peak is drawn at negative x, and
+    /// the histogram's fullest column is at negative x; the viewer's
+    /// direction is drawn at positive x, its own.
+    #[cfg(feature = "desc")]
+    #[test]
+    fn the_polar_figure_and_the_histogram_agree_in_orientation() {
+        let m = crate::MaterialDesc::from_json(r#"{"type":"phong","exponent":200}"#)
+            .unwrap()
+            .build()
+            .unwrap();
+        let wo = wo_from_theta(45.0, 0.0);
+        assert!(wo.x > 0.0);
+        let c = curves(&m, wo, &[BsdfStrategy::Brdf], 720).unwrap();
+        for curve in c.all() {
+            let (t, _) = curve
+                .points
+                .iter()
+                .copied()
+                .fold((0.0, 0.0), |a, p| if p.1 > a.1 { p } else { a });
+            let (x, _) = figure_xy(t, 1.0);
+            // Drawn where the direction's own x is.
+            assert!((x - plane_direction(wo, t).x).abs() < 1e-12);
+            assert!(
+                x < -0.6,
+                "{}: peak at θi {}°, x {x}",
+                curve.label(),
+                t.to_degrees()
+            );
+        }
+        assert!((figure_xy(45f64.to_radians(), 1.0).0 - wo.x).abs() < 1e-12);
+        let res = 32;
+        let h = crate::experiment::histogram::projected_histograms(
+            &m.sampler(BsdfStrategy::Brdf).unwrap(),
+            wo,
+            100_000,
+            1,
+            res,
+            &(),
+        );
+        let column = |i: usize| (0..res).map(|j| h.observed[j * res + i]).sum::<f64>();
+        let fullest = (0..res)
+            .max_by(|&a, &b| column(a).total_cmp(&column(b)))
+            .unwrap();
+        let x = (fullest as f64 + 0.5) / res as f64 * 2.0 - 1.0;
+        assert!(x < -0.6, "the histogram's fullest column is at x {x}");
     }
 }
