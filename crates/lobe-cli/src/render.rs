@@ -112,6 +112,11 @@ Scene file (TOML; unknown keys are errors; paths are relative to the scene file)
 
   [environment]
   path = \"forest.hdr\"  # .hdr or .exr (equirectangular, +Y up), or \"sky\"
+  # or, instead of path, the built-in sky with its sun placed, in degrees
+  # (as --light sky:E:A takes them: elevation in [0, 90] above the horizon,
+  # azimuth 0 toward -Z; a key left out takes the built-in sky's 35 and 40,
+  # as path = \"sky\" does):
+  # sky = { sun_elevation = 20, sun_azimuth = 120 }
   scale = 1.0          # default 1
   rotation_y = 0.0     # degrees about +Y; default 0
 

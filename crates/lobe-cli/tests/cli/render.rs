@@ -581,3 +581,49 @@ fn an_interrupted_render_writes_the_passes_it_finished() {
         assert!(!d.join(format!("whole.{ext}")).exists(), "{ext}");
     }
 }
+
+/// Issue 41: a scene places the built-in sky's sun with
+/// `[environment] sky = { sun_elevation, sun_azimuth }`: the same image as
+/// the default sky when the keys are the defaults, another one elsewhere,
+/// and one line naming the file, the line and the key for a bad value.
+#[test]
+fn a_scene_places_the_skys_sun() {
+    let d = dir("sky-keys");
+    let render = |name: &str, environment: &str| {
+        let scene = d.join(format!("{name}.toml"));
+        let text = test_scene().replace("path = \"sky\"", environment);
+        std::fs::write(&scene, text).unwrap();
+        let out = d.join(name);
+        let o = lobe(
+            &[
+                "render",
+                scene.to_str().unwrap(),
+                "--spp",
+                "2",
+                "--out",
+                out.to_str().unwrap(),
+                "--quiet",
+            ],
+            None,
+        );
+        (o, out.with_extension("exr"), scene)
+    };
+    let read = |p: &Path| std::fs::read(p).unwrap();
+    let (o, plain, _) = render("plain", "path = \"sky\"");
+    assert!(o.status.success(), "{o:?}");
+    let (o, defaults, _) = render("defaults", "sky = { sun_elevation = 35, sun_azimuth = 40 }");
+    assert!(o.status.success(), "{o:?}");
+    assert_eq!(read(&plain), read(&defaults));
+    let (o, low, _) = render("low", "sky = { sun_elevation = 5, sun_azimuth = 120 }");
+    assert!(o.status.success(), "{o:?}");
+    assert_ne!(read(&plain), read(&low));
+    let (o, _, scene) = render("bad", "sky = { sun_elevation = 91, sun_azimuth = 120 }");
+    let e = one_line_error(&o);
+    assert!(
+        e.contains(&format!(
+            "{}:10:25: field environment.sky.sun_elevation: 91 is out of range",
+            scene.display()
+        )),
+        "{e}"
+    );
+}
