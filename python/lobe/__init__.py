@@ -27,14 +27,24 @@ True
 
 from __future__ import annotations
 
-import json
-import os
-from collections.abc import Mapping
-from typing import Any, Sequence
+# The modules lobe uses under private names, and the typing names for the
+# annotations (strings here) only where a type checker reads them: ``dir(lobe)``
+# shows lobe's own names (``__dir__`` below).
+import json as _json
+import os as _os
+from collections.abc import Mapping as _Mapping
+import typing as _typing
 
-import numpy as np
+import numpy as _np
 
 from . import _lobe
+
+if _typing.TYPE_CHECKING:
+    import os
+    from collections.abc import Mapping
+    from typing import Any, Sequence
+
+    import numpy as np
 from ._lobe import (
     Material,
     SampleResult,
@@ -63,24 +73,34 @@ __all__ = [
     "chi2",
 ]
 
+#: The package's version: the Rust crates' (the workspace's ``version``),
+#: as the compiled module was built with it.
+__version__: str = _lobe.__version__
+
+
+def __dir__() -> list[str]:
+    """lobe's own names: ``__all__`` and the module's dunders (not the
+    modules it imports)."""
+    return sorted(set(__all__) | {n for n in globals() if n.startswith("__") and n.endswith("__")})
+
 
 def _jsonable(x: Any) -> Any:
-    if isinstance(x, np.generic):
+    if isinstance(x, _np.generic):
         return x.item()
-    if isinstance(x, np.ndarray):
+    if isinstance(x, _np.ndarray):
         return x.tolist()
     raise ValueError(f"material: {x!r} ({type(x).__name__}) is not a number, string, list or dict")
 
 
 def _check_finite(v: Any, path: str) -> None:
     """Non-finite numbers are not JSON: name the field instead."""
-    if isinstance(v, Mapping):
+    if isinstance(v, _Mapping):
         for k, x in v.items():
             _check_finite(x, f"{path}.{k}" if path else str(k))
-    elif isinstance(v, (list, tuple, np.ndarray)):
-        for x in (v.tolist() if isinstance(v, np.ndarray) else v):
+    elif isinstance(v, (list, tuple, _np.ndarray)):
+        for x in (v.tolist() if isinstance(v, _np.ndarray) else v):
             _check_finite(x, path)
-    elif isinstance(v, (float, np.floating)) and not np.isfinite(v):
+    elif isinstance(v, (float, _np.floating)) and not _np.isfinite(v):
         raise ValueError(f"material: field `{path}`: {v} is not a finite number")
 
 
@@ -119,10 +139,10 @@ def load_dict(desc: Mapping[str, Any]) -> Material:
     ...
     ValueError: material: field `exponnt`: unknown field `exponnt`, expected one of `type`, ...
     """
-    if not isinstance(desc, Mapping):
+    if not isinstance(desc, _Mapping):
         raise TypeError(f"load_dict: expected a dict, got {type(desc).__name__}")
     _check_finite(desc, "")
-    return _lobe._load_json(json.dumps(dict(desc), default=_jsonable))
+    return _lobe._load_json(_json.dumps(dict(desc), default=_jsonable))
 
 
 def _material(m: Material | Mapping[str, Any]) -> Material:
@@ -186,7 +206,7 @@ def estimate(
         m, None if wo is None else [float(x) for x in wo], None if theta is None else float(theta), str(light), list(normal), list(tangent), names, int(samples),
         str(sequence), int(seed), int(replicas), mis_bsdf, ms,
     )
-    return json.loads(text)
+    return _json.loads(text)
 
 
 def render(
@@ -222,11 +242,11 @@ def render(
     >>> img.shape, str(img.dtype)
     ((6, 8, 3), 'float32')
     """
-    if isinstance(scene, Mapping):
-        text = _lobe._json_to_toml(json.dumps(dict(scene), default=_jsonable))
-        path = os.path.join(os.getcwd(), "<dict>.toml")
+    if isinstance(scene, _Mapping):
+        text = _lobe._json_to_toml(_json.dumps(dict(scene), default=_jsonable))
+        path = _os.path.join(_os.getcwd(), "<dict>.toml")
     else:
-        path = os.fspath(scene)
+        path = _os.fspath(scene)
         try:
             with open(path, encoding="utf-8") as f:
                 text = f.read()

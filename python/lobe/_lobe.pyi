@@ -17,11 +17,13 @@ _Floats = npt.NDArray[np.floating[Any]]
 __all__ = [
     "BLOCK", "Material", "SampleResult", "_chi2_test", "_chi2_uniforms", "_estimate_json", "_json_to_toml",
     "_load_json", "_render", "cache_info", "clear_cache", "get_threads", "set_cache_limit", "set_threads", "sidak",
-    "simd_level",
+    "simd_level", "__version__",
 ]
 
 BLOCK: int
 """Rows per block of the array calls (the unit of the thread split)."""
+__version__: str
+"""The package's version: the Rust workspace's."""
 
 @final
 class SampleResult:
@@ -84,7 +86,9 @@ class Material:
     def batched(self, strategy: Optional[str] = None) -> bool:
         """Whether ``strategy`` runs on the batch SIMD kernels (else the scalar f64 path)."""
     def chooses_lobe(self, strategy: Optional[str] = None) -> bool:
-        """Whether ``strategy`` chooses between two lobes with ``uc``."""
+        """A method (call it: ``m.chooses_lobe("vndf")``): whether ``strategy``
+        (default: vndf where it applies, else brdf) chooses between the
+        material's two lobes with ``uc``, which ``sample`` then requires."""
     @property
     def model(self) -> str:
         """The model's short name (lambert, phong, blinn-phong, cook-torrance, measured)."""

@@ -463,6 +463,19 @@ pub fn prepare_output_files(flag: &str, files: &[PathBuf]) -> Result<()> {
     Ok(())
 }
 
+/// An error that ends the program with `status` and no message of its own
+/// (the command said what happened): `main` exits with it.
+#[derive(Debug)]
+pub struct ExitStatus(pub u8);
+
+impl std::fmt::Display for ExitStatus {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "exit status {}", self.0)
+    }
+}
+
+impl std::error::Error for ExitStatus {}
+
 /// The SIMD level `LOBE_SIMD` asks for, checked before any work: an unknown
 /// name or a level this CPU lacks is an error naming the variable (not a
 /// note of a fallback deep in the render).

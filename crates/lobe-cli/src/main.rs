@@ -77,6 +77,7 @@ fn main() -> ExitCode {
     });
     match result {
         Ok(()) => ExitCode::SUCCESS,
+        Err(ref e) if let Some(s) = e.downcast_ref::<common::ExitStatus>() => ExitCode::from(s.0),
         Err(e) => {
             // One line, whatever the message holds.
             let message = format!("{e:#}");

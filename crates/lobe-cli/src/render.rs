@@ -6,10 +6,12 @@ use clap::Args;
 use lobe::estimator::Strategy;
 use lobe_render::SppAllocation;
 use lobe_render::integrator::{
-    MAX_SPP_FACTOR, RenderLoop, batch_refusal, max_pixel_spp, render_progressive,
+    MAX_SPP_FACTOR, RenderLoop, batch_refusal, max_pixel_spp, render_until,
 };
-use lobe_render::{fallbacks, load_scene, render};
+use lobe_render::{fallbacks, load_scene};
 use std::path::PathBuf;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::time::Instant;
 
 /// The arguments of `lobe render`.
@@ -32,7 +34,12 @@ use std::time::Instant;
                   among the pixels by their noise, as a pilot estimates it (--spp-allocation \
                   variance, the default; the same total; NAME.spp.png shows where they went): the \
                   fastest way to a clean image where a few pixels (a highlight, an edge) hold most \
-                  of the noise; --spp-allocation uniform gives every pixel --spp.",
+                  of the noise; --spp-allocation uniform gives every pixel --spp.\n\n\
+                  Ctrl-C (SIGINT) or SIGTERM stops the render at the next row: the passes \
+                  finished so far are written (a --time render's; the spp done in the EXR's \
+                  `spp` attribute and on stderr) and lobe exits with 130 (SIGINT) or 143 \
+                  (SIGTERM); if no pass finished (a render without --time is one pass), nothing \
+                  is written. A second Ctrl-C ends lobe at once.",
     after_help = "Example:\n  lobe render examples/scene.toml --spp 16 --strategy mis-power --out preview",
     after_long_help = SCENE_HELP
 )]
@@ -105,6 +112,11 @@ Scene file (TOML; unknown keys are errors; paths are relative to the scene file)
 
   [environment]
   path = \"forest.hdr\"  # .hdr or .exr (equirectangular, +Y up), or \"sky\"
+  # or, instead of path, the built-in sky with its sun placed, in degrees
+  # (as --light sky:E:A takes them: elevation in [0, 90] above the horizon,
+  # azimuth 0 toward -Z; a key left out takes the built-in sky's 35 and 40,
+  # as path = \"sky\" does):
+  # sky = { sun_elevation = 20, sun_azimuth = 120 }
   scale = 1.0          # default 1
   rotation_y = 0.0     # degrees about +Y; default 0
 
@@ -247,13 +259,32 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         "{msg:>12} [{wide_bar}] {human_pos}/{human_len} samples, {per_sec}, {elapsed}<{eta_left}"
     };
     pb.set_style(crate::common::progress_style(template));
+    let interrupt = Interrupt::catch()?;
     let t0 = Instant::now();
-    let image = match budget {
-        None => render(&scene, &opts, |n| pb.inc(n)),
-        Some(b) => render_progressive(&scene, &opts, b, u64::MAX, |n| pb.inc(n)),
-    };
+    // Without --time, one pass of --spp; with it, passes until the time is
+    // up. Either stops at the next row on a signal.
+    let max_passes = if budget.is_some() { u64::MAX } else { 1 };
+    let image = render_until(&scene, &opts, budget, max_passes, &interrupt.stop, |n| {
+        pb.inc(n)
+    });
     let secs = t0.elapsed().as_secs_f64();
     pb.finish_and_clear();
+    let signal = interrupt.signal();
+    let Some(image) = image else {
+        let (name, status) = signal.expect("only a signal stops a render before its first pass");
+        eprintln!(
+            "lobe: interrupted ({name}) after {secs:.1} s, before the first pass{} finished: nothing written",
+            if budget.is_some() {
+                format!(" of {} spp", opts.spp)
+            } else {
+                format!(
+                    " (the whole render, {} spp; --time renders in passes)",
+                    opts.spp
+                )
+            }
+        );
+        return Err(crate::common::ExitStatus(status).into());
+    };
     if image.stats.nonfinite > 0 {
         eprintln!(
             "lobe: warning: {} path samples were not finite numbers and counted as 0",
@@ -265,6 +296,14 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     // Where the samples went, when the variance allocation placed them.
     let spp_png = crate::common::with_ext(&base, "spp.png");
     // The three files written at once on the pool's threads.
+    let passes = image.stats.passes.max(1);
+    let note = signal.map(|(name, _)| {
+        format!(
+            "interrupted ({name}) after {passes} passes of {} spp: {} spp",
+            opts.spp,
+            passes * opts.spp
+        )
+    });
     let (png_written, (spp_written, exr_written)) = rayon::join(
         || {
             image.write_png(
@@ -274,13 +313,17 @@ pub fn run(args: &RenderArgs) -> Result<()> {
                 },
             )
         },
-        || rayon::join(|| image.write_spp_png(&spp_png), || image.write_exr(&exr)),
+        || {
+            rayon::join(
+                || image.write_spp_png(&spp_png),
+                || image.write_exr_noted(&exr, note.as_deref()),
+            )
+        },
     );
     exr_written?;
     png_written?;
     let wrote_spp = spp_written?;
     let samples = image.stats.camera_rays as f64;
-    let passes = image.stats.passes.max(1);
     let spp = if budget.is_some() {
         format!(
             "{} spp ({passes} passes of {})",
@@ -310,6 +353,30 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     } else {
         format!("{} and {}", exr.display(), png.display())
     };
+    if let Some((name, status)) = signal {
+        // (The spp a pixel got on average: the variance allocation keeps
+        // the total.)
+        eprintln!(
+            "lobe: interrupted ({name}) after {passes}{} passes ({} spp{}{}) in {secs:.1} s{}; wrote {written}",
+            if budget.is_some() { "" } else { " of 1" },
+            passes * opts.spp,
+            if image.spp.is_some() {
+                " on average"
+            } else {
+                ""
+            },
+            if budget.is_some() {
+                format!(", {} a pass", opts.spp)
+            } else {
+                String::new()
+            },
+            match budget {
+                Some(b) => format!(" of --time {}", b.as_secs_f64()),
+                None => String::new(),
+            },
+        );
+        return Err(crate::common::ExitStatus(status).into());
+    }
     println!(
         "wrote {written} ({w}x{h}, {spp}, {}, {}, max_depth {}): {:.2} s, {:.2} M samples/s, {:.2} M rays/s",
         opts.sequence,
@@ -320,4 +387,43 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         image.stats.rays as f64 / secs.max(1e-9) / 1e6
     );
     Ok(())
+}
+
+/// SIGINT and SIGTERM during a render: the first sets `stop`, which the
+/// render reads at every row (and records which signal it was); a second
+/// one ends the process at once with 128 + its number, as a shell expects.
+/// The handlers stay until the process exits.
+struct Interrupt {
+    stop: Arc<AtomicBool>,
+    /// The first signal's number (0: none).
+    which: Arc<AtomicUsize>,
+}
+
+impl Interrupt {
+    fn catch() -> Result<Self> {
+        use signal_hook::consts::{SIGINT, SIGTERM};
+        use signal_hook::flag;
+        let stop = Arc::new(AtomicBool::new(false));
+        let which = Arc::new(AtomicUsize::new(0));
+        for sig in [SIGINT, SIGTERM] {
+            let err = |e| anyhow!("cannot catch signal {sig}: {e}");
+            // In this order: a signal that finds `stop` set already exits;
+            // else it records itself and sets `stop`.
+            flag::register_conditional_shutdown(sig, 128 + sig, Arc::clone(&stop)).map_err(err)?;
+            flag::register_usize(sig, Arc::clone(&which), sig as usize).map_err(err)?;
+            flag::register(sig, Arc::clone(&stop)).map_err(err)?;
+        }
+        Ok(Interrupt { stop, which })
+    }
+
+    /// The signal that stopped the render, by name, and the exit status it
+    /// asks for (128 + its number); `None` when none came.
+    fn signal(&self) -> Option<(&'static str, u8)> {
+        if !self.stop.load(Ordering::SeqCst) {
+            return None;
+        }
+        let sig = self.which.load(Ordering::SeqCst) as i32;
+        let name = signal_hook::low_level::signal_name(sig).unwrap_or("a signal");
+        Some((name, u8::try_from(128 + sig).unwrap_or(1)))
+    }
 }

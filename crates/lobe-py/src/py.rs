@@ -617,7 +617,9 @@ impl PyMaterial {
         Ok(lobe::batch::BatchSampler::new(&self.m, st).is_ok())
     }
 
-    /// Whether `strategy` chooses between two lobes with `uc`.
+    /// A method (call it: `m.chooses_lobe("vndf")`): whether `strategy`
+    /// (default: vndf where it applies, else brdf) chooses between the
+    /// material's two lobes with `uc`, which `sample` then requires.
     /// Conventions: local frame (+z the normal), wo toward the viewer, wi
     /// toward the light, f without the cosine, weight = f·cos θi / pdf.
     #[pyo3(signature = (strategy = None))]
@@ -802,7 +804,8 @@ fn _estimate_json(
         mis_bsdf,
         mis_samples,
     };
-    let m = material.m;
+    // (A clone: the material holds its measured table by reference count.)
+    let m = material.m.clone();
     py.detach(|| crate::estimate::estimate_json(&m, &a))
         .map_err(value_error)
 }
@@ -960,5 +963,7 @@ fn _lobe(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(_chi2_test, m)?)?;
     m.add_function(wrap_pyfunction!(sidak, m)?)?;
     m.add("BLOCK", engine::BLOCK)?;
+    // The package's version (`lobe.__version__`): the workspace's.
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

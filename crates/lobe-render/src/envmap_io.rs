@@ -25,6 +25,40 @@ pub enum LoadError {
 /// The built-in sky's resolution and sun.
 pub const SKY: (usize, usize, f64, f64) = (512, 256, 35.0, 40.0);
 
+/// Whether `degrees` is a sun elevation the built-in sky takes: a finite
+/// number in [0, 90] (`--light sky:E:A` and a scene's
+/// `sky.sun_elevation` alike).
+#[must_use]
+pub fn sun_elevation_ok(degrees: f64) -> bool {
+    (0.0..=90.0).contains(&degrees)
+}
+
+/// Whether `degrees` is a sun azimuth the built-in sky takes: any finite
+/// number (0 is −Z).
+#[must_use]
+pub fn sun_azimuth_ok(degrees: f64) -> bool {
+    degrees.is_finite()
+}
+
+/// The built-in sky ([`SKY`]'s resolution) with its sun at `elevation` and
+/// `azimuth` degrees, times `scale`, rotated by `rotation_y` degrees about
+/// +Y: the texels of [`EnvMap::sky`] through [`EnvMap::new`] (which
+/// counts the texels clamped, as [`load_envmap`] does).
+pub fn sky(
+    elevation: f64,
+    azimuth: f64,
+    scale: f64,
+    rotation_y: f64,
+) -> Result<(EnvMap, usize), lobe::envmap::EnvMapError> {
+    let sky = EnvMap::sky(SKY.0, SKY.1, elevation, azimuth);
+    let (w, h) = sky.size();
+    let texels = (0..h)
+        .flat_map(|j| (0..w).map(move |i| (i, j)))
+        .map(|(i, j)| sky.texel(i, j))
+        .collect();
+    EnvMap::new(w, h, texels, scale, rotation_y)
+}
+
 /// Load `path` (`.hdr`, `.exr`, or the word `sky`) as an environment map
 /// with `scale` and a rotation about +Y in degrees. Returns the map and the
 /// number of texels whose negative, infinite or NaN channels were clamped
@@ -35,13 +69,7 @@ pub fn load_envmap(path: &Path, scale: f64, rotation_y: f64) -> Result<(EnvMap, 
         source,
     };
     if path.as_os_str() == "sky" {
-        let sky = EnvMap::sky(SKY.0, SKY.1, SKY.2, SKY.3);
-        let (w, h) = sky.size();
-        let texels = (0..h)
-            .flat_map(|j| (0..w).map(move |i| (i, j)))
-            .map(|(i, j)| sky.texel(i, j))
-            .collect();
-        return EnvMap::new(w, h, texels, scale, rotation_y).map_err(map_err);
+        return sky(SKY.2, SKY.3, scale, rotation_y).map_err(map_err);
     }
     let io_err = |source| LoadError::Io {
         path: path.to_path_buf(),

@@ -139,6 +139,7 @@ use lobe::math::{Rgb, luminance};
 use lobe::sequence::{Sequence, hash64, pair_point};
 use lobe::{BsdfSampler, BsdfStrategy, Frame, Material};
 use rayon::prelude::*;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
 mod wavefront;
@@ -361,13 +362,19 @@ pub fn render_pass(
     on_pool(opts, || {
         if pass > 0 && needs_pilot(opts) {
             // The allocations of later passes come from pass 0's pilot.
-            let prior = pilot_phase(scene, opts).0;
-            render_on_pool(scene, opts, pass, &progress, Some(&prior)).0
+            let prior = pilot_phase(scene, opts, &NEVER).expect(NOT_CANCELLED).0;
+            render_on_pool(scene, opts, pass, &progress, Some(&prior), &NEVER)
         } else {
-            render_on_pool(scene, opts, pass, &progress, None).0
+            render_on_pool(scene, opts, pass, &progress, None, &NEVER)
         }
+        .expect(NOT_CANCELLED)
+        .0
     })
 }
+
+/// The flag of the renders that cannot be cancelled.
+static NEVER: AtomicBool = AtomicBool::new(false);
+const NOT_CANCELLED: &str = "a render without a cancellation flag finishes";
 
 /// Whether `s` is adaptive MIS, whose first bounce a per-pixel pilot tunes.
 fn is_adaptive(s: Strategy) -> bool {
@@ -554,6 +561,27 @@ pub fn render_progressive(
     max_passes: u64,
     progress: impl Fn(u64) + Sync,
 ) -> Image {
+    render_until(scene, opts, Some(budget), max_passes, &NEVER, progress).expect(NOT_CANCELLED)
+}
+
+/// [`render_progressive`] that a caller can stop: whole passes until
+/// `budget` has passed (with `None`, until `max_passes` are done; at least
+/// one pass either way) or until `cancel` is set, whichever comes first.
+/// `cancel` is read before every pass, every row and every block of
+/// samples (of a pass and of the pilot): once it is set, the running pass
+/// is abandoned within a block of samples per thread, and the mean of the
+/// passes finished before it is returned, the same bits as an uncancelled
+/// render of that many passes, or `None` if no pass finished. The library installs no signal handler: a program sets the
+/// flag from its own (as `lobe render` does on Ctrl-C).
+#[must_use]
+pub fn render_until(
+    scene: &Scene,
+    opts: &RenderOptions,
+    budget: Option<Duration>,
+    max_passes: u64,
+    cancel: &AtomicBool,
+    progress: impl Fn(u64) + Sync,
+) -> Option<Image> {
     let t0 = Instant::now();
     let max_passes = match opts.sequence {
         Sequence::Sobol => max_passes.min(SOBOL_MAX_SAMPLES / max_pixel_spp(opts)),
@@ -561,15 +589,21 @@ pub fn render_progressive(
     }
     .max(1);
     on_pool(opts, || {
-        let (mut sum, prior) = render_on_pool(scene, opts, 0, &progress, None);
+        let (mut sum, prior) = render_on_pool(scene, opts, 0, &progress, None, cancel)?;
         let mut passes = 1;
         // Go on while another pass, at the mean pass time so far, fits.
-        while passes < max_passes {
-            let per_pass = t0.elapsed() / passes as u32;
-            if t0.elapsed() + per_pass > budget {
-                break;
+        while passes < max_passes && !cancel.load(Ordering::Relaxed) {
+            if let Some(budget) = budget {
+                let per_pass = t0.elapsed() / passes as u32;
+                if t0.elapsed() + per_pass > budget {
+                    break;
+                }
             }
-            let img = render_on_pool(scene, opts, passes, &progress, prior.as_ref()).0;
+            let Some((img, _)) =
+                render_on_pool(scene, opts, passes, &progress, prior.as_ref(), cancel)
+            else {
+                break;
+            };
             for (a, b) in sum.pixels.iter_mut().zip(&img.pixels) {
                 *a += *b;
             }
@@ -583,7 +617,7 @@ pub fn render_progressive(
             *p *= k;
         }
         sum.stats.passes = passes;
-        sum
+        Some(sum)
     })
 }
 
@@ -599,6 +633,8 @@ fn context<'a>(
 ) -> Context<'a> {
     Context {
         progress,
+        // (Set by the caller that can be cancelled.)
+        cancel: &NEVER,
         batch,
         scene,
         light,
@@ -627,6 +663,11 @@ fn add_stats(a: RenderStats, b: RenderStats) -> RenderStats {
         nonfinite: a.nonfinite + b.nonfinite,
         passes: 1,
     }
+}
+
+/// [`add_stats`] of rows, `None` (a row skipped) if either is.
+fn add_some_stats(a: Option<RenderStats>, b: Option<RenderStats>) -> Option<RenderStats> {
+    Some(add_stats(a?, b?))
 }
 
 /// A pixel's sample values' luminance: count, sum and sum of squares.
@@ -674,8 +715,12 @@ struct Prior {
 /// (a seed apart from the image's); under adaptive MIS the balance
 /// heuristic at the first bounce, recorded, and under the variance
 /// allocation the values' moments ([`spp_counts`]). Their values are not
-/// in the image.
-fn pilot_phase(scene: &Scene, opts: &RenderOptions) -> (Prior, RenderStats) {
+/// in the image. `None` when `cancel` was set before its last row finished.
+fn pilot_phase(
+    scene: &Scene,
+    opts: &RenderOptions,
+    cancel: &AtomicBool,
+) -> Option<(Prior, RenderStats)> {
     let (w, h) = (scene.camera.width as usize, scene.camera.height as usize);
     let shading = shadings(scene, opts);
     let light = Light::Env(scene.environment.clone());
@@ -691,15 +736,18 @@ fn pilot_phase(scene: &Scene, opts: &RenderOptions) -> (Prior, RenderStats) {
     // On the batch loop where it renders the scene: the same draws,
     // recorded from f32 lanes.
     let batch = batch_loop(scene, opts);
-    let ctx = context(
-        scene,
-        &pilot_opts,
-        0,
-        &light,
-        &shading,
-        &|_| {},
-        batch.as_ref(),
-    );
+    let ctx = Context {
+        cancel,
+        ..context(
+            scene,
+            &pilot_opts,
+            0,
+            &light,
+            &shading,
+            &|_| {},
+            batch.as_ref(),
+        )
+    };
     let k = ctx.spp;
     let adaptive = is_adaptive(opts.strategy);
     let mode = if adaptive {
@@ -715,13 +763,16 @@ fn pilot_phase(scene: &Scene, opts: &RenderOptions) -> (Prior, RenderStats) {
     let mut pilots: Vec<Pilot> = fresh(w * h);
     let mut moments: Vec<Moments> = fresh(w * h);
     if w == 0 {
-        return (Prior::default(), RenderStats::default());
+        return Some((Prior::default(), RenderStats::default()));
     }
     let stats = pilots
         .par_chunks_mut(w)
         .zip(moments.par_chunks_mut(w))
         .enumerate()
         .map(|(y, (row, mrow))| {
+            if ctx.cancel.load(Ordering::Relaxed) {
+                return None;
+            }
             let mut stats = RenderStats::default();
             if let Some(b) = ctx.batch {
                 let mut sums = vec![Rgb::ZERO; w];
@@ -729,12 +780,16 @@ fn pilot_phase(scene: &Scene, opts: &RenderOptions) -> (Prior, RenderStats) {
                 stats = b.row(&ctx, y, &mut sums, &|_| (k, mode), pilots, Some(mrow));
             } else {
                 for (x, (p, m)) in row.iter_mut().zip(mrow).enumerate() {
+                    if ctx.cancel.load(Ordering::Relaxed) {
+                        return None;
+                    }
                     (_, *p, *m) = ctx.pixel(x, y, k, mode, &mut stats);
                 }
             }
-            stats
+            // (Set during the row, the flag may have cut it short.)
+            (!ctx.cancel.load(Ordering::Relaxed)).then_some(stats)
         })
-        .reduce(RenderStats::default, add_stats);
+        .reduce(|| Some(RenderStats::default()), add_some_stats)?;
     // The two decisions are independent: made side by side.
     let (counts, allocs) = rayon::join(
         || {
@@ -748,7 +803,7 @@ fn pilot_phase(scene: &Scene, opts: &RenderOptions) -> (Prior, RenderStats) {
             _ => Vec::new(),
         },
     );
-    (Prior { allocs, counts }, stats)
+    Some((Prior { allocs, counts }, stats))
 }
 
 /// Every pixel's allocation (row by row): from the pilots of the pixels
@@ -808,33 +863,42 @@ fn box_pool<T: Default + Send + Sync, U: Send>(
 
 /// One pass, and what its pilot decided when it ran one (pass 0 runs the
 /// pilot where the render needs one and returns it; later passes borrow
-/// it as `prior`).
+/// it as `prior`). `None` when `cancel` was set before its last row
+/// finished: the pass is abandoned.
 fn render_on_pool(
     scene: &Scene,
     opts: &RenderOptions,
     pass: u64,
     progress: &(dyn Fn(u64) + Sync),
     prior: Option<&Prior>,
-) -> (Image, Option<Prior>) {
+    cancel: &AtomicBool,
+) -> Option<(Image, Option<Prior>)> {
     let (w, h) = (scene.camera.width as usize, scene.camera.height as usize);
     let shading = shadings(scene, opts);
     let light = Light::Env(scene.environment.clone());
     let batch = batch_loop(scene, opts);
-    let ctx = context(
-        scene,
-        opts,
-        pass,
-        &light,
-        &shading,
-        progress,
-        batch.as_ref(),
-    );
+    let ctx = Context {
+        cancel,
+        ..context(
+            scene,
+            opts,
+            pass,
+            &light,
+            &shading,
+            progress,
+            batch.as_ref(),
+        )
+    };
     let mut img = Image::new(w, h);
     if w == 0 || h == 0 {
-        return (img, None);
+        return Some((img, None));
     }
     let spp = ctx.spp;
-    let own = (prior.is_none() && needs_pilot(opts)).then(|| pilot_phase(scene, opts));
+    let own = if prior.is_none() && needs_pilot(opts) {
+        Some(pilot_phase(scene, opts, cancel)?)
+    } else {
+        None
+    };
     let none = Prior::default();
     let (prior, pilot_stats) = match (&own, prior) {
         (Some((p, stats)), _) => (p, *stats),
@@ -853,7 +917,7 @@ fn render_on_pool(
             }
             render_rows(&ctx, &mut img.pixels, count, |x, y| {
                 (count(x, y), FirstBounce::Allocated(allocs[y * w + x]))
-            })
+            })?
         }
         s => {
             if s == Strategy::Light {
@@ -861,7 +925,7 @@ fn render_on_pool(
             }
             render_rows(&ctx, &mut img.pixels, count, |x, y| {
                 (count(x, y), FirstBounce::Plain)
-            })
+            })?
         }
     };
     for (i, px) in img.pixels.iter_mut().enumerate() {
@@ -874,18 +938,21 @@ fn render_on_pool(
         nonfinite: stats.nonfinite + pilot_stats.nonfinite,
         ..stats
     };
-    (img, own.map(|(p, _)| p))
+    Some((img, own.map(|(p, _)| p)))
 }
 
 /// Every pixel's samples `0..n` of the pass with first-bounce mode `mode`,
 /// `(n, mode) = plan(x, y)` (`n = count(x, y)`, the cheaper call), rows in
-/// parallel; stores each pixel's sum (not divided).
+/// parallel; stores each pixel's sum (not divided). `None` when
+/// `ctx.cancel` was set before the last row finished: the rows not begun
+/// are skipped and a row running stops at its next block (batch loop) or
+/// progress step of a pixel (scalar loop).
 fn render_rows(
     ctx: &Context<'_>,
     pixels: &mut [Rgb],
     count: impl Fn(usize, usize) -> u64,
     plan: impl Fn(usize, usize) -> (u64, FirstBounce) + Sync,
-) -> RenderStats {
+) -> Option<RenderStats> {
     let w = ctx.width;
     // The rows handed out to the threads the costliest first (by their
     // samples), so that no thread is left with a long row at the end while
@@ -900,17 +967,28 @@ fn render_rows(
     rows.into_iter()
         .par_bridge()
         .map(|(_, y, row)| {
-            if let Some(b) = ctx.batch {
-                return b.row(ctx, y, row, &|x| plan(x, y), None, None);
+            if ctx.cancel.load(Ordering::Relaxed) {
+                return None;
             }
-            let mut stats = RenderStats::default();
-            for (x, px) in row.iter_mut().enumerate() {
-                let (n, mode) = plan(x, y);
-                *px = ctx.pixel(x, y, n, mode, &mut stats).0;
-            }
-            stats
+            let stats = if let Some(b) = ctx.batch {
+                b.row(ctx, y, row, &|x| plan(x, y), None, None)
+            } else {
+                let mut stats = RenderStats::default();
+                for (x, px) in row.iter_mut().enumerate() {
+                    if ctx.cancel.load(Ordering::Relaxed) {
+                        return None;
+                    }
+                    let (n, mode) = plan(x, y);
+                    *px = ctx.pixel(x, y, n, mode, &mut stats).0;
+                }
+                stats
+            };
+            // Set during the row, the flag may have cut it short (a batch
+            // row stops after its block, a pixel after its progress step):
+            // a row finishes only if the flag was still clear at its end.
+            (!ctx.cancel.load(Ordering::Relaxed)).then_some(stats)
         })
-        .reduce(RenderStats::default, add_stats)
+        .reduce(|| Some(RenderStats::default()), add_some_stats)
 }
 
 /// The randomization of pixel `index` for `seed` (hashed, so that
@@ -925,6 +1003,8 @@ const PROGRESS_STEP: u64 = 4096;
 
 struct Context<'a> {
     progress: &'a (dyn Fn(u64) + Sync),
+    /// Set: rows not begun are skipped, and their pass abandoned.
+    cancel: &'a AtomicBool,
     /// The batch loop, where it renders the scene (never for the pilot).
     batch: Option<&'a wavefront::Batch<'a>>,
     scene: &'a Scene,
@@ -1012,6 +1092,11 @@ impl Context<'_> {
             if pending == PROGRESS_STEP {
                 (self.progress)(pending);
                 pending = 0;
+                // Cancelled: the pixel is left unfinished (its pass is
+                // abandoned, see `render_rows`).
+                if self.cancel.load(Ordering::Relaxed) {
+                    break;
+                }
             }
         }
         if pending > 0 {

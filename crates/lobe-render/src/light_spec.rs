@@ -106,18 +106,19 @@ pub fn parse_light(flag: &str, spec: &str, frame: &Frame) -> Result<ParsedLight,
             let elevation = parts
                 .next()
                 .map_or(Ok(default_elevation), |s| number("sun elevation", s))?;
-            let azimuth =
-                match parts.next() {
-                    None => default_azimuth,
-                    Some(s) => s.parse::<f64>().ok().filter(|a| a.is_finite()).ok_or_else(
-                        || {
-                            format!(
-                                "{flag} {spec}: sun azimuth `{s}` is not a finite number of degrees"
-                            )
-                        },
-                    )?,
-                };
-            if parts.next().is_some() || elevation > 90.0 {
+            let azimuth = match parts.next() {
+                None => default_azimuth,
+                Some(s) => s
+                    .parse::<f64>()
+                    .ok()
+                    .filter(|&a| crate::envmap_io::sun_azimuth_ok(a))
+                    .ok_or_else(|| {
+                        format!(
+                            "{flag} {spec}: sun azimuth `{s}` is not a finite number of degrees"
+                        )
+                    })?,
+            };
+            if parts.next().is_some() || !crate::envmap_io::sun_elevation_ok(elevation) {
                 return Err(format!(
                     "{flag} {spec}: expected sky[:ELEVATION[:AZIMUTH]], the sun's elevation in [0, 90] degrees above the horizon and its azimuth in degrees (0 is -Z)"
                 ));

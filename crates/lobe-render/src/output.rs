@@ -197,7 +197,21 @@ impl Image {
     /// `exr`'s run-length default 5%, which took half again as long to
     /// write), on the calling thread (a thread pool per file would cost
     /// more than it saves).
+    ///
+    /// The header holds what the image is the mean of, from
+    /// [`Image::stats`] when it counts camera rays: `spp` (a 64-bit float
+    /// attribute: the camera rays per pixel, the mean where the variance
+    /// allocation gave pixels different counts) and `passes` (a 64-bit
+    /// float: whole passes, [`crate::integrator::RenderStats::passes`]).
     pub fn write_exr(&self, path: &Path) -> Result<(), OutputError> {
+        self.write_exr_noted(path, None)
+    }
+
+    /// [`Image::write_exr`] with `note`, when given, in the header's
+    /// standard `comments` attribute (`software` names lobe either way) (Latin-1 text: other characters are
+    /// an error).
+    pub fn write_exr_noted(&self, path: &Path, note: Option<&str>) -> Result<(), OutputError> {
+        use exr::meta::attribute::{AttributeValue, Text};
         use exr::prelude::{Image as ExrImage, SpecificChannels, WritableImage};
         let err = |message: String| OutputError {
             path: path.to_path_buf(),
@@ -207,19 +221,36 @@ impl Image {
         if rgb.len() != 3 * self.width * self.height {
             return Err(err("the pixel buffer does not match the size".into()));
         }
+        let note = match note {
+            Some(n) => Some(Text::new_or_none(n).ok_or_else(|| {
+                err(format!(
+                    "the note {n:?} has characters an EXR text cannot hold"
+                ))
+            })?),
+            None => None,
+        };
         let w = self.width;
+        let pixels = (self.width * self.height) as f64;
         write_replacing(path, |out| {
-            ExrImage::from_encoded_channels(
+            let mut image = ExrImage::from_encoded_channels(
                 (self.width, self.height),
                 exr::prelude::Encoding::UNCOMPRESSED,
                 SpecificChannels::rgb(|p: exr::math::Vec2<usize>| {
                     let k = 3 * (p.y() * w + p.x());
                     (rgb[k], rgb[k + 1], rgb[k + 2])
                 }),
-            )
-            .write()
-            .non_parallel()
-            .to_buffered(out)
+            );
+            let other = &mut image.attributes.other;
+            if self.stats.camera_rays > 0 && pixels > 0.0 {
+                let spp = self.stats.camera_rays as f64 / pixels;
+                other.insert(Text::from("spp"), AttributeValue::F64(spp));
+                let passes = self.stats.passes.max(1) as f64;
+                other.insert(Text::from("passes"), AttributeValue::F64(passes));
+            }
+            let layer = &mut image.layer_data.attributes;
+            layer.comments = note;
+            layer.software_name = Some(Text::from(concat!("lobe ", env!("CARGO_PKG_VERSION"))));
+            image.write().non_parallel().to_buffered(out)
         })
     }
 
@@ -406,6 +437,47 @@ mod tests {
         img.write_exr(&exr).unwrap();
         let back = crate::load_envmap(&exr, 1.0, 0.0).unwrap().0;
         assert_eq!(back.texel(1, 1), lobe::Rgb::new(0.5, 1.0, 2.0));
+        std::fs::remove_dir_all(&d).unwrap();
+    }
+
+    /// The header of a render's EXR: its camera rays per pixel (`spp`),
+    /// its passes, and a note in `comments`; none of them for an image
+    /// that counts no camera rays.
+    #[test]
+    fn the_exr_header_says_the_samples_per_pixel() {
+        use exr::meta::attribute::{AttributeValue, Text};
+        let d = std::env::temp_dir().join(format!("lobe-exr-meta-{}", std::process::id()));
+        std::fs::create_dir_all(&d).unwrap();
+        let read = |p: &Path| {
+            let meta = exr::meta::MetaData::read_from_file(p, false).unwrap();
+            let h = &meta.headers[0];
+            // (One layer: the reader puts every custom attribute in it.)
+            let mut attrs = h.shared_attributes.other.clone();
+            attrs.extend(h.own_attributes.other.clone());
+            if let Some(c) = &h.own_attributes.comments {
+                attrs.insert(Text::from("comments"), AttributeValue::Text(c.clone()));
+            }
+            attrs
+        };
+        let mut img = Image::new(4, 3);
+        let plain = d.join("plain.exr");
+        img.write_exr(&plain).unwrap();
+        let attrs = read(&plain);
+        assert!(!attrs.contains_key(&Text::from("spp")), "{attrs:?}");
+        img.stats.camera_rays = 12 * 24;
+        img.stats.passes = 3;
+        let noted = d.join("noted.exr");
+        img.write_exr_noted(&noted, Some("interrupted after 3 passes"))
+            .unwrap();
+        let attrs = read(&noted);
+        assert_eq!(attrs[&Text::from("spp")], AttributeValue::F64(24.0));
+        assert_eq!(attrs[&Text::from("passes")], AttributeValue::F64(3.0));
+        assert_eq!(
+            attrs[&Text::from("comments")],
+            AttributeValue::Text(Text::from("interrupted after 3 passes"))
+        );
+        let e = img.write_exr_noted(&noted, Some("3 ≥ 2")).unwrap_err();
+        assert!(e.to_string().contains("cannot hold"), "{e}");
         std::fs::remove_dir_all(&d).unwrap();
     }
 

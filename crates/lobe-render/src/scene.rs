@@ -14,6 +14,9 @@
 //!
 //! [environment]
 //! path = "forest.hdr" # .hdr or .exr, relative to the scene file; or "sky"
+//! # or, instead of path, the built-in sky with its sun placed (degrees, as
+//! # `--light sky:E:A`; each key defaults to the built-in sky's, 35 and 40):
+//! # sky = { sun_elevation = 20, sun_azimuth = 120 }
 //! scale = 1.0         # default 1
 //! rotation_y = 0.0    # degrees about +Y; default 0
 //!
@@ -291,15 +294,35 @@ fn one() -> f64 {
     1.0
 }
 
+/// `[environment]`: a map (`path`) or the built-in sky with its sun
+/// placed (`sky`); exactly one of the two.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct EnvironmentDesc {
     /// `.hdr` or `.exr`, relative to the scene file, or `sky`.
-    pub path: String,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub path: Option<String>,
+    /// The built-in sky with its sun where these keys say.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sky: Option<SkyDesc>,
     #[serde(default = "one")]
     pub scale: f64,
     #[serde(default)]
     pub rotation_y: f64,
+}
+
+/// `[environment] sky = { sun_elevation = E, sun_azimuth = A }`: the
+/// built-in sky with its sun at elevation E in [0, 90] degrees above the
+/// horizon and azimuth A degrees (0 is −Z), as `--light sky:E:A`; a key
+/// left out takes the built-in sky's value ([`crate::envmap_io::SKY`]: 35
+/// and 40, as `--light sky` and `path = "sky"`).
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SkyDesc {
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sun_elevation: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sun_azimuth: Option<f64>,
 }
 
 /// One `[[object]]`: `type` says which of the shape keys apply.
@@ -607,15 +630,69 @@ fn build(desc: &SceneDesc, base: &Path) -> FieldResult<Scene> {
         ));
     }
     let mut warnings = Vec::new();
-    let env_path = if e.path == "sky" {
-        PathBuf::from("sky")
-    } else {
-        base.join(&e.path)
+    let map = match (&e.path, &e.sky) {
+        (Some(_), Some(_)) => {
+            return Err((
+                env_field("sky"),
+                "`path` and `sky` are exclusive: `path` names a map (or \"sky\", the built-in sky as it is), `sky` places the built-in sky's sun; give one of them".into(),
+            ));
+        }
+        (None, None) => {
+            return Err((
+                FieldPath::of(&["environment"]),
+                "missing `path` (an .hdr or .exr map, or \"sky\") or `sky` (the built-in sky with its sun: sky = { sun_elevation = 35, sun_azimuth = 40 })".into(),
+            ));
+        }
+        (None, Some(sky)) => {
+            let (_, _, elevation, azimuth) = crate::envmap_io::SKY;
+            let elevation = sky.sun_elevation.unwrap_or(elevation);
+            let azimuth = sky.sun_azimuth.unwrap_or(azimuth);
+            let sky_field = |k: &str| FieldPath::of(&["environment", "sky", k]);
+            if !crate::envmap_io::sun_elevation_ok(elevation) {
+                return Err((
+                    sky_field("sun_elevation"),
+                    format!(
+                        "{elevation} is out of range: the sun's elevation is in [0, 90] degrees above the horizon"
+                    ),
+                ));
+            }
+            if !crate::envmap_io::sun_azimuth_ok(azimuth) {
+                return Err((
+                    sky_field("sun_azimuth"),
+                    format!("{azimuth} is not a finite number of degrees"),
+                ));
+            }
+            let (map, clamped) = crate::envmap_io::sky(elevation, azimuth, e.scale, e.rotation_y)
+                .map_err(|err| (env_field("sky"), err.to_string()))?;
+            if clamped > 0 {
+                warnings.push(format!(
+                    "environment.sky: {clamped} texels with negative, infinite or NaN channels were clamped to 0"
+                ));
+            }
+            map
+        }
+        (Some(path), None) => {
+            if let Some(sun) = path.strip_prefix("sky:") {
+                let mut parts = sun.splitn(2, ':');
+                let (el, az) = (parts.next().unwrap_or("E"), parts.next().unwrap_or("A"));
+                return Err((
+                    env_field("path"),
+                    format!(
+                        "`{path}`: a scene places the sky's sun with keys of their own: sky = {{ sun_elevation = {el}, sun_azimuth = {az} }} instead of path"
+                    ),
+                ));
+            }
+            let env_path = if path == "sky" {
+                PathBuf::from("sky")
+            } else {
+                base.join(path)
+            };
+            let loaded = load_envmap_checked(&env_path, e.scale, e.rotation_y)
+                .map_err(|err| (env_field("path"), err.to_string()))?;
+            warnings.extend(loaded.warnings);
+            loaded.map
+        }
     };
-    let loaded = load_envmap_checked(&env_path, e.scale, e.rotation_y)
-        .map_err(|err| (env_field("path"), err.to_string()))?;
-    warnings.extend(loaded.warnings);
-    let map = loaded.map;
 
     let r = &desc.render;
     let render_field = |k: &str| FieldPath::of(&["render", k]);
@@ -898,5 +975,134 @@ strategy = "vndf"
         assert!(e.contains("field object[1].path: no/bunny.obj"), "{e}");
         let e = err(&GOOD.replace("[camera]\norigin = [0, 1, 4]\n", "[camera]\n"));
         assert!(e.contains("missing field `origin`"), "{e}");
+    }
+
+    /// The environment of `GOOD` with `environment` in place of its
+    /// `path = "sky"` line.
+    fn with_environment(environment: &str) -> String {
+        GOOD.replace("path = \"sky\"\n", &format!("{environment}\n"))
+    }
+
+    fn environment(environment: &str) -> Arc<EnvMap> {
+        let text = with_environment(environment);
+        match parse_scene(&text, Path::new("scene.toml")) {
+            Ok(s) => s.environment,
+            Err(e) => panic!("{environment}: {e}"),
+        }
+    }
+
+    fn same_map(a: &EnvMap, b: &EnvMap) -> bool {
+        let (w, h) = a.size();
+        a.size() == b.size()
+            && (0..h).all(|j| (0..w).all(|i| a.texel(i, j) == b.texel(i, j)))
+            && [DVec3::Y, DVec3::X, DVec3::new(0.3, 0.4, -0.8).normalize()]
+                .iter()
+                .all(|&d| a.eval(d) == b.eval(d) && a.pdf(d) == b.pdf(d))
+    }
+
+    /// Issue 41: `sky = { sun_elevation, sun_azimuth }` is the light of
+    /// `--light sky:E:A`; `sky = {}` (or a key left out) takes the
+    /// built-in sky's values, as `path = "sky"` and `--light sky` do.
+    #[test]
+    fn the_sky_keys_place_the_sun_as_the_light_option_does() {
+        use crate::light_spec::parse_light;
+        let frame = lobe::Frame::from_normal(DVec3::Z);
+        let light = |spec: &str| match parse_light("--light", spec, &frame).unwrap().light {
+            lobe::Light::Env(m) => m,
+            other => panic!("{other:?}"),
+        };
+        let keyed = environment("sky = { sun_elevation = 20, sun_azimuth = 120 }");
+        assert!(same_map(&keyed, &light("sky:20:120")));
+        assert!(!same_map(&keyed, &light("sky:20:121")));
+        assert!(!same_map(&keyed, &light("sky:21:120")));
+        let inline = environment("[environment.sky]\nsun_elevation = 90\nsun_azimuth = -30.5");
+        assert!(same_map(&inline, &light("sky:90:-30.5")));
+        // Defaults: the built-in sky's (35, 40), key by key.
+        let plain = environment("path = \"sky\"");
+        assert!(same_map(&environment("sky = {}"), &plain));
+        assert!(same_map(&plain, &light("sky:35:40")));
+        assert!(same_map(
+            &environment("sky = { sun_elevation = 20 }"),
+            &light("sky:20:40")
+        ));
+        assert!(same_map(
+            &environment("sky = { sun_azimuth = 120 }"),
+            &light("sky:35:120")
+        ));
+        // scale and rotation_y apply as to path = "sky".
+        let turned = "scale = 2\nrotation_y = 30";
+        assert!(same_map(
+            &environment(&format!("sky = {{}}\n{turned}")),
+            &environment(&format!("path = \"sky\"\n{turned}"))
+        ));
+        // And a render under it is the same image.
+        let render = |env: &str| {
+            let s = parse_scene(&with_environment(env), Path::new("scene.toml")).unwrap();
+            crate::render(&s, &s.options, |_| {}).pixels
+        };
+        assert_eq!(render("sky = {}"), render("path = \"sky\""));
+    }
+
+    /// Issue 41: the sun's keys take exactly what `--light sky:E:A` takes,
+    /// and a value refused names the key, the file and the line.
+    #[test]
+    fn the_sky_keys_take_what_the_light_option_takes() {
+        use crate::light_spec::parse_light;
+        let frame = lobe::Frame::from_normal(DVec3::Z);
+        let elevations = ["-1", "-0.0", "0", "20", "90", "90.5", "1e3", "nan", "inf"];
+        let azimuths = ["-400", "0", "120", "720", "inf", "-inf", "nan"];
+        for el in elevations {
+            for az in azimuths {
+                let text = with_environment(&format!(
+                    "sky = {{ sun_elevation = {el}, sun_azimuth = {az} }}"
+                ));
+                let scene = parse_scene(&text, Path::new("scene.toml"));
+                let option = parse_light("--light", &format!("sky:{el}:{az}"), &frame);
+                assert_eq!(scene.is_ok(), option.is_ok(), "{el}, {az}");
+            }
+        }
+        let e = err(&with_environment("sky = { sun_elevation = 95 }"));
+        assert_eq!(
+            e,
+            "scene.toml:10:25: field environment.sky.sun_elevation: 95 is out of range: the sun's elevation is in [0, 90] degrees above the horizon"
+        );
+        let e = err(&with_environment("sky = { sun_elevation = -5 }"));
+        assert!(
+            e.contains("field environment.sky.sun_elevation: -5 is out of range"),
+            "{e}"
+        );
+        let e = err(&with_environment("sky = { sun_azimuth = nan }"));
+        assert!(
+            e.starts_with("scene.toml:10:")
+                && e.contains("field environment.sky.sun_azimuth: NaN is not a finite number"),
+            "{e}"
+        );
+        let e = err(&with_environment("sky = { sun_elevation = \"high\" }"));
+        assert!(
+            e.contains("field environment.sky.sun_elevation: invalid type"),
+            "{e}"
+        );
+        let e = err(&with_environment("sky = { sun_height = 20 }"));
+        assert!(e.contains("unknown field `sun_height`"), "{e}");
+        let e = err(&with_environment(
+            "path = \"sky\"\nsky = { sun_elevation = 20 }",
+        ));
+        assert!(
+            e.starts_with("scene.toml:11:")
+                && e.contains("field environment.sky: `path` and `sky` are exclusive"),
+            "{e}"
+        );
+        let e = err(&with_environment("scale = 1"));
+        assert!(
+            e.starts_with("scene.toml:") && e.contains("field environment: missing `path`"),
+            "{e}"
+        );
+        let e = err(&with_environment("path = \"sky:20:120\""));
+        assert!(
+            e.contains(
+                "field environment.path: `sky:20:120`: a scene places the sky's sun with keys of their own: sky = { sun_elevation = 20, sun_azimuth = 120 } instead of path"
+            ),
+            "{e}"
+        );
     }
 }

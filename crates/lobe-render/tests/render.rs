@@ -633,6 +633,76 @@ fn progressive_passes_are_reproducible() {
     }
 }
 
+/// Issue 41: a cancelled render keeps its finished passes. `render_until`
+/// stops at the next row once the flag is set: the pass then running is
+/// abandoned, and the image is the mean of the passes before it, the same
+/// bits as an uncancelled render of that many passes; a flag set before
+/// the first pass finished gives no image.
+#[test]
+fn a_cancelled_render_keeps_its_finished_passes() {
+    use lobe_render::integrator::{render_pass, render_progressive, render_until};
+    use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+    let (scene, _) = sphere_on_plane();
+    for (strategy, spp_allocation, render_loop) in [
+        (
+            Strategy::mis(Heuristic::Balance),
+            SppAllocation::Uniform,
+            RenderLoop::Batch,
+        ),
+        (Strategy::MIS, SppAllocation::Variance, RenderLoop::Batch),
+        (Strategy::MIS, SppAllocation::Variance, RenderLoop::Scalar),
+    ] {
+        let mut o = opts(strategy, 4);
+        o.spp_allocation = spp_allocation;
+        o.render_loop = render_loop;
+        // One thread: the flag is set during pass 1's first row, so the
+        // rows after it are skipped whatever the machine.
+        o.threads = Some(1);
+        let first = render_pass(&scene, &o, 0, |_| {});
+        let per_pass = first.stats.camera_rays;
+        assert!(per_pass > 0);
+        let done = AtomicU64::new(0);
+        let cancel = AtomicBool::new(false);
+        let img = render_until(&scene, &o, None, 100, &cancel, |n| {
+            if done.fetch_add(n, Ordering::Relaxed) + n > per_pass {
+                cancel.store(true, Ordering::Relaxed);
+            }
+        })
+        .expect("pass 0 finished before the flag was set");
+        assert_eq!(img.stats.passes, 1, "{strategy}");
+        assert_eq!(img.stats.camera_rays, per_pass);
+        assert_eq!(img.pixels, first.pixels, "{strategy}");
+        assert!(done.load(Ordering::Relaxed) < 2 * per_pass, "{strategy}");
+
+        // Set after two passes: the mean of the two, as render_progressive
+        // gives it.
+        let done = AtomicU64::new(0);
+        let cancel = AtomicBool::new(false);
+        let img = render_until(&scene, &o, None, 100, &cancel, |n| {
+            if done.fetch_add(n, Ordering::Relaxed) + n > 2 * per_pass {
+                cancel.store(true, Ordering::Relaxed);
+            }
+        })
+        .unwrap();
+        let two = render_progressive(&scene, &o, std::time::Duration::from_secs(3600), 2, |_| {});
+        assert_eq!((img.stats.passes, two.stats.passes), (2, 2));
+        assert_eq!(img.pixels, two.pixels, "{strategy}");
+
+        // Without a budget or a flag: max_passes.
+        let never = AtomicBool::new(false);
+        let three = render_until(&scene, &o, None, 3, &never, |_| {}).unwrap();
+        assert_eq!(three.stats.passes, 3);
+        assert_eq!(three.stats.camera_rays, 3 * per_pass);
+
+        // Set before the first pass (in the pilot, or at the first row):
+        // nothing.
+        let set = AtomicBool::new(true);
+        assert!(render_until(&scene, &o, None, 100, &set, |_| {}).is_none());
+        let hour = Some(std::time::Duration::from_secs(3600));
+        assert!(render_until(&scene, &o, hour, 100, &set, |_| {}).is_none());
+    }
+}
+
 #[test]
 fn the_same_image_for_any_thread_count() {
     let obj = "v -0.5 0 -0.5\nv 0.5 0 -0.5\nv 0 0.9 0\nv 0 0 0.6\n\

@@ -441,3 +441,189 @@ fn a_render_shows_progress_lines_off_a_terminal() {
     assert!(lines[0].contains("% (") && lines[0].contains(" of "), "{e}");
     assert!(!e.contains("3w") && !e.contains("weeks"), "{e}");
 }
+
+/// Issue 41: SIGINT or SIGTERM during a `--time` render writes the passes
+/// finished so far, with their spp in the EXR's header and on stderr, and
+/// exits with 128 + the signal's number; during a render's only pass it
+/// writes nothing and says so.
+#[cfg(unix)]
+#[test]
+fn an_interrupted_render_writes_the_passes_it_finished() {
+    use std::io::BufRead;
+    use std::process::Stdio;
+    use std::sync::mpsc;
+    use std::time::{Duration, Instant};
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let d = dir("interrupt");
+    // The render's stderr lines, and the percentage of the plain progress
+    // lines (one pass of samples is 100%).
+    let start = |args: &[&str], out: &Path| {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_lobe"))
+            .args([
+                "render",
+                "examples/scene.toml",
+                "--spp-allocation",
+                "uniform",
+            ])
+            .args(args)
+            .arg("--out")
+            .arg(out)
+            .current_dir(&root)
+            .env("LOBE_PROGRESS_EVERY", "0.05")
+            .stderr(Stdio::piped())
+            .stdout(Stdio::null())
+            .spawn()
+            .unwrap();
+        let (tx, rx) = mpsc::channel();
+        let stderr = child.stderr.take().unwrap();
+        std::thread::spawn(move || {
+            for l in std::io::BufReader::new(stderr).lines() {
+                let Ok(l) = l else { return };
+                if tx.send(l).is_err() {
+                    return;
+                }
+            }
+        });
+        (child, rx)
+    };
+    let percent = |l: &str| -> Option<f64> {
+        let rest = l.strip_prefix("lobe: rendering ")?;
+        rest.split('%').next()?.trim().parse().ok()
+    };
+    let kill = |pid: u32, sig: &str| {
+        let s = Command::new("kill")
+            .arg(format!("-{sig}"))
+            .arg(pid.to_string())
+            .status()
+            .unwrap();
+        assert!(s.success());
+    };
+    for (sig, name, status) in [("INT", "SIGINT", 130), ("TERM", "SIGTERM", 143)] {
+        let out = d.join(format!("timed-{sig}"));
+        let t0 = Instant::now();
+        let (mut child, rx) = start(&["--spp", "4", "--time", "30"], &out);
+        // Signalled once a progress line shows more than one pass done.
+        let mut lines = Vec::new();
+        loop {
+            let l = rx
+                .recv_timeout(Duration::from_secs(8))
+                .unwrap_or_else(|e| panic!("no progress past one pass ({e}): {lines:?}"));
+            let past = percent(&l).is_some_and(|p| p > 100.0);
+            lines.push(l);
+            if past {
+                break;
+            }
+        }
+        kill(child.id(), sig);
+        let code = child.wait().unwrap().code();
+        lines.extend(rx.iter());
+        assert!(t0.elapsed() < Duration::from_secs(10), "{lines:?}");
+        assert_eq!(code, Some(status), "{lines:?}");
+        let last = lines.last().unwrap();
+        let head = format!("lobe: interrupted ({name}) after ");
+        let rest = last
+            .strip_prefix(head.as_str())
+            .unwrap_or_else(|| panic!("{lines:?}"));
+        // "N passes (K spp, 4 a pass) in S s of --time 30; wrote ..."
+        let passes: u64 = rest.split(' ').next().unwrap().parse().unwrap();
+        assert!(passes >= 2, "{last}");
+        let spp_said = format!("({} spp, 4 a pass)", 4 * passes);
+        assert!(rest.contains(&spp_said), "{last}");
+        assert!(
+            rest.contains("of --time 30; wrote ") && rest.contains(".exr") && rest.contains(".png"),
+            "{last}"
+        );
+        let exr = out.with_extension("exr");
+        let meta = exr::meta::MetaData::read_from_file(&exr, false).unwrap();
+        let h = &meta.headers[0];
+        let attrs: std::collections::HashMap<_, _> = h
+            .shared_attributes
+            .other
+            .iter()
+            .chain(&h.own_attributes.other)
+            .map(|(k, v)| (k.to_string(), v.clone()))
+            .collect();
+        use exr::meta::attribute::AttributeValue;
+        assert_eq!(
+            attrs.get("spp"),
+            Some(&AttributeValue::F64((4 * passes) as f64)),
+            "{attrs:?}"
+        );
+        let note = h.own_attributes.comments.as_ref().unwrap().to_string();
+        assert!(note.starts_with(&format!("interrupted ({name})")), "{note}");
+        assert!(out.with_extension("png").exists());
+    }
+
+    // A render without --time is one pass: interrupted in it, nothing.
+    let out = d.join("whole");
+    let (mut child, rx) = start(&["--spp", "100000"], &out);
+    let mut lines = Vec::new();
+    loop {
+        let l = rx.recv_timeout(Duration::from_secs(8)).unwrap();
+        let started = percent(&l).is_some();
+        lines.push(l);
+        if started {
+            break;
+        }
+    }
+    kill(child.id(), "INT");
+    let code = child.wait().unwrap().code();
+    lines.extend(rx.iter());
+    assert_eq!(code, Some(130), "{lines:?}");
+    let last = lines.last().unwrap();
+    assert!(
+        last.starts_with("lobe: interrupted (SIGINT) after ")
+            && last.contains("before the first pass")
+            && last.ends_with("nothing written"),
+        "{lines:?}"
+    );
+    for ext in ["exr", "png", "spp.png"] {
+        assert!(!d.join(format!("whole.{ext}")).exists(), "{ext}");
+    }
+}
+
+/// Issue 41: a scene places the built-in sky's sun with
+/// `[environment] sky = { sun_elevation, sun_azimuth }`: the same image as
+/// the default sky when the keys are the defaults, another one elsewhere,
+/// and one line naming the file, the line and the key for a bad value.
+#[test]
+fn a_scene_places_the_skys_sun() {
+    let d = dir("sky-keys");
+    let render = |name: &str, environment: &str| {
+        let scene = d.join(format!("{name}.toml"));
+        let text = test_scene().replace("path = \"sky\"", environment);
+        std::fs::write(&scene, text).unwrap();
+        let out = d.join(name);
+        let o = lobe(
+            &[
+                "render",
+                scene.to_str().unwrap(),
+                "--spp",
+                "2",
+                "--out",
+                out.to_str().unwrap(),
+                "--quiet",
+            ],
+            None,
+        );
+        (o, out.with_extension("exr"), scene)
+    };
+    let read = |p: &Path| std::fs::read(p).unwrap();
+    let (o, plain, _) = render("plain", "path = \"sky\"");
+    assert!(o.status.success(), "{o:?}");
+    let (o, defaults, _) = render("defaults", "sky = { sun_elevation = 35, sun_azimuth = 40 }");
+    assert!(o.status.success(), "{o:?}");
+    assert_eq!(read(&plain), read(&defaults));
+    let (o, low, _) = render("low", "sky = { sun_elevation = 5, sun_azimuth = 120 }");
+    assert!(o.status.success(), "{o:?}");
+    assert_ne!(read(&plain), read(&low));
+    let (o, _, scene) = render("bad", "sky = { sun_elevation = 91, sun_azimuth = 120 }");
+    let e = one_line_error(&o);
+    assert!(
+        e.contains(&format!(
+            "{}:10:25: field environment.sky.sun_elevation: 91 is out of range",
+            scene.display()
+        )),
+        "{e}"
+    );
+}

@@ -17,6 +17,7 @@ use lobe::estimator::{Allocation, Heuristic, MisForm, Pilot, Strategy};
 use lobe::math::{Rgb, luminance};
 use lobe::sequence::{Sequence, SobolKeys, hash64, pair_point_seeded, pair_seed, sobol_pairs};
 use lobe::{BsdfStrategy, Frame};
+use std::sync::atomic::Ordering;
 
 /// Samples shaded together: camera rays, then every BSDF draw of the block
 /// in one [`BatchSampler::sample`] call per object, every light draw in one
@@ -552,6 +553,11 @@ impl Batch<'_> {
                 m += run;
             }
             (ctx.progress)(filled as u64);
+            // Cancelled: the row is left unfinished (its pass is
+            // abandoned, see `render_rows`).
+            if ctx.cancel.load(Ordering::Relaxed) {
+                break;
+            }
         }
         ROW_BUFFERS.set(Some((lanes, pts, draws)));
         stats
