@@ -35,7 +35,7 @@ use std::time::Instant;
                   variance, the default; the same total; NAME.spp.png shows where they went): the \
                   fastest way to a clean image where a few pixels (a highlight, an edge) hold most \
                   of the noise; --spp-allocation uniform gives every pixel --spp.\n\n\
-                  Ctrl-C (SIGINT) or SIGTERM stops the render at the next row: the passes \
+                  Ctrl-C (SIGINT) or SIGTERM stops the render within a block of samples: the passes \
                   finished so far are written (a --time render's; the spp done in the EXR's \
                   `spp` attribute and on stderr) and lobe exits with 130 (SIGINT) or 143 \
                   (SIGTERM); if no pass finished (a render without --time is one pass), nothing \
@@ -271,7 +271,8 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     pb.finish_and_clear();
     let signal = interrupt.signal();
     let Some(image) = image else {
-        let (name, status) = signal.expect("only a signal stops a render before its first pass");
+        let (name, status) = signal
+            .ok_or_else(|| anyhow!("the render stopped before its first pass, with no signal"))?;
         eprintln!(
             "lobe: interrupted ({name}) after {secs:.1} s, before the first pass{} finished: nothing written",
             if budget.is_some() {
@@ -299,9 +300,9 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let passes = image.stats.passes.max(1);
     let note = signal.map(|(name, _)| {
         format!(
-            "interrupted ({name}) after {passes} passes of {} spp: {} spp",
-            opts.spp,
-            passes * opts.spp
+            "interrupted ({name}): {} spp done, in passes of {}",
+            passes * opts.spp,
+            opts.spp
         )
     });
     let (png_written, (spp_written, exr_written)) = rayon::join(
@@ -390,7 +391,8 @@ pub fn run(args: &RenderArgs) -> Result<()> {
 }
 
 /// SIGINT and SIGTERM during a render: the first sets `stop`, which the
-/// render reads at every row (and records which signal it was); a second
+/// render reads at every block of samples (and records which signal it
+/// was); a second
 /// one ends the process at once with 128 + its number, as a shell expects.
 /// The handlers stay until the process exits.
 struct Interrupt {

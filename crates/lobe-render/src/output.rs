@@ -240,14 +240,19 @@ impl Image {
                     (rgb[k], rgb[k + 1], rgb[k + 2])
                 }),
             );
-            let other = &mut image.attributes.other;
+            let layer = &mut image.layer_data.attributes;
+            // (One custom attribute per map: `exr` writes a map in its
+            // hash order, which differs from run to run, and the same
+            // image must give the same bytes.)
             if self.stats.camera_rays > 0 && pixels > 0.0 {
                 let spp = self.stats.camera_rays as f64 / pixels;
-                other.insert(Text::from("spp"), AttributeValue::F64(spp));
                 let passes = self.stats.passes.max(1) as f64;
-                other.insert(Text::from("passes"), AttributeValue::F64(passes));
+                let image = &mut image.attributes.other;
+                image.insert(Text::from("spp"), AttributeValue::F64(spp));
+                layer
+                    .other
+                    .insert(Text::from("passes"), AttributeValue::F64(passes));
             }
-            let layer = &mut image.layer_data.attributes;
             layer.comments = note;
             layer.software_name = Some(Text::from(concat!("lobe ", env!("CARGO_PKG_VERSION"))));
             image.write().non_parallel().to_buffered(out)
@@ -476,6 +481,13 @@ mod tests {
             attrs[&Text::from("comments")],
             AttributeValue::Text(Text::from("interrupted after 3 passes"))
         );
+        // The same bytes every time (the header's maps in a fixed order).
+        let bytes = std::fs::read(&noted).unwrap();
+        for _ in 0..8 {
+            img.write_exr_noted(&noted, Some("interrupted after 3 passes"))
+                .unwrap();
+            assert_eq!(std::fs::read(&noted).unwrap(), bytes);
+        }
         let e = img.write_exr_noted(&noted, Some("3 ≥ 2")).unwrap_err();
         assert!(e.to_string().contains("cannot hold"), "{e}");
         std::fs::remove_dir_all(&d).unwrap();
