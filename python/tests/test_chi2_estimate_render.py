@@ -96,7 +96,11 @@ def test_estimate_returns_the_cli_table(lobe_exe):
     ref = t["reference"][0]
     for r in t["strategies"]:
         assert abs(r["mean"][0] - ref) < 6 * r["stderr"][0] + 1e-12
-        assert r["stderr_reliable"] is True and r["variance_rel_stderr"] < 0.15
+        assert r["stderr_reliable"] == (r["variance_rel_stderr"] <= 0.15)
+    # Phong's lobe misses most of the beam, so brdf sampling's weights are
+    # heavy-tailed here and its standard error is flagged; uniform's is not.
+    flags = {r["name"]: r["stderr_reliable"] for r in t["strategies"]}
+    assert flags["uniform"] is True and flags["brdf"] is False
     with pytest.raises(ValueError, match="does not apply"):
         lobe.estimate({"type": "phong"}, strategies=["vndf"], samples=100)
     with pytest.raises(ValueError, match="unknown light"):
@@ -109,6 +113,7 @@ def test_estimate_returns_the_cli_table(lobe_exe):
     assert cli["reference"] == t["reference"]
     for a, b in zip(cli["strategies"], t["strategies"]):
         assert a["mean"] == b["mean"] and a["variance"] == b["variance"]
+        assert a["stderr_reliable"] == b["stderr_reliable"]
 
 
 def test_render_a_tiny_scene():
