@@ -118,16 +118,18 @@ fn writes_the_grid_and_the_numbers() {
     let budget = j["time_budget_s"].as_f64().unwrap();
     assert!(budget > 0.0, "{j}");
     // Issue 41: the header says what was equalized, and the times are
-    // equal (3% by construction, checked under a fake clock in
-    // lobe-render's tests; 25% here, where a loaded machine's noise on
-    // renders of 50 ms is 10 to 20%; before: 3.2 to 6.9 ms against 6.5 ms).
+    // equal: within 3% by construction, which lobe-render's tests check
+    // under a fake clock. Here, on a real clock, only within a factor of 2:
+    // two tests side by side on two cores moved renders of 50 ms by 27%
+    // (a timed test is not a benchmark; before the fix the spread was
+    // 3.2 to 6.9 ms against 6.5 ms).
     assert!(
         stdout.contains("Equal time: ") && stdout.contains("(the time of mis at "),
         "{stdout}"
     );
     for r in j["equal_time"].as_array().unwrap() {
         let t = r["time_s"].as_f64().unwrap();
-        assert!((t / budget - 1.0).abs() < 0.25, "{r} against {budget}");
+        assert!((0.5..2.0).contains(&(t / budget)), "{r} against {budget}");
         assert!(r["worst_pixel_share"].as_f64().unwrap() <= 1.0, "{r}");
     }
     // The help names the defaults it runs.
