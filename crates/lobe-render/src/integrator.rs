@@ -288,9 +288,8 @@ pub fn strategy_for(strategy: Strategy, m: &Material) -> Strategy {
 }
 
 fn object_shading(strategy: Strategy, m: &Material) -> ObjectShading<'_> {
-    let estimator = strategy_for(strategy, m)
-        .for_material(m)
-        .or_else(|_| Strategy::Bsdf(BsdfStrategy::Brdf).for_material(m))
+    let estimator = ShadingEstimator::new(strategy_for(strategy, m), m)
+        .or_else(|_| ShadingEstimator::new(Strategy::Bsdf(BsdfStrategy::Brdf), m))
         .expect("brdf applies to every material");
     let continuation = estimator.sampler().unwrap_or_else(|| {
         m.sampler(m.best_bsdf_strategy())

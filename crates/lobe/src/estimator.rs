@@ -74,15 +74,15 @@ impl Accumulator {
     }
 }
 
-impl Strategy {
-    /// Validate this strategy for `m` once, into an estimator of one
-    /// shading point; the error says why a BSDF strategy does not apply.
-    pub fn for_material<'m>(&self, m: &'m Material) -> Result<ShadingEstimator<'m>, Error> {
-        let sampler = match self.bsdf_strategy(m) {
+impl<'m> ShadingEstimator<'m> {
+    /// Validate `strategy` for `m` once, into an estimator of one shading
+    /// point; the error says why a BSDF strategy does not apply.
+    pub fn new(strategy: Strategy, m: &'m Material) -> Result<Self, Error> {
+        let sampler = match strategy.bsdf_strategy(m) {
             Some(s) => Some(m.sampler(s)?),
             None => None,
         };
-        let strategy = match *self {
+        let strategy = match strategy {
             Strategy::Mis(mis) => Strategy::Mis(Mis {
                 bsdf: sampler.map(|s| s.strategy()),
                 ..mis
@@ -169,7 +169,7 @@ pub struct ShadingEstimate {
     pub bsdf: Option<DrawnBsdf>,
 }
 
-/// A [`Strategy`] validated for one material ([`Strategy::for_material`]).
+/// A [`Strategy`] validated for one material ([`ShadingEstimator::new`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ShadingEstimator<'m> {
     strategy: Strategy,
@@ -750,7 +750,7 @@ pub fn estimate(
     light: &Light,
     plan: &Plan,
 ) -> Result<Accumulator, Error> {
-    let est = plan.strategy.for_material(m)?.prepare(sp, light, plan);
+    let est = ShadingEstimator::new(plan.strategy, m)?.prepare(sp, light, plan);
     let mut acc = Accumulator::default();
     for chunk in 0..plan.chunks() {
         acc.merge(&estimate_chunk(&est, sp, light, plan, chunk));

@@ -97,7 +97,7 @@ pub fn curves(
     progress: &dyn Progress,
 ) -> Result<Vec<Curve>, Error> {
     for (t, _) in series {
-        t.for_material(m)?;
+        crate::estimator::ShadingEstimator::new(*t, m)?;
     }
     let CurveSettings {
         runs,

@@ -33,7 +33,7 @@ pub mod variance;
 pub mod warp_test;
 
 use crate::estimator::{
-    Accumulator, Plan, ShadingPoint, estimate_chunk, reference, reference_env_row,
+    Accumulator, Plan, ShadingEstimator, ShadingPoint, estimate_chunk, reference, reference_env_row,
 };
 use crate::progress::Progress;
 use crate::{Error, Light, Material, Rgb};
@@ -65,7 +65,7 @@ pub fn estimate_chunked(
     plan: &Plan,
     progress: &dyn Progress,
 ) -> Result<Accumulator, Error> {
-    let est = plan.strategy.for_material(m)?.prepare(sp, light, plan);
+    let est = ShadingEstimator::new(plan.strategy, m)?.prepare(sp, light, plan);
     let parts = map_indices(plan.chunks(), |c| {
         let a = estimate_chunk(&est, sp, light, plan, c);
         progress.advance(a.count() as u64);

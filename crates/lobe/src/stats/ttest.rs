@@ -127,7 +127,9 @@ impl Moments {
         self.mean += dn;
         self.m4 += t * dn2 * (n * n - 3.0 * n + 3.0) + 6.0 * dn2 * self.m2 - 4.0 * dn * self.m3;
         self.m3 += t * dn * (n - 2.0) - 3.0 * dn * self.m2;
-        self.m2 += t;
+        // Welford's update as before the higher moments (`t` is the same
+        // quantity, rounded differently): the variance keeps its bits.
+        self.m2 += d * (x - self.mean);
     }
 
     /// Adds every observation of `other` (as if pushed here).
@@ -154,7 +156,8 @@ impl Moments {
             + b.m3
             + d2 * d * nab * (na - nb) / (n * n)
             + 3.0 * d * (na * b.m2 - nb * a.m2) / n;
-        self.m2 = a.m2 + b.m2 + d2 * (nab / n);
+        // As before the higher moments, to the bit.
+        self.m2 = a.m2 + (b.m2 + d2 * (nab / n));
         self.n += other.n;
     }
 

@@ -9,7 +9,9 @@
 use crate::common;
 
 use glam::DVec3;
-use lobe::estimator::{Allocation, Plan, ShadingPoint, Strategy, estimate, reference};
+use lobe::estimator::{
+    Allocation, Plan, ShadingEstimator, ShadingPoint, Strategy, estimate, reference,
+};
 use lobe::light::LightDistribution;
 use lobe::math::luminance;
 use lobe::sequence::Sequence;
@@ -96,8 +98,7 @@ fn adaptive_mis_is_never_worse_than_its_parts() {
                     samples: 1 << 16,
                     seed: 3,
                 };
-                let est = Strategy::MIS
-                    .for_material(&m)
+                let est = ShadingEstimator::new(Strategy::MIS, &m)
                     .unwrap()
                     .prepare(&sp, &light, &plan);
                 let per_draw = match est.allocation() {
@@ -165,8 +166,7 @@ fn adaptive_mis_is_unbiased_with_the_predicted_variance() {
                 (mean - r).abs() <= 5.0 * se + 1e-12,
                 "{json} {name}: {mean} ± {se} vs {r}"
             );
-            let est = Strategy::MIS
-                .for_material(&m)
+            let est = ShadingEstimator::new(Strategy::MIS, &m)
                 .unwrap()
                 .prepare(&sp, &light, &plan);
             let e = exact(&m, wo, &light);
