@@ -145,12 +145,12 @@ pub fn run(args: &EstimateArgs) -> Result<()> {
         Setting::Replicas => "--replicas",
     };
     // Checked before the progress bar starts.
-    settings
+    let checked = settings
         .check(&m)
         .map_err(|e| anyhow::anyhow!(e.named(flag)))?;
     let bar = Bar::new(args.quiet);
     let sp = args.light.shading_point(&light, wo)?;
-    let mut table = estimate_table(&m, &sp, &light, &settings, &bar, &SystemClock::new())
+    let mut table = estimate_table(&m, &sp, &light, &checked, &bar, &SystemClock::new())
         .map_err(|e| anyhow::anyhow!(e.named(flag)))?;
     bar.finish();
     crate::common::zero_exact_rows(&mut table);

@@ -80,7 +80,7 @@ pub fn estimate_json(m: &Material, a: &EstimateArgs) -> Result<String, String> {
     };
     // The settings are checked before the light is parsed (a map may take
     // a while to load).
-    settings.check(m).map_err(|e| e.named(keyword))?;
+    let checked = settings.check(m).map_err(|e| e.named(keyword))?;
     let frame = Frame::from_normal_tangent(a.normal, a.tangent).ok_or_else(|| {
         format!(
             "tangent {} is parallel to normal {} (or one is zero)",
@@ -92,7 +92,7 @@ pub fn estimate_json(m: &Material, a: &EstimateArgs) -> Result<String, String> {
         Light::Env(_) => ShadingPoint { frame, wo },
         _ => ShadingPoint::local(wo),
     };
-    let table = estimate_table(m, &sp, &light, &settings, &(), &SystemClock::new())
+    let table = estimate_table(m, &sp, &light, &checked, &(), &SystemClock::new())
         .map_err(|e| e.named(keyword))?;
     serde_json::to_string(&table).map_err(|e| e.to_string())
 }

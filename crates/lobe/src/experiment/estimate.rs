@@ -193,17 +193,17 @@ impl EstimateSettings {
     }
 }
 
-/// The table the settings ask for at `sp` under `light`: checked, run
-/// ([`run_table_with`]), and refused if a row is not a finite number.
+/// The table that settings checked for `m` ([`EstimateSettings::check`])
+/// ask for at `sp` under `light`: run ([`run_table_with`]), and refused if
+/// a row is not a finite number.
 pub fn estimate_table(
     m: &Material,
     sp: &ShadingPoint,
     light: &Light,
-    settings: &EstimateSettings,
+    checked: &CheckedSettings,
     progress: &dyn Progress,
     clock: &dyn Clock,
 ) -> Result<Table, SettingsError> {
-    let checked = settings.check(m)?;
     let table = run_table_with(
         m,
         sp,
