@@ -941,7 +941,7 @@ pub fn run(args: &CompareArgs) -> Result<()> {
     let strategies = strategies.unwrap_or_else(|| default_strategies(&scene));
     let spp = args
         .spp
-        .unwrap_or(u32::try_from(scene.options.spp).unwrap_or(u32::MAX))
+        .unwrap_or(u32::try_from(scene.settings.spp).unwrap_or(u32::MAX))
         .max(1);
     let settings = CompareSettings {
         strategies,
@@ -949,12 +949,12 @@ pub fn run(args: &CompareArgs) -> Result<()> {
         reference_spp: args
             .reference_spp
             .unwrap_or_else(|| default_reference_spp(spp)),
-        seed: args.seed.unwrap_or(scene.options.seed),
+        seed: args.seed.unwrap_or(scene.settings.seed),
         sequence: match &args.sequence {
             Some(s) => crate::estimate::parse_sequence(s)?,
-            None => scene.options.sequence,
+            None => scene.settings.sequence,
         },
-        max_depth: scene.options.max_depth,
+        max_depth: scene.settings.max_depth,
         threads: args.threads.map(|t| t as usize),
         equal_time: true,
     };

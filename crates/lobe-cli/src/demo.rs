@@ -67,7 +67,7 @@ const REFERENCE_SPP: u32 = 768;
 const MAX_DEPTH: u32 = 3;
 
 /// Sizes of the run.
-struct DemoSizes {
+struct DemoSettings {
     tour_samples: usize,
     width: u32,
     height: u32,
@@ -75,10 +75,10 @@ struct DemoSizes {
     reference_spp: u32,
 }
 
-impl DemoSizes {
-    fn new(quick: bool) -> DemoSizes {
+impl DemoSettings {
+    fn new(quick: bool) -> DemoSettings {
         if quick {
-            DemoSizes {
+            DemoSettings {
                 tour_samples: 1024,
                 width: 96,
                 height: 30,
@@ -86,7 +86,7 @@ impl DemoSizes {
                 reference_spp: 16,
             }
         } else {
-            DemoSizes {
+            DemoSettings {
                 tour_samples: 65536,
                 width: 640,
                 height: 200,
@@ -117,10 +117,10 @@ const TOUR: [(&str, &str); 4] = [
 /// Run `lobe demo`.
 pub fn run(args: &DemoArgs) -> Result<()> {
     let t0 = Instant::now();
-    let plan = DemoSizes::new(args.quick);
+    let demo = DemoSettings::new(args.quick);
     crate::common::prepare_output_dir("--out", &args.out)?;
-    tour(&plan, args.quiet)?;
-    showcase(&plan, &args.out, args.quiet)?;
+    tour(&demo, args.quiet)?;
+    showcase(&demo, &args.out, args.quiet)?;
     println!(
         "\ndone in {}",
         crate::compare::fmt_time(t0.elapsed().as_secs_f64())
@@ -128,10 +128,10 @@ pub fn run(args: &DemoArgs) -> Result<()> {
     Ok(())
 }
 
-fn tour(plan: &DemoSizes, quiet: bool) -> Result<()> {
+fn tour(demo: &DemoSettings, quiet: bool) -> Result<()> {
     let wo = crate::common::theta_to_wo(30.0)?;
     let light = Light::Constant(Rgb::ONE);
-    let n = plan.tour_samples;
+    let n = demo.tour_samples;
     println!(
         "lobe demo, part 1: L_o = ∫ f_r L_i cos dω at θo = 30° under a white furnace (L_i = 1),"
     );
@@ -162,6 +162,7 @@ fn tour(plan: &DemoSizes, quiet: bool) -> Result<()> {
                 sequence: Sequence::Independent,
                 samples: n,
                 seed: 1,
+                replicas: lobe::experiment::table::REPLICAS,
             },
             &bar,
             &SystemClock::new(),
@@ -323,16 +324,16 @@ fn showcase_caption(s: &CompareSettings) -> Vec<String> {
     ]
 }
 
-fn showcase(plan: &DemoSizes, dir: &Path, quiet: bool) -> Result<()> {
-    let (scene, labels) = showcase_scene(plan.width, plan.height)?;
+fn showcase(demo: &DemoSettings, dir: &Path, quiet: bool) -> Result<()> {
+    let (scene, labels) = showcase_scene(demo.width, demo.height)?;
     let settings = CompareSettings {
         strategies: vec![
             Strategy::Bsdf(BsdfStrategy::Brdf),
             Strategy::Light,
             Strategy::MIS,
         ],
-        spp: plan.spp,
-        reference_spp: plan.reference_spp,
+        spp: demo.spp,
+        reference_spp: demo.reference_spp,
         seed: 1,
         sequence: Sequence::Sobol,
         max_depth: MAX_DEPTH,
@@ -341,7 +342,7 @@ fn showcase(plan: &DemoSizes, dir: &Path, quiet: bool) -> Result<()> {
     };
     println!(
         "lobe demo, part 2: the showcase, {}×{}: eight spheres (Phong, Blinn-Phong, GGX, Beckmann gold; a",
-        plan.width, plan.height
+        demo.width, demo.height
     );
     println!(
         "broad and a sharp lobe each) on a grey ground under the built-in sky with its sun, rendered by"
@@ -359,7 +360,7 @@ fn showcase(plan: &DemoSizes, dir: &Path, quiet: bool) -> Result<()> {
         &FigureSpec {
             title: format!(
                 "lobe demo: BSDF sampling, light sampling and MIS at {} spp under the built-in sky ({}×{}, paths of up to {} bounces)",
-                settings.spp, plan.width, plan.height, settings.max_depth
+                settings.spp, demo.width, demo.height, settings.max_depth
             ),
             cmp: &cmp,
             labels,

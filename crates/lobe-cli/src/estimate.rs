@@ -6,7 +6,7 @@ use anyhow::Result;
 use clap::Args;
 use glam::DVec3;
 use lobe::estimator::Strategy;
-use lobe::experiment::estimate::{EstimateSettings, MAX_MIS_SAMPLES, Setting, estimate_table};
+use lobe::experiment::estimate::{EstimateTableSettings, MAX_MIS_SAMPLES, Setting, estimate_table};
 use lobe::experiment::table::{StderrMethod, Table};
 use lobe::progress::SystemClock;
 use lobe::sequence::Sequence;
@@ -77,13 +77,13 @@ pub struct EstimateArgs {
 #[must_use]
 pub fn strategy_help() -> String {
     format!(
-        "`all` or a comma-separated list of techniques (all: {}). {}",
+        "`all` or a comma-separated list of strategies (all: {}). {}",
         lobe::strategy::ALL_MEANS,
         crate::common::strategy_help()
     )
 }
 
-/// Parse `all` or a list of technique names: the BSDF strategies
+/// Parse `all` or a list of strategy names: the BSDF strategies
 /// (uniform, cosine, brdf, vndf, spherical-caps, bounded-vndf), `light`,
 /// and MIS: `mis` (adaptive), `mis-balance` and `mis-power`, multi-sample,
 /// or `mis-one` and `mis-power-one`, one-sample. Each is checked against the
@@ -100,7 +100,7 @@ pub fn parse_strategies(
 }
 
 /// `B,L`: samples of BSDF and light sampling per MIS estimate (their
-/// range is checked with the other settings, [`EstimateSettings::check`]).
+/// range is checked with the other settings, [`EstimateTableSettings::check`]).
 pub fn parse_mis_samples(spec: &str) -> Result<(u32, u32)> {
     let bad = || {
         anyhow::anyhow!(
@@ -127,7 +127,7 @@ pub fn run(args: &EstimateArgs) -> Result<()> {
     let wo = args.view.wo()?;
     let light = args.light.light()?;
     let mis_samples = parse_mis_samples(&args.mis_samples)?;
-    let settings = EstimateSettings {
+    let settings = EstimateTableSettings {
         strategies: args.strategy.split(',').map(str::to_string).collect(),
         mis_bsdf: args.mis_bsdf.clone(),
         mis_samples,

@@ -66,7 +66,7 @@ pub fn run(args: &FitArgs) -> Result<()> {
     } else {
         Ndf::Ggx
     };
-    let options = lobe::fit::FitOptions {
+    let options = lobe::fit::FitSettings {
         distribution: ndf,
         fresnel: args.fresnel.parse()?,
         anisotropic: args.anisotropic,
@@ -120,15 +120,15 @@ pub fn spinner(message: &str) -> indicatif::ProgressBar {
 
 /// `ggx, α 0.123, schlick` (or `α 0.1/0.3` and `conductor`).
 pub fn fit_label(fit: &lobe::fit::Fit) -> String {
-    let alpha = if fit.options.anisotropic {
+    let alpha = if fit.settings.anisotropic {
         format!("α {:.3}/{:.3}", fit.alpha_u, fit.alpha_v)
     } else {
         format!("α {:.3}", fit.alpha_u)
     };
     format!(
         "{}, {alpha}, {}",
-        fit.options.distribution.name(),
-        fit.options.fresnel.name()
+        fit.settings.distribution.name(),
+        fit.settings.fresnel.name()
     )
 }
 

@@ -19,7 +19,7 @@ use anyhow::{Context, Result, anyhow, bail};
 use clap::Args;
 use glam::DVec3;
 use lobe::experiment::warp_test::{WarpTest, chi2_config, warp_test};
-use lobe::stats::chi2::Chi2Config;
+use lobe::stats::chi2::Chi2Settings;
 use lobe::{BsdfStrategy, Material};
 use std::path::{Path, PathBuf};
 
@@ -269,7 +269,7 @@ fn histogram(
     path: &Path,
 ) -> Result<()> {
     let sampler = m.sampler(s)?;
-    let config = Chi2Config {
+    let config = Chi2Settings {
         samples: args.samples,
         seed: args.seed,
         ..chi2_config(m)
@@ -321,13 +321,13 @@ fn comparison(args: &PlotArgs, data: &Material) -> Result<Option<(Material, Stri
     let Some(dist) = &args.fit else {
         return Ok(None);
     };
-    let options = lobe::fit::FitOptions {
+    let options = lobe::fit::FitSettings {
         distribution: if dist == "beckmann" {
             lobe::Ndf::Beckmann
         } else {
             lobe::Ndf::Ggx
         },
-        ..lobe::fit::FitOptions::default()
+        ..lobe::fit::FitSettings::default()
     };
     let pb = if args.quiet {
         indicatif::ProgressBar::hidden()

@@ -20,7 +20,7 @@ use std::time::Instant;
     about = "Render a scene under an environment map to NAME.exr and NAME.png",
     long_about = "Render a scene file: spheres, planes and OBJ meshes with lobe materials, lit by an \
                   environment map (the only light), seen by a pinhole camera. Each camera ray's hit \
-                  estimates the reflected radiance with the chosen technique exactly as `lobe estimate` \
+                  estimates the reflected radiance with the chosen strategy exactly as `lobe estimate` \
                   does, plus a shadow ray: a BSDF sampling strategy, `light` (environment-map sampling) \
                   or MIS (see --strategy; `mis`, the default, is adaptive MIS). A BSDF strategy that \
                   does not apply to an object's material (vndf on a Phong sphere, say) falls back to \
@@ -29,7 +29,7 @@ use std::time::Instant;
                   a filmic curve (ACES fit) on luminance that keeps each pixel's hue, sRGB-encoded, \
                   8 bits). Every pixel has its own randomization of the sample pattern (--sequence: \
                   Owen-scrambled Sobol by default, in its own dimensions for the pixel position, each \
-                  technique's samples and each bounce), so the image is the same for any --threads. \
+                  BSDF and light draw and each bounce), so the image is the same for any --threads. \
                   --time renders whole passes until the time is up. The samples are shared out \
                   among the pixels by their noise, as a pilot estimates it (--spp-allocation \
                   variance, the default; the same total; NAME.spp.png shows where they went): the \
@@ -78,7 +78,7 @@ pub struct RenderArgs {
     pub threads: Option<u32>,
     /// The loop that renders: batch (the default: blocks of samples on the
     /// f32 SIMD kernels of lobe::batch, direct lighting; a scene or
-    /// technique it does not cover is rendered by the scalar loop, with a
+    /// strategy it does not cover is rendered by the scalar loop, with a
     /// note) or scalar (the f64 reference loop)
     #[arg(long = "loop", value_name = "LOOP")]
     pub render_loop: Option<String>,
@@ -146,7 +146,7 @@ Examples:
 /// The help of `--strategy`: every accepted name.
 fn strategy_help() -> String {
     format!(
-        "One technique (overrides the scene's render.strategy; default mis). {}",
+        "One strategy (overrides the scene's render.strategy; default mis). {}",
         crate::common::strategy_help()
     )
 }
@@ -173,7 +173,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     };
     // `--threads` for all of the command's work, the map's loading too:
     // rayon's global pool, which the render then runs on (a pool of the
-    // same size, see `RenderOptions::threads`).
+    // same size, see `RenderSettings::threads`).
     if let Some(n) = args.threads {
         // (Fails only if the pool exists already; the render then starts a
         // pool of its own, of `n` threads.)
@@ -182,7 +182,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             .build_global();
     }
     let mut scene = load_scene(&args.scene)?;
-    let mut opts = scene.options;
+    let mut opts = scene.settings;
     if let Some(n) = args.spp {
         opts.spp = n;
     }
@@ -209,7 +209,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     if let Some(l) = &args.render_loop {
         opts.render_loop = l.parse().map_err(|m| anyhow!("--loop: {m}"))?;
     }
-    scene.options = opts;
+    scene.settings = opts;
     for w in &scene.warnings {
         eprintln!("lobe: warning: {w}");
     }

@@ -30,7 +30,7 @@ use lobe::experiment::warp_test::{WarpTest, chi2_config, warp_test};
 use lobe::math::luminance;
 use lobe::progress::SystemClock;
 use lobe::sequence::{Sequence, hash64};
-use lobe::stats::chi2::Chi2Config;
+use lobe::stats::chi2::Chi2Settings;
 use lobe::{BsdfStrategy, Light, Material, MaterialDesc, Rgb};
 use rayon::prelude::*;
 use std::fmt::Write as _;
@@ -83,7 +83,7 @@ pub struct ReportArgs {
 
 /// How much work the report does.
 #[derive(Debug, Clone, Copy)]
-struct ReportSizes {
+struct ReportSettings {
     /// Samples per estimate in the tables.
     samples: usize,
     /// Runs and largest exponent of the convergence plots.
@@ -100,10 +100,10 @@ struct ReportSizes {
     lost_samples: usize,
 }
 
-impl ReportSizes {
+impl ReportSettings {
     fn new(quick: bool) -> Self {
         if quick {
-            ReportSizes {
+            ReportSettings {
                 samples: 4096,
                 runs: 4,
                 max_exp: 8,
@@ -115,7 +115,7 @@ impl ReportSizes {
                 lost_samples: 4096,
             }
         } else {
-            ReportSizes {
+            ReportSettings {
                 samples: 1 << 16,
                 runs: 32,
                 max_exp: 14,
@@ -387,7 +387,7 @@ enum Done {
 
 pub fn run(args: &ReportArgs) -> Result<()> {
     let start = Instant::now();
-    let settings = ReportSizes::new(args.quick);
+    let settings = ReportSettings::new(args.quick);
     let dir = &args.out;
     crate::common::prepare_output_dir("--out", dir)?;
     let models = if args.materials.is_empty() {
@@ -446,6 +446,7 @@ pub fn run(args: &ReportArgs) -> Result<()> {
                         sequence: Sequence::Independent,
                         samples: settings.samples,
                         seed: args.seed,
+                        replicas: lobe::experiment::table::REPLICAS,
                     },
                     &(),
                     &SystemClock::new(),
@@ -541,7 +542,7 @@ fn run_job(
     models: &[Model],
     materials: &[Vec<Material>],
     tables: &[Vec<(f64, f64, Table)>],
-    st: &ReportSizes,
+    st: &ReportSettings,
     seed: u64,
     dir: &Path,
 ) -> Result<Done> {
@@ -615,7 +616,7 @@ fn run_job(
             let wo = view(model.warp_theta);
             let m = &materials[i][k];
             let wseed = hash64(seed ^ 0x7761_7270);
-            let cfg = Chi2Config {
+            let cfg = Chi2Settings {
                 n_z: st.chi2_nz,
                 n_phi: st.chi2_nphi,
                 samples: st.warp_samples,
@@ -849,7 +850,7 @@ fn efficiency(row: &Row) -> Option<f64> {
 }
 
 fn uniform_row(t: &Table) -> Option<&Row> {
-    t.strategies.iter().find(|r| r.name == "uniform")
+    t.row(BsdfStrategy::Uniform.into())
 }
 
 /// The full table of one shading point.
@@ -980,19 +981,15 @@ fn find_point(r: &ModelResult, value: f64, theta: f64) -> Option<&Point> {
         .find(|p| p.value == value && p.theta == theta)
 }
 
-fn variance_of(p: &Point, name: &str) -> Option<f64> {
+fn variance_of(p: &Point, s: BsdfStrategy) -> Option<f64> {
     p.table
-        .strategies
-        .iter()
-        .find(|r| r.name == name)
+        .row(s.into())
         .map(|r| if exact(r) { 0.0 } else { r.variance })
 }
 
-fn lost_of(p: &Point, name: &str) -> Option<f64> {
+fn lost_of(p: &Point, s: BsdfStrategy) -> Option<f64> {
     p.table
-        .strategies
-        .iter()
-        .position(|r| r.name == name)
+        .position(s.into())
         .and_then(|i| p.lost.get(i).copied())
 }
 
@@ -1004,8 +1001,8 @@ fn findings(model: &Model, r: &ModelResult) -> String {
         .points
         .iter()
         .filter_map(|p| {
-            let u = variance_of(p, "uniform")?;
-            let b = variance_of(p, "brdf")?;
+            let u = variance_of(p, BsdfStrategy::Uniform)?;
+            let b = variance_of(p, BsdfStrategy::Brdf)?;
             Some((p, if b > 0.0 { u / b } else { f64::INFINITY }))
         })
         .collect();
@@ -1062,10 +1059,10 @@ fn findings(model: &Model, r: &ModelResult) -> String {
         .iter()
         .filter_map(|&v| {
             let p = find_point(r, v, theta)?;
-            let b = variance_of(p, "brdf")?;
-            let n = variance_of(p, "vndf")?;
+            let b = variance_of(p, BsdfStrategy::Brdf)?;
+            let n = variance_of(p, BsdfStrategy::Vndf)?;
             all_better &= b > n;
-            let lost = lost_of(p, "brdf").unwrap_or(f64::NAN);
+            let lost = lost_of(p, BsdfStrategy::Brdf).unwrap_or(f64::NAN);
             let name = if matches!(model.source, Source::Lecture(_)) {
                 format!("{}: ", param_value(model, v))
             } else {
@@ -1111,7 +1108,7 @@ fn slope_text(c: &Curve) -> String {
     }
 }
 
-fn section(h: &mut String, model: &Model, r: &ModelResult, st: &ReportSizes) {
+fn section(h: &mut String, model: &Model, r: &ModelResult, st: &ReportSettings) {
     let fig_value = model.values[model.figure_value];
     let _ = writeln!(h, "<section id=\"{}\"><h2>{}</h2>", model.id, model.title);
     h.push_str(&model.intro);
@@ -1322,7 +1319,7 @@ fn heat_note(model: &Model) -> &'static str {
 fn page(
     models: &[Model],
     results: &[ModelResult],
-    st: &ReportSizes,
+    st: &ReportSettings,
     args: &ReportArgs,
     elapsed: f64,
 ) -> String {

@@ -5,7 +5,7 @@
 //! exactly the Rust test's.
 
 use glam::{DVec2, DVec3};
-use lobe::stats::chi2::{Chi2Config, Chi2Result, chi2_test_cells};
+use lobe::stats::chi2::{Chi2Result, Chi2Settings, chi2_test_cells};
 use lobe::stats::quadrature::Estimate;
 use rand::{RngExt, SeedableRng};
 use std::cell::Cell;
@@ -38,7 +38,7 @@ pub fn test_cells(
     cell_probs: &[f64],
     cell_errors: &[f64],
 ) -> Chi2Result {
-    let cfg = Chi2Config {
+    let cfg = Chi2Settings {
         n_z,
         n_phi,
         samples: dirs.len(),
@@ -80,12 +80,12 @@ mod tests {
     /// probabilities are exact: cosine sampling, closed-form cells.
     #[test]
     fn equals_the_harness() {
-        let cfg = Chi2Config {
+        let cfg = Chi2Settings {
             n_z: 20,
             n_phi: 40,
             samples: 100_000,
             seed: 3,
-            ..Chi2Config::default()
+            ..Chi2Settings::default()
         };
         let cosine = |u: DVec2| {
             let r = u.x.sqrt();

@@ -5,7 +5,7 @@
 
 use glam::DVec3;
 use lobe::estimator::ShadingPoint;
-use lobe::experiment::estimate::{EstimateSettings, Setting, estimate_table};
+use lobe::experiment::estimate::{EstimateTableSettings, Setting, estimate_table};
 use lobe::progress::SystemClock;
 use lobe::{Frame, Light, Material};
 
@@ -61,7 +61,7 @@ pub fn estimate_json(m: &Material, a: &EstimateArgs) -> Result<String, String> {
             DVec3::new(r.sin(), 0.0, r.cos())
         }
     };
-    let settings = EstimateSettings {
+    let settings = EstimateTableSettings {
         strategies: a.strategies.clone(),
         mis_bsdf: a.mis_bsdf.clone(),
         mis_samples: a.mis_samples,

@@ -828,7 +828,7 @@ fn _render<'py>(
 ) -> PyResult<Bound<'py, PyAny>> {
     let mut scene =
         lobe_render::parse_scene(text, std::path::Path::new(path)).map_err(value_error)?;
-    let mut opts = scene.options;
+    let mut opts = scene.settings;
     if let Some(n) = spp {
         if n == 0 {
             return Err(value_error("spp: at least 1 sample per pixel"));
@@ -858,7 +858,7 @@ fn _render<'py>(
             .map_err(|e| value_error(format!("spp_allocation: {e}")))?;
     }
     opts.threads = threads;
-    scene.options = opts;
+    scene.settings = opts;
     let (w, h) = (scene.camera.width as usize, scene.camera.height as usize);
     let img = py.detach(|| lobe_render::render(&scene, &opts, |_| {}));
     let data = img.to_rgb32f();

@@ -22,8 +22,8 @@
 //! caller's [`Progress`] and times come from the caller's [`Clock`].
 
 use crate::integrator::{Image, render};
-use crate::options::RenderOptions;
 use crate::scene::Scene;
+use crate::settings::RenderSettings;
 use lobe::BsdfStrategy;
 use lobe::estimator::{Heuristic, Strategy};
 use lobe::math::luminance;
@@ -131,7 +131,7 @@ pub fn default_reference_spp(spp: u32) -> u32 {
 #[must_use]
 pub fn render_one(
     scene: &Scene,
-    opts: &RenderOptions,
+    opts: &RenderSettings,
     label: &str,
     progress: &dyn Progress,
     clock: &dyn Clock,
@@ -214,14 +214,14 @@ pub fn run_comparison(
     clock: &dyn Clock,
 ) -> Comparison {
     let spp = s.spp.max(1);
-    let opts = |strategy: Strategy, spp: u32, seed: u64| RenderOptions {
+    let opts = |strategy: Strategy, spp: u32, seed: u64| RenderSettings {
         spp: spp.into(),
         strategy,
         seed,
         sequence: s.sequence,
         max_depth: s.max_depth,
         threads: s.threads,
-        ..RenderOptions::default()
+        ..RenderSettings::default()
     };
     for &m in &s.strategies {
         let _ = render_one(scene, &opts(m, 1, s.seed), "warm-up", progress, &NoClock);

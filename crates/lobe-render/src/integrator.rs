@@ -60,7 +60,7 @@
 //! bounce the BSDF sample's direction and lobe choice, the light sample
 //! (multi-sample MIS gives each strategy its own dimensions), the
 //! continuation's direction and lobe choice, and Russian roulette. The
-//! pattern ([`RenderOptions::sequence`]) is `sobol` (Owen-scrambled,
+//! pattern ([`RenderSettings::sequence`]) is `sobol` (Owen-scrambled,
 //! padded per pair) by default, or `stratified`, or `independent`. Pixel
 //! `(x, y)` has its own randomization, seeded from `(seed, y · width + x)`,
 //! so the image is the same bit for bit for any thread count and any order
@@ -91,12 +91,12 @@
 //!
 //! # Batch loop
 //!
-//! [`RenderOptions::render_loop`] is [`RenderLoop::Batch`] by default: for
+//! [`RenderSettings::render_loop`] is [`RenderLoop::Batch`] by default: for
 //! direct lighting (`max_depth = 1`) with a BSDF strategy, `light`, or MIS
 //! with one BSDF and one light draw (`mis`, `mis-balance`, `mis-power`),
 //! each row is rendered in blocks of [`BLOCK`] samples (consecutive samples
 //! of consecutive pixels), the whole row at the block's SIMD level: the
-//! camera rays and their hits (f64 lanes, [`crate::lanes`], testing only
+//! camera rays and their hits (f64 lanes, [`crate::ray_block`], testing only
 //! the spheres whose film box ([`crate::camera::Camera::film_bounds`]) the
 //! block's pixels overlap; the escaping rays' radiance from
 //! [`lobe::envmap::EnvMap::eval_many`]), then every BSDF draw of the block in one
@@ -127,8 +127,8 @@
 //! for any thread count.
 
 use crate::geometry::{Hit, spawn_ray};
-pub use crate::options::{RenderLoop, RenderOptions, SppAllocation};
 use crate::scene::Scene;
+pub use crate::settings::{RenderLoop, RenderSettings, SppAllocation};
 use glam::{DVec2, DVec3};
 use lobe::estimator::{
     Allocation, DrawnBsdf, Mis, MisForm, Pilot, ShadingEstimator, ShadingPoint, Strategy,
@@ -344,7 +344,7 @@ pub const SOBOL_MAX_SAMPLES: u64 = 1 << 32;
 /// (camera rays) finished, every few thousand samples of a pixel and at its
 /// end (they add up to `width × height × spp`).
 #[must_use]
-pub fn render(scene: &Scene, opts: &RenderOptions, progress: impl Fn(u64) + Sync) -> Image {
+pub fn render(scene: &Scene, opts: &RenderSettings, progress: impl Fn(u64) + Sync) -> Image {
     render_pass(scene, opts, 0, progress)
 }
 
@@ -354,7 +354,7 @@ pub fn render(scene: &Scene, opts: &RenderOptions, progress: impl Fn(u64) + Sync
 #[must_use]
 pub fn render_pass(
     scene: &Scene,
-    opts: &RenderOptions,
+    opts: &RenderSettings,
     pass: u64,
     progress: impl Fn(u64) + Sync,
 ) -> Image {
@@ -382,7 +382,7 @@ fn is_adaptive(s: Strategy) -> bool {
 
 /// Whether a render with `opts` starts with a pilot: adaptive MIS, or the
 /// variance allocation of samples.
-fn needs_pilot(opts: &RenderOptions) -> bool {
+fn needs_pilot(opts: &RenderSettings) -> bool {
     is_adaptive(opts.strategy) || opts.spp_allocation == SppAllocation::Variance
 }
 
@@ -394,7 +394,7 @@ pub const MAX_SPP_FACTOR: u64 = 64;
 /// `spp`, or [`MAX_SPP_FACTOR`] × `spp` under the variance allocation (a
 /// Sobol render needs it times the pass count ≤ [`SOBOL_MAX_SAMPLES`]).
 #[must_use]
-pub fn max_pixel_spp(opts: &RenderOptions) -> u64 {
+pub fn max_pixel_spp(opts: &RenderSettings) -> u64 {
     let spp = opts.spp.max(1);
     match opts.spp_allocation {
         SppAllocation::Uniform => spp,
@@ -537,7 +537,7 @@ pub const PILOT_RADIUS: usize = 3;
 
 /// `f` on a pool of `opts.threads` threads: the current pool (rayon's
 /// global one outside of any) when it has that many, else a new one.
-fn on_pool<T: Send>(opts: &RenderOptions, f: impl FnOnce() -> T + Send) -> T {
+fn on_pool<T: Send>(opts: &RenderSettings, f: impl FnOnce() -> T + Send) -> T {
     if let Some(n) = opts.threads
         && n != rayon::current_num_threads()
         && let Ok(pool) = rayon::ThreadPoolBuilder::new().num_threads(n).build()
@@ -555,7 +555,7 @@ fn on_pool<T: Send>(opts: &RenderOptions, f: impl FnOnce() -> T + Send) -> T {
 #[must_use]
 pub fn render_progressive(
     scene: &Scene,
-    opts: &RenderOptions,
+    opts: &RenderSettings,
     budget: Duration,
     max_passes: u64,
     progress: impl Fn(u64) + Sync,
@@ -575,7 +575,7 @@ pub fn render_progressive(
 #[must_use]
 pub fn render_until(
     scene: &Scene,
-    opts: &RenderOptions,
+    opts: &RenderSettings,
     budget: Option<Duration>,
     max_passes: u64,
     cancel: &AtomicBool,
@@ -623,7 +623,7 @@ pub fn render_until(
 /// The first bounce's shading per pixel of adaptive MIS.
 fn context<'a>(
     scene: &'a Scene,
-    opts: &RenderOptions,
+    opts: &RenderSettings,
     pass: u64,
     light: &'a Light,
     shading: &'a [ObjectShading<'a>],
@@ -647,7 +647,7 @@ fn context<'a>(
     }
 }
 
-fn shadings<'s>(scene: &'s Scene, opts: &RenderOptions) -> Vec<ObjectShading<'s>> {
+fn shadings<'s>(scene: &'s Scene, opts: &RenderSettings) -> Vec<ObjectShading<'s>> {
     scene
         .objects
         .iter()
@@ -717,13 +717,13 @@ struct Prior {
 /// in the image. `None` when `cancel` was set before its last row finished.
 fn pilot_phase(
     scene: &Scene,
-    opts: &RenderOptions,
+    opts: &RenderSettings,
     cancel: &AtomicBool,
 ) -> Option<(Prior, RenderStats)> {
     let (w, h) = (scene.camera.width as usize, scene.camera.height as usize);
     let shading = shadings(scene, opts);
     let light = Light::Env(scene.environment.clone());
-    let pilot_opts = RenderOptions {
+    let pilot_opts = RenderSettings {
         seed: hash64(opts.seed ^ 0x7069_6c6f_7470_6978),
         spp: match opts.spp_allocation {
             // (A variance needs two samples.)
@@ -733,7 +733,7 @@ fn pilot_phase(
         ..*opts
     };
     // On the batch loop where it renders the scene: the same draws,
-    // recorded from f32 lanes.
+    // recorded from f32 rows.
     let batch = batch_loop(scene, opts);
     let ctx = Context {
         cancel,
@@ -866,7 +866,7 @@ fn box_pool<T: Default + Send + Sync, U: Send>(
 /// finished: the pass is abandoned.
 fn render_on_pool(
     scene: &Scene,
-    opts: &RenderOptions,
+    opts: &RenderSettings,
     pass: u64,
     progress: &(dyn Fn(u64) + Sync),
     prior: Option<&Prior>,
@@ -1236,7 +1236,7 @@ impl Context<'_> {
 /// The batch loop for `scene` where `opts` asks for it and it covers the
 /// scene and strategy ([`batch_refusal`] says why not); else `None`, the
 /// scalar loop.
-fn batch_loop<'a>(scene: &'a Scene, opts: &RenderOptions) -> Option<wavefront::Batch<'a>> {
+fn batch_loop<'a>(scene: &'a Scene, opts: &RenderSettings) -> Option<wavefront::Batch<'a>> {
     match opts.render_loop {
         RenderLoop::Batch => {
             wavefront::Batch::new(scene, opts.strategy, opts.max_depth.max(1)).ok()

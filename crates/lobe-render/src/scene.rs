@@ -39,7 +39,7 @@ use crate::camera::{Camera, CameraError};
 use crate::envmap_io::load_envmap_checked;
 use crate::geometry::{Hit, Plane, Ray, Sphere};
 use crate::mesh::Mesh;
-use crate::options::{RenderLoop, RenderOptions, SppAllocation};
+use crate::settings::{RenderLoop, RenderSettings, SppAllocation};
 use glam::DVec3;
 use lobe::envmap::EnvMap;
 use lobe::estimator::Strategy;
@@ -157,20 +157,20 @@ pub struct Scene {
     pub environment: Arc<EnvMap>,
     pub objects: Vec<Object>,
     /// The scene's own render settings (`[render]`); callers may override.
-    pub options: RenderOptions,
+    pub settings: RenderSettings,
     /// Things worth telling the user (clamped texels, dropped triangles).
     pub warnings: Vec<String>,
 }
 
 impl Scene {
-    /// A scene with no objects and default render options.
+    /// A scene with no objects and default render settings.
     #[must_use]
     pub fn new(camera: Camera, environment: impl Into<Arc<EnvMap>>) -> Scene {
         Scene {
             camera,
             environment: environment.into(),
             objects: Vec::new(),
-            options: RenderOptions::default(),
+            settings: RenderSettings::default(),
             warnings: Vec::new(),
         }
     }
@@ -357,7 +357,7 @@ pub struct RenderDesc {
     pub sequence: String,
     #[serde(default = "default_depth")]
     pub max_depth: u32,
-    /// `variance` (the default) or `uniform` ([`crate::options::SppAllocation`]).
+    /// `variance` (the default) or `uniform` ([`crate::settings::SppAllocation`]).
     #[serde(default = "default_spp_allocation")]
     pub spp_allocation: String,
 }
@@ -724,7 +724,7 @@ fn build(desc: &SceneDesc, base: &Path) -> FieldResult<Scene> {
         .map_err(|e: String| (render_field("spp_allocation"), e))?;
 
     let mut scene = Scene::new(camera, map);
-    scene.options = RenderOptions {
+    scene.settings = RenderSettings {
         spp: r.spp,
         strategy,
         seed: r.seed,
@@ -901,8 +901,11 @@ strategy = "vndf"
     fn a_good_scene_loads() {
         let s = parse_scene(GOOD, Path::new("scene.toml")).unwrap();
         assert_eq!(s.objects.len(), 2);
-        assert_eq!(s.options.spp, 4);
-        assert_eq!(s.options.strategy, Strategy::Bsdf(lobe::BsdfStrategy::Vndf));
+        assert_eq!(s.settings.spp, 4);
+        assert_eq!(
+            s.settings.strategy,
+            Strategy::Bsdf(lobe::BsdfStrategy::Vndf)
+        );
         assert_eq!(s.camera.width, 32);
     }
 
@@ -1038,7 +1041,7 @@ strategy = "vndf"
         // And a render under it is the same image.
         let render = |env: &str| {
             let s = parse_scene(&with_environment(env), Path::new("scene.toml")).unwrap();
-            crate::render(&s, &s.options, |_| {}).pixels
+            crate::render(&s, &s.settings, |_| {}).pixels
         };
         assert_eq!(render("sky = {}"), render("path = \"sky\""));
     }

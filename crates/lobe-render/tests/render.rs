@@ -8,7 +8,7 @@ use lobe::estimator::{Heuristic, Strategy};
 use lobe::{BsdfStrategy, Material, MaterialDesc, Rgb};
 use lobe_render::integrator::RenderLoop;
 use lobe_render::{
-    Camera, Image, Mesh, Object, RenderOptions, Scene, SppAllocation, load_scene, render,
+    Camera, Image, Mesh, Object, RenderSettings, Scene, SppAllocation, load_scene, render,
 };
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -17,8 +17,8 @@ fn lambert(a: f64) -> Material {
     Material::lambert(Rgb::splat(a)).unwrap()
 }
 
-fn opts(method: Strategy, spp: u64) -> RenderOptions {
-    RenderOptions {
+fn opts(method: Strategy, spp: u64) -> RenderSettings {
+    RenderSettings {
         spp,
         strategy: method,
         seed: 3,
@@ -89,7 +89,7 @@ fn white_furnace_every_method() {
             .chain(variance.then_some((m, SppAllocation::Variance)))
     });
     for (method, spp_allocation) in allocations {
-        let o = RenderOptions {
+        let o = RenderSettings {
             spp_allocation,
             ..opts(method, 16)
         };
@@ -185,7 +185,7 @@ fn white_furnace_with_bounces() {
         Strategy::mis(Heuristic::Balance),
         Strategy::mis(Heuristic::Power),
     ] {
-        let o = RenderOptions {
+        let o = RenderSettings {
             max_depth: 32,
             ..opts(method, 16)
         };
@@ -302,7 +302,7 @@ fn sphere_on_plane() -> (Scene, Vec<(usize, usize)>) {
 fn batch_loop_matches_the_scalar_loop() {
     use lobe_render::integrator::batch_refusal;
     let (scene, px) = sphere_on_plane();
-    let scalar = |o: RenderOptions| RenderOptions {
+    let scalar = |o: RenderSettings| RenderSettings {
         render_loop: RenderLoop::Scalar,
         ..o
     };
@@ -324,7 +324,7 @@ fn batch_loop_matches_the_scalar_loop() {
             (a - b).abs() < 2e-4 * b,
             "{method}: same seed, batch {a} scalar {b}"
         );
-        let other = render(&scene, &RenderOptions { seed: 11, ..o }, |_| {});
+        let other = render(&scene, &RenderSettings { seed: 11, ..o }, |_| {});
         let diff = Image {
             pixels: other
                 .pixels
@@ -372,7 +372,7 @@ fn batch_loop_matches_the_scalar_loop() {
     for (sc, method, depth) in [(&scene, Strategy::MIS, 2), (&scene, one_sample, 1)] {
         let why = batch_refusal(sc, method, depth);
         assert!(why.is_some(), "{method} depth {depth}");
-        let o = RenderOptions {
+        let o = RenderSettings {
             max_depth: depth,
             ..opts(method, 2)
         };
@@ -744,7 +744,7 @@ fn the_same_image_for_any_thread_count() {
         }
         let one = render(
             &scene,
-            &RenderOptions {
+            &RenderSettings {
                 threads: Some(1),
                 ..o
             },
@@ -752,7 +752,7 @@ fn the_same_image_for_any_thread_count() {
         );
         let two = render(
             &scene,
-            &RenderOptions {
+            &RenderSettings {
                 threads: Some(2),
                 ..o
             },
@@ -861,10 +861,10 @@ fn scene_files_load_and_their_errors_name_file_line_and_field() {
     assert_eq!(scene.objects.len(), 2);
     // vndf does not apply to Phong or Lambert: both fall back to brdf.
     assert_eq!(
-        lobe_render::fallbacks(&scene, scene.options.strategy).len(),
+        lobe_render::fallbacks(&scene, scene.settings.strategy).len(),
         2
     );
-    let img = render(&scene, &scene.options, |_| {});
+    let img = render(&scene, &scene.settings, |_| {});
     assert!(img.pixels.iter().all(|p| p.is_finite()));
 
     let bad = dir.join("bad.toml");
@@ -910,8 +910,8 @@ fn scene_files_load_and_their_errors_name_file_line_and_field() {
 
     std::fs::write(&bad, format!("{SCENE}spp_allocation = \"uniform\"\n")).unwrap();
     let s = load_scene(&bad).unwrap();
-    assert_eq!(s.options.spp_allocation, SppAllocation::Uniform);
-    assert_eq!(scene.options.spp_allocation, SppAllocation::Variance);
+    assert_eq!(s.settings.spp_allocation, SppAllocation::Uniform);
+    assert_eq!(scene.settings.spp_allocation, SppAllocation::Variance);
     std::fs::write(&bad, format!("{SCENE}spp_allocation = \"even\"\n")).unwrap();
     let e = load_scene(&bad).unwrap_err().to_string();
     assert!(

@@ -384,12 +384,12 @@ impl<'m> ShadingEstimator<'m> {
     }
 
     /// Adaptive MIS at one shading point: run a pilot of
-    /// [`pilot_samples`]`(plan.samples)` samples of its own (independent
-    /// numbers, a seed apart from the plan's, not part of the estimate) and
+    /// [`pilot_samples`]`(settings.samples)` samples of its own (independent
+    /// numbers, a seed apart from the settings', not part of the estimate) and
     /// return this estimator with the allocation the pilot chose. Any other
     /// strategy is returned as it is.
     #[must_use]
-    pub fn prepare(&self, sp: &ShadingPoint, light: &Light, plan: &Plan) -> Self {
+    pub fn prepare(&self, sp: &ShadingPoint, light: &Light, settings: &EstimateSettings) -> Self {
         let Strategy::Mis(mis) = self.strategy else {
             return *self;
         };
@@ -397,8 +397,8 @@ impl<'m> ShadingEstimator<'m> {
             return *self;
         }
         let k = self.strategy.points_per_sample();
-        let n = pilot_samples(plan.samples);
-        let seed = sequence::hash64(plan.seed ^ 0x7069_6c6f_7421_0000);
+        let n = pilot_samples(settings.samples);
+        let seed = sequence::hash64(settings.seed ^ 0x7069_6c6f_7421_0000);
         let mut points = vec![[0.0; 3]; n * k];
         sequence::fill(Sequence::Independent, seed, n * k, 0, 0, &mut points);
         let mut pilot = Pilot::default();
@@ -702,12 +702,12 @@ fn light_value(
     }
 }
 
-/// What one estimate is: a strategy, a sequence, a number of samples and a
-/// seed. One sample of multi-sample MIS draws `n_bsdf + n_light` directions
+/// The settings of one [`estimate`]: a strategy, a sequence, a number of
+/// samples and a seed. One sample of multi-sample MIS draws `n_bsdf + n_light` directions
 /// (as one sample per pixel of a renderer's MIS does); compare strategies of
 /// different cost by efficiency, 1/(variance × time).
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Plan {
+pub struct EstimateSettings {
     pub strategy: Strategy,
     pub sequence: Sequence,
     /// Number of samples (of `points_per_sample` directions each).
@@ -715,11 +715,11 @@ pub struct Plan {
     pub seed: u64,
 }
 
-impl Plan {
+impl EstimateSettings {
     /// `samples` independent samples with `seed`.
     #[must_use]
     pub fn independent(strategy: impl Into<Strategy>, samples: usize, seed: u64) -> Self {
-        Plan {
+        EstimateSettings {
             strategy: strategy.into(),
             sequence: Sequence::Independent,
             samples,
@@ -742,23 +742,23 @@ impl Plan {
 
 /// Estimate chunk by chunk, in order, on this thread. A caller with threads
 /// runs [`estimate_chunk`] for every chunk and merges them in chunk order,
-/// which gives the same numbers. The error says why the plan's strategy
+/// which gives the same numbers. The error says why the settings' strategy
 /// does not apply to `m`.
 pub fn estimate(
     m: &Material,
     sp: &ShadingPoint,
     light: &Light,
-    plan: &Plan,
+    settings: &EstimateSettings,
 ) -> Result<Accumulator, Error> {
-    let est = ShadingEstimator::new(plan.strategy, m)?.prepare(sp, light, plan);
+    let est = ShadingEstimator::new(settings.strategy, m)?.prepare(sp, light, settings);
     let mut acc = Accumulator::default();
-    for chunk in 0..plan.chunks() {
-        acc.merge(&estimate_chunk(&est, sp, light, plan, chunk));
+    for chunk in 0..settings.chunks() {
+        acc.merge(&estimate_chunk(&est, sp, light, settings, chunk));
     }
     Ok(acc)
 }
 
-/// The estimates of chunk `chunk` of `plan`, by `est` (the plan's strategy
+/// The estimates of chunk `chunk` of `settings`, by `est` (the settings' strategy
 /// validated for the material, and for adaptive MIS
 /// [`ShadingEstimator::prepare`]d at this point).
 #[must_use]
@@ -766,19 +766,19 @@ pub fn estimate_chunk(
     est: &ShadingEstimator,
     sp: &ShadingPoint,
     light: &Light,
-    plan: &Plan,
+    settings: &EstimateSettings,
     chunk: usize,
 ) -> Accumulator {
-    let k = plan.strategy.points_per_sample();
+    let k = settings.strategy.points_per_sample();
     let first = chunk * CHUNK;
-    let len = CHUNK.min(plan.estimates().saturating_sub(first));
+    let len = CHUNK.min(settings.estimates().saturating_sub(first));
     let mut points = vec![[0.0; 3]; len * k];
-    if k == 1 || plan.sequence == Sequence::Independent {
+    if k == 1 || settings.sequence == Sequence::Independent {
         // Independent numbers: the points of one sample are consecutive.
         sequence::fill(
-            plan.sequence,
-            plan.seed,
-            plan.estimates() * k,
+            settings.sequence,
+            settings.seed,
+            settings.estimates() * k,
             chunk,
             first * k,
             &mut points,
@@ -790,9 +790,9 @@ pub fn estimate_chunk(
         let mut stream = vec![[0.0; 3]; len];
         for t in 0..k {
             sequence::fill(
-                plan.sequence,
-                sequence::stream_seed(plan.seed, t),
-                plan.estimates(),
+                settings.sequence,
+                sequence::stream_seed(settings.seed, t),
+                settings.estimates(),
                 chunk,
                 first,
                 &mut stream,

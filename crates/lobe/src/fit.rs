@@ -1,7 +1,7 @@
 //! Fit an analytic material to a measured one (`lobe fit`).
 //!
 //! The model is Cook-Torrance (GGX or Beckmann, Smith height-correlated
-//! shadowing, `ks = 1`) plus a Lambertian `kd`, with ([`FitOptions`]):
+//! shadowing, `ks = 1`) plus a Lambertian `kd`, with ([`FitSettings`]):
 //! * an isotropic `alpha`, or (`anisotropic`) `alpha_u` along the tangent
 //!   x and `alpha_v` along y;
 //! * a Schlick Fresnel term with an RGB `f0`, or (`FresnelFit::Conductor`)
@@ -75,7 +75,7 @@ impl std::str::FromStr for FresnelFit {
 
 /// What is fitted.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct FitOptions {
+pub struct FitSettings {
     /// GGX or Beckmann.
     pub distribution: Ndf,
     pub fresnel: FresnelFit,
@@ -83,10 +83,10 @@ pub struct FitOptions {
     pub anisotropic: bool,
 }
 
-impl Default for FitOptions {
+impl Default for FitSettings {
     /// GGX, Schlick, isotropic.
     fn default() -> Self {
-        FitOptions {
+        FitSettings {
             distribution: Ndf::Ggx,
             fresnel: FresnelFit::Schlick,
             anisotropic: false,
@@ -97,7 +97,7 @@ impl Default for FitOptions {
 /// A fitted material.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Fit {
-    pub options: FitOptions,
+    pub settings: FitSettings,
     /// `alpha_u` (= `alpha_v` unless anisotropic).
     pub alpha_u: f64,
     pub alpha_v: f64,
@@ -117,7 +117,7 @@ impl Fit {
     /// The fitted material.
     pub fn material(&self) -> crate::error::Result<Material> {
         model(
-            self.options.distribution,
+            self.settings.distribution,
             self.alpha_u,
             self.alpha_v,
             self.fresnel,
@@ -135,7 +135,7 @@ impl Fit {
     #[must_use]
     pub fn to_json(&self) -> String {
         let c = |v: Rgb| format!("[{:.6},{:.6},{:.6}]", v.x, v.y, v.z);
-        let alpha = if self.options.anisotropic {
+        let alpha = if self.settings.anisotropic {
             format!(
                 r#""alpha_u":{:.6},"alpha_v":{:.6}"#,
                 self.alpha_u, self.alpha_v
@@ -152,7 +152,7 @@ impl Fit {
         };
         format!(
             r#"{{"type":"cook-torrance","distribution":"{}",{alpha},"shadowing":"smith-correlated","kd":{},"fresnel":{fresnel}}}"#,
-            self.options.distribution.name(),
+            self.settings.distribution.name(),
             c(self.kd),
         )
     }
@@ -241,7 +241,7 @@ fn logit(p: f64) -> f64 {
 /// `(alpha_u, alpha_v, fresnel, kd)` of a point of the search space:
 /// `ln alpha_u [, ln alpha_v]`, then `logit f0` (3) or `ln eta`, `ln k`
 /// (3 + 3), then `logit kd` (3).
-fn params(o: FitOptions, x: &[f64]) -> (f64, f64, Fresnel, Rgb) {
+fn params(o: FitSettings, x: &[f64]) -> (f64, f64, Fresnel, Rgb) {
     let a = |v: f64| v.exp().clamp(1e-3, 1.0);
     let au = a(x[0]);
     let (av, i) = if o.anisotropic { (a(x[1]), 2) } else { (au, 1) };
@@ -266,7 +266,7 @@ fn params(o: FitOptions, x: &[f64]) -> (f64, f64, Fresnel, Rgb) {
 
 /// The start of the search space for `alpha`, a Fresnel guess (`f0`, or
 /// `(eta, k)`) and `kd`.
-fn start(o: FitOptions, alpha: f64, f0: f64, eta_k: (f64, f64), kd: f64) -> Vec<f64> {
+fn start(o: FitSettings, alpha: f64, f0: f64, eta_k: (f64, f64), kd: f64) -> Vec<f64> {
     let mut x = vec![alpha.ln()];
     if o.anisotropic {
         x.push(alpha.ln());
@@ -292,7 +292,7 @@ const CHUNK: usize = 2048;
 /// material), whose parameters are then within about 1e-5 relative.
 const EXACT: f64 = 1e-11;
 
-fn error(t: &Target, o: FitOptions, x: &[f64]) -> f64 {
+fn error(t: &Target, o: FitSettings, x: &[f64]) -> f64 {
     let (au, av, fresnel, kd) = params(o, x);
     let Ok(m) = model(o.distribution, au, av, fresnel, kd) else {
         return f64::INFINITY;
@@ -406,32 +406,32 @@ fn nelder_mead(
 
 /// Fit Cook-Torrance with `distribution` (GGX or Beckmann), a Schlick
 /// Fresnel term, one alpha and a Lambertian term to `target` (any
-/// material; a measured one in practice): [`fit`] with those options.
+/// material; a measured one in practice): [`fit`] with those settings.
 pub fn fit_cook_torrance(
     target_material: &Material,
     distribution: Ndf,
 ) -> crate::error::Result<Fit> {
     fit(
         target_material,
-        FitOptions {
+        FitSettings {
             distribution,
-            ..FitOptions::default()
+            ..FitSettings::default()
         },
     )
 }
 
-/// Fit Cook-Torrance + Lambert with `options` to `target_material` (any
+/// Fit Cook-Torrance + Lambert with `settings` to `target_material` (any
 /// material; a measured one in practice). Errors: the Blinn-Phong NDF, a
 /// target that reflects nothing at the fitting pairs.
-pub fn fit(target_material: &Material, options: FitOptions) -> crate::error::Result<Fit> {
-    if options.distribution == Ndf::BlinnPhong {
+pub fn fit(target_material: &Material, settings: FitSettings) -> crate::error::Result<Fit> {
+    if settings.distribution == Ndf::BlinnPhong {
         return Err(crate::Error::UnknownName {
             field: "distribution".into(),
             value: "blinn-phong".into(),
             expected: "ggx, beckmann".into(),
         });
     }
-    let full = target(target_material, options.anisotropic);
+    let full = target(target_material, settings.anisotropic);
     if full.pairs.is_empty() {
         return Err(crate::Error::param(
             "material",
@@ -440,19 +440,19 @@ pub fn fit(target_material: &Material, options: FitOptions) -> crate::error::Res
     }
     let coarse = full.every(COARSE);
     let mut evaluations = 0.0;
-    let dims = start(options, 0.3, 0.5, (1.0, 1.0), 0.3).len();
+    let dims = start(settings, 0.3, 0.5, (1.0, 1.0), 0.3).len();
     let max_evals = 200 * dims + 100;
     // Coarse: the starts on every COARSE-th pair.
     let mut best: Option<(Vec<f64>, f64)> = None;
     {
-        let mut f = |x: &[f64]| error(&coarse, options, x);
+        let mut f = |x: &[f64]| error(&coarse, settings, x);
         // (alpha, f0, (eta, k), kd): a rough plastic, a glossy metal, a matte one.
         for (alpha, f0, eta_k, kd) in [
             (0.3, 0.5, (1.0, 2.0), 0.3),
             (0.05, 0.9, (0.3, 3.0), 0.05),
             (0.7, 0.1, (1.5, 0.5), 0.6),
         ] {
-            let x0 = start(options, alpha, f0, eta_k, kd);
+            let x0 = start(settings, alpha, f0, eta_k, kd);
             // Two rounds: restart from the best point with a fresh simplex.
             let (x1, _, e1) = nelder_mead(&mut f, &x0, 0.5, 1e-6, 1e-9, max_evals);
             let (x2, v2, e2) = nelder_mead(&mut f, &x1, 0.1, 1e-8, 1e-14, max_evals);
@@ -468,12 +468,12 @@ pub fn fit(target_material: &Material, options: FitOptions) -> crate::error::Res
     }
     // Fine: every pair, from the coarse fit.
     let (x0, _) = best.expect("three starts");
-    let mut f = |x: &[f64]| error(&full, options, x);
+    let mut f = |x: &[f64]| error(&full, settings, x);
     let (x, e, n) = nelder_mead(&mut f, &x0, 0.05, 1e-8, 1e-14, max_evals);
     evaluations += n as f64;
-    let (alpha_u, alpha_v, fresnel, kd) = params(options, &x);
+    let (alpha_u, alpha_v, fresnel, kd) = params(settings, &x);
     Ok(Fit {
-        options,
+        settings,
         alpha_u,
         alpha_v,
         fresnel,

@@ -53,13 +53,13 @@
 //!
 //! ```
 //! # #[cfg(feature = "desc")] {
-//! use lobe::estimator::{Plan, ShadingPoint, estimate, reference};
+//! use lobe::estimator::{EstimateSettings, ShadingPoint, estimate, reference};
 //! use lobe::{Light, Material, Rgb, Strategy};
 //! let m = Material::load(r#"{"type":"phong","exponent":100}"#)?;
 //! let sp = ShadingPoint::local(lobe::frame::wo_from_theta(30.0, 0.0));
 //! let light = Light::Constant(Rgb::ONE);
 //! let strategy: Strategy = "mis".parse()?;
-//! let acc = estimate(&m, &sp, &light, &Plan::independent(strategy, 1 << 16, 1))?;
+//! let acc = estimate(&m, &sp, &light, &EstimateSettings::independent(strategy, 1 << 16, 1))?;
 //! let exact = reference(&m, &sp, &light, 1e-9);
 //! assert!((acc.mean().x - exact.x).abs() < 5.0 * acc.std_error().x + 1e-12);
 //! # }

@@ -14,7 +14,7 @@ pub mod quadrature;
 pub mod ttest;
 
 #[cfg(feature = "stats")]
-pub use chi2::{Chi2Config, Chi2Result, chi2_test, chi2_test_many, sidak, success_probability};
+pub use chi2::{Chi2Result, Chi2Settings, chi2_test, chi2_test_many, sidak, success_probability};
 pub use quadrature::{
     Estimate, Tolerance, integrate_2d, integrate_hemisphere, integrate_sphere,
     integrate_sphere_region, integrate_sphere_region_many,

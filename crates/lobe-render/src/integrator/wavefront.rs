@@ -6,7 +6,7 @@
 //! ("Batch loop") for what it covers and how it is checked.
 
 use super::{Context, FirstBounce, Moments, RenderStats, dims, pixel_seed};
-use crate::lanes::{HitLanes, NO_HIT, RayLanes, Vec3Lanes, spawn_many};
+use crate::ray_block::{HitBlock, NO_HIT, RayBlock, Vec3Block, spawn_many};
 use crate::scene::{Scene, Shape};
 use glam::{DVec2, DVec3};
 use lobe::batch::{
@@ -175,8 +175,8 @@ impl<'a> Batch<'a> {
 /// Per sample of a block that hits a surface facing the camera.
 #[derive(Debug, Clone, Copy)]
 struct Point {
-    /// The sample's index in the block (its column is `Lanes::px[m]`, its
-    /// estimate goes to `Lanes::value[m]`).
+    /// The sample's index in the block (its column is `RowBlock::px[m]`, its
+    /// estimate goes to `RowBlock::value[m]`).
     m: u32,
     /// The object hit.
     obj: u32,
@@ -223,7 +223,7 @@ impl Default for Draw {
 }
 
 /// Reusable structure-of-arrays buffers of one row.
-struct Lanes {
+struct RowBlock {
     a: [Vec<f32>; 6],
     out: [Vec<f32>; 10],
     valid: Vec<u8>,
@@ -263,13 +263,13 @@ struct Lanes {
     plans: Vec<PixelPlan>,
     value: Vec<Rgb>,
     /// The block's camera rays and their hits; then its shadow rays.
-    rays: RayLanes,
-    hits: HitLanes,
+    rays: RayBlock,
+    hits: HitBlock,
     /// The shadow rays' origins (the hit points), normals and directions,
     /// each ray's draw index, and whether it is blocked.
-    shadow_p: Vec3Lanes,
-    shadow_ng: Vec3Lanes,
-    shadow_dir: Vec3Lanes,
+    shadow_p: Vec3Block,
+    shadow_ng: Vec3Block,
+    shadow_dir: Vec3Block,
     shadow_draw: Vec<usize>,
     blocked: Vec<bool>,
 }
@@ -278,10 +278,10 @@ struct Lanes {
 /// lobe choice, light ([`PixelSeeds`] in this order).
 const PAIRS: usize = 4;
 
-impl Lanes {
+impl RowBlock {
     fn new() -> Self {
         let v = || vec![0.0f32; 2 * BLOCK];
-        Lanes {
+        RowBlock {
             a: std::array::from_fn(|_| v()),
             out: std::array::from_fn(|_| v()),
             valid: vec![0; 2 * BLOCK],
@@ -304,19 +304,19 @@ impl Lanes {
             runs: Vec::with_capacity(BLOCK),
             plans: Vec::with_capacity(BLOCK),
             value: Vec::with_capacity(BLOCK),
-            rays: RayLanes::default(),
-            hits: HitLanes::default(),
-            shadow_p: Vec3Lanes::default(),
-            shadow_ng: Vec3Lanes::default(),
-            shadow_dir: Vec3Lanes::default(),
+            rays: RayBlock::default(),
+            hits: HitBlock::default(),
+            shadow_p: Vec3Block::default(),
+            shadow_ng: Vec3Block::default(),
+            shadow_dir: Vec3Block::default(),
             shadow_draw: Vec::with_capacity(2 * BLOCK),
             blocked: Vec::with_capacity(2 * BLOCK),
         }
     }
 }
 
-/// A row's reusable buffers: its lanes, points and draws.
-type RowBuffers = (Lanes, Vec<Point>, Vec<Draw>);
+/// A row's reusable buffers: its ray block, points and draws.
+type RowBuffers = (RowBlock, Vec<Point>, Vec<Draw>);
 
 thread_local! {
     /// A worker thread's row buffers, kept between the rows it renders (a
@@ -410,9 +410,9 @@ impl Batch<'_> {
         let mut stats = RenderStats::default();
         // The thread's buffers from its last row (every block writes what
         // it reads), or new ones.
-        let (mut lanes, mut pts, mut draws) = ROW_BUFFERS.take().unwrap_or_else(|| {
+        let (mut rows, mut pts, mut draws) = ROW_BUFFERS.take().unwrap_or_else(|| {
             (
-                Lanes::new(),
+                RowBlock::new(),
                 Vec::with_capacity(BLOCK),
                 vec![Draw::default(); 2 * BLOCK],
             )
@@ -425,14 +425,14 @@ impl Batch<'_> {
             // The block's samples, pixel by pixel: each one's column, plan
             // and index in its pixel's sequence, and (Sobol) its pairs'
             // seeds; independent or stratified numbers: its seeds.
-            for v in &mut lanes.pair_seeds {
+            for v in &mut rows.pair_seeds {
                 v.clear();
             }
-            lanes.pair_index.clear();
-            lanes.px.clear();
-            lanes.runs.clear();
-            lanes.plans.clear();
-            lanes.each.clear();
+            rows.pair_index.clear();
+            rows.px.clear();
+            rows.runs.clear();
+            rows.plans.clear();
+            rows.each.clear();
             let mut filled = 0usize;
             while filled < BLOCK && x < row.len() {
                 // (A pixel's plan is asked again when its samples go on in
@@ -442,9 +442,9 @@ impl Batch<'_> {
                 if run > 0 {
                     let seeds = pixel_seeds(ctx, x, y);
                     let plan = self.plan(mode);
-                    lanes.px.extend(std::iter::repeat_n(x as f64, run));
-                    lanes.runs.push((x, run));
-                    lanes.plans.extend(std::iter::repeat_n(plan, run));
+                    rows.px.extend(std::iter::repeat_n(x as f64, run));
+                    rows.runs.push((x, run));
+                    rows.plans.extend(std::iter::repeat_n(plan, run));
                     for i in i0..i0 + run as u64 {
                         let index = match ctx.sequence {
                             Sequence::Stratified => i,
@@ -452,13 +452,13 @@ impl Batch<'_> {
                         };
                         if sobol {
                             debug_assert!(index <= u64::from(u32::MAX));
-                            lanes.pair_index.push(index as u32);
+                            rows.pair_index.push(index as u32);
                         } else {
-                            lanes.each.push((seeds, index, n));
+                            rows.each.push((seeds, index, n));
                         }
                     }
                     if sobol {
-                        for (v, s) in lanes.pair_seeds.iter_mut().zip(seeds.all()) {
+                        for (v, s) in rows.pair_seeds.iter_mut().zip(seeds.all()) {
                             v.extend(std::iter::repeat_n(SobolKeys::new(s), run));
                         }
                     }
@@ -475,36 +475,35 @@ impl Batch<'_> {
             }
             // The camera pairs of every sample; the other pairs (below)
             // only for the samples that hit.
-            let n = lanes.px.len();
-            let (jx, jy) = (&mut lanes.pair_x[0][..n], &mut lanes.pair_y[0][..n]);
+            let n = rows.px.len();
+            let (jx, jy) = (&mut rows.pair_x[0][..n], &mut rows.pair_y[0][..n]);
             if sobol {
-                sobol_pairs(self.level, &lanes.pair_seeds[0], &lanes.pair_index, jx, jy);
+                sobol_pairs(self.level, &rows.pair_seeds[0], &rows.pair_index, jx, jy);
             } else {
-                for ((&(seeds, index, n), x), y) in lanes.each.iter().zip(jx).zip(jy) {
+                for ((&(seeds, index, n), x), y) in rows.each.iter().zip(jx).zip(jy) {
                     [*x, *y] = seeded_pair(ctx, &seeds, n, index, 0).to_array();
                 }
             }
             // The block's camera rays, traced together.
-            lanes.film.0.clear();
-            lanes.film.1.clear();
+            rows.film.0.clear();
+            rows.film.1.clear();
             let yf = y as f64;
-            let (jx, jy) = (&lanes.pair_x[0][..n], &lanes.pair_y[0][..n]);
-            lanes
-                .film
+            let (jx, jy) = (&rows.pair_x[0][..n], &rows.pair_y[0][..n]);
+            rows.film
                 .0
-                .extend(lanes.px.iter().zip(jx).map(|(&x, &j)| x + j));
-            lanes.film.1.extend(jy.iter().map(|&j| yf + j));
-            self.camera_points(ctx, y, &mut pts, &mut lanes, &mut stats);
+                .extend(rows.px.iter().zip(jx).map(|(&x, &j)| x + j));
+            rows.film.1.extend(jy.iter().map(|&j| yf + j));
+            self.camera_points(ctx, y, &mut pts, &mut rows, &mut stats);
             if sobol {
                 // The shading pairs of the samples that hit, compacted: a
                 // gather per array, written by index (no `push`es).
                 let n = pts.len();
-                lanes.hit_index.resize(n, 0);
-                for (h, pt) in lanes.hit_index.iter_mut().zip(&pts) {
-                    *h = lanes.pair_index[pt.m as usize];
+                rows.hit_index.resize(n, 0);
+                for (h, pt) in rows.hit_index.iter_mut().zip(&pts) {
+                    *h = rows.pair_index[pt.m as usize];
                 }
                 for p in self.shading_pairs() {
-                    let (dst, src) = (&mut lanes.hit_seeds[p], &lanes.pair_seeds[p]);
+                    let (dst, src) = (&mut rows.hit_seeds[p], &rows.pair_seeds[p]);
                     dst.resize(n, SobolKeys::default());
                     for (d, pt) in dst.iter_mut().zip(&pts) {
                         *d = src[pt.m as usize];
@@ -513,14 +512,14 @@ impl Batch<'_> {
                 for p in self.shading_pairs() {
                     sobol_pairs(
                         self.level,
-                        &lanes.hit_seeds[p],
-                        &lanes.hit_index,
-                        &mut lanes.pair_x[p][..n],
-                        &mut lanes.pair_y[p][..n],
+                        &rows.hit_seeds[p],
+                        &rows.hit_index,
+                        &mut rows.pair_x[p][..n],
+                        &mut rows.pair_y[p][..n],
                     );
                 }
                 for (h, pt) in pts.iter_mut().enumerate() {
-                    let (px, py) = (&lanes.pair_x, &lanes.pair_y);
+                    let (px, py) = (&rows.pair_x, &rows.pair_y);
                     self.assign_u(pt, |p| DVec2::new(px[p][h], py[p][h]));
                 }
             }
@@ -528,16 +527,16 @@ impl Batch<'_> {
                 ctx.scene,
                 &pts,
                 &mut draws,
-                &mut lanes,
+                &mut rows,
                 &mut stats,
                 pilots.as_deref_mut(),
             );
             // Each pixel's values added to its sum in sample order, the sum
             // held in a register over the pixel's run.
             let mut m = 0;
-            for &(x, run) in &lanes.runs {
+            for &(x, run) in &rows.runs {
                 let mut acc = row[x];
-                for v in &lanes.value[m..m + run] {
+                for v in &rows.value[m..m + run] {
                     if v.is_finite() {
                         acc += *v;
                     } else {
@@ -546,7 +545,7 @@ impl Batch<'_> {
                 }
                 row[x] = acc;
                 if let Some(mo) = moments.as_deref_mut() {
-                    for v in &lanes.value[m..m + run] {
+                    for v in &rows.value[m..m + run] {
                         mo[x].add(*v);
                     }
                 }
@@ -559,15 +558,15 @@ impl Batch<'_> {
                 break;
             }
         }
-        ROW_BUFFERS.set(Some((lanes, pts, draws)));
+        ROW_BUFFERS.set(Some((rows, pts, draws)));
         stats
     }
 
-    /// The camera rays of a block of row `y` (film positions `lanes.film`), their
+    /// The camera rays of a block of row `y` (film positions `rows.film`), their
     /// hits and shading frames: a [`Point`] in `pts` per sample that hits
-    /// and faces the camera, in sample order; `lanes.value` the map's
+    /// and faces the camera, in sample order; `rows.value` the map's
     /// radiance for a sample whose ray escapes, else zero. With
-    /// independent or stratified numbers (`lanes.each`) the points also get
+    /// independent or stratified numbers (`rows.each`) the points also get
     /// their draws' numbers.
     #[inline(always)]
     fn camera_points(
@@ -575,38 +574,38 @@ impl Batch<'_> {
         ctx: &Context<'_>,
         y: usize,
         pts: &mut Vec<Point>,
-        lanes: &mut Lanes,
+        rows: &mut RowBlock,
         stats: &mut RenderStats,
     ) {
-        let n = lanes.film.0.len();
+        let n = rows.film.0.len();
         ctx.scene
             .camera
-            .rays_many(self.level, &lanes.film.0, &lanes.film.1, &mut lanes.rays);
+            .rays_many(self.level, &rows.film.0, &rows.film.1, &mut rows.rays);
         stats.camera_rays += n as u64;
         stats.rays += n as u64;
         // The objects whose film box the block's pixels overlap (the block
         // covers [x0, x1 + 1) × [y, y + 1) of the film).
-        let (x0, x1) = (lanes.px[0], lanes.px[n - 1] + 1.0);
+        let (x0, x1) = (rows.px[0], rows.px[n - 1] + 1.0);
         let y = y as f64;
         let may_hit = |k: usize| {
             self.film_bounds[k]
                 .is_none_or(|b| x1 >= b[0] && x0 <= b[1] && y + 1.0 >= b[2] && y <= b[3])
         };
         ctx.scene
-            .intersect_many_where(self.level, &lanes.rays, &mut lanes.hits, may_hit);
-        lanes.bsdf_dirs.clear();
-        lanes.draw_index.clear();
-        lanes.value.clear();
-        lanes.value.resize(n, Rgb::ZERO);
-        // (Slices borrowed once, see `Vec3Lanes::view`.)
-        let h = &lanes.hits;
+            .intersect_many_where(self.level, &rows.rays, &mut rows.hits, may_hit);
+        rows.bsdf_dirs.clear();
+        rows.draw_index.clear();
+        rows.value.clear();
+        rows.value.resize(n, Rgb::ZERO);
+        // (Slices borrowed once, see `Vec3Block::view`.)
+        let h = &rows.hits;
         let (obj, hp, hng, hns) = (&h.obj[..n], h.p.view(n), h.ng.view(n), h.ns.view(n));
-        let (dirs, plans) = (lanes.rays.dir.view(n), &lanes.plans[..n]);
+        let (dirs, plans) = (rows.rays.dir.view(n), &rows.plans[..n]);
         for m in 0..n {
             let dir = dirs.get(m);
             if obj[m] == NO_HIT {
-                lanes.bsdf_dirs.push(dir);
-                lanes.draw_index.push(m);
+                rows.bsdf_dirs.push(dir);
+                rows.draw_index.push(m);
                 continue;
             }
             // The scalar loop's normals (see `Context::radiance`).
@@ -632,18 +631,18 @@ impl Batch<'_> {
                 plan: plans[m],
                 u: [[0.0; 3]; 2],
             };
-            if let Some(&(seeds, index, n)) = lanes.each.get(m) {
+            if let Some(&(seeds, index, n)) = rows.each.get(m) {
                 self.assign_u(&mut pt, |p| seeded_pair(ctx, &seeds, n, index, p));
             }
             pts.push(pt);
         }
         // The map's radiance where the rays escape.
-        let e = lanes.bsdf_dirs.len();
-        lanes.miss_radiance.resize(e, Rgb::ZERO);
+        let e = rows.bsdf_dirs.len();
+        rows.miss_radiance.resize(e, Rgb::ZERO);
         self.env
-            .eval_many(&lanes.bsdf_dirs, &mut lanes.miss_radiance[..e]);
-        for (&m, &l) in lanes.draw_index.iter().zip(&lanes.miss_radiance[..e]) {
-            lanes.value[m] = l;
+            .eval_many(&rows.bsdf_dirs, &mut rows.miss_radiance[..e]);
+        for (&m, &l) in rows.draw_index.iter().zip(&rows.miss_radiance[..e]) {
+            rows.value[m] = l;
         }
     }
 
@@ -690,14 +689,14 @@ impl Batch<'_> {
 
     /// The draws of a block: BSDF samples and light samples' `f` and pdf
     /// in batches per object, then the shadow rays and the estimates (into
-    /// `lanes.value`, at each point's sample).
+    /// `rows.value`, at each point's sample).
     #[inline(always)]
     fn shade(
         &self,
         scene: &Scene,
         pts: &[Point],
         draws: &mut [Draw],
-        lanes: &mut Lanes,
+        rows: &mut RowBlock,
         stats: &mut RenderStats,
         mut pilots: Option<&mut [Pilot]>,
     ) {
@@ -705,13 +704,13 @@ impl Batch<'_> {
         // whole block (`EnvMap::sample_lookup_many`).
         // A draw's bucket: its object, then BSDF 0 / light 1.
         let buckets = 2 * self.samplers.len();
-        lanes.buckets.resize_with(buckets, Vec::new);
-        for b in &mut lanes.buckets {
+        rows.buckets.resize_with(buckets, Vec::new);
+        for b in &mut rows.buckets {
             b.clear();
         }
         let bucket = |obj: u32, light: bool| 2 * obj as usize + usize::from(light);
-        lanes.light_u.clear();
-        lanes.draw_index.clear();
+        rows.light_u.clear();
+        rows.draw_index.clear();
         let draws = &mut draws[..2 * pts.len()];
         for (i, (pt, pair)) in pts.iter().zip(draws.chunks_exact_mut(2)).enumerate() {
             for (s, d) in pair.iter_mut().enumerate() {
@@ -723,23 +722,22 @@ impl Batch<'_> {
                 match slot {
                     Slot::Unused => {}
                     Slot::Bsdf => {
-                        lanes.buckets[bucket(pt.obj, false)].push((2 * i + s) as u32);
+                        rows.buckets[bucket(pt.obj, false)].push((2 * i + s) as u32);
                     }
                     Slot::Light | Slot::LightCompensated => {
                         let compensated = slot == Slot::LightCompensated;
-                        lanes
-                            .light_u
+                        rows.light_u
                             .push((compensated, DVec2::new(pt.u[s][1], pt.u[s][2])));
-                        lanes.draw_index.push(2 * i + s);
+                        rows.draw_index.push(2 * i + s);
                     }
                 }
             }
         }
-        let n = lanes.light_u.len();
-        lanes.light_out.resize(n, None);
+        let n = rows.light_u.len();
+        rows.light_out.resize(n, None);
         self.env
-            .sample_lookup_many(&lanes.light_u, &mut lanes.light_out[..n]);
-        for (&di, out) in lanes.draw_index.iter().zip(&lanes.light_out[..n]) {
+            .sample_lookup_many(&rows.light_u, &mut rows.light_out[..n]);
+        for (&di, out) in rows.draw_index.iter().zip(&rows.light_out[..n]) {
             let pt = &pts[di / 2];
             let Some((dir, l)) = *out else {
                 continue;
@@ -752,12 +750,12 @@ impl Batch<'_> {
             d.dir = dir;
             d.wi = wi;
             d.light = l;
-            lanes.buckets[bucket(pt.obj, true)].push(di as u32);
+            rows.buckets[bucket(pt.obj, true)].push(di as u32);
         }
         // One batch call per object and kind of draw.
         for b in 0..buckets {
-            if !lanes.buckets[b].is_empty() {
-                self.batch_group(b, pts, draws, lanes);
+            if !rows.buckets[b].is_empty() {
+                self.batch_group(b, pts, draws, rows);
             }
         }
         // The shadow rays of the block, traced together: the BSDF draws'
@@ -766,18 +764,15 @@ impl Batch<'_> {
         // Written by index into arrays of the most rays there can be, then
         // cut to the rays there are.
         let most = 2 * pts.len();
-        lanes.shadow_p.resize(most);
-        lanes.shadow_ng.resize(most);
-        lanes.shadow_dir.resize(most);
-        lanes.shadow_draw.resize(most, 0);
+        rows.shadow_p.resize(most);
+        rows.shadow_ng.resize(most);
+        rows.shadow_dir.resize(most);
+        rows.shadow_draw.resize(most, 0);
         let mut r = 0;
-        let (mut sp, mut sng) = (
-            lanes.shadow_p.view_mut(most),
-            lanes.shadow_ng.view_mut(most),
-        );
+        let (mut sp, mut sng) = (rows.shadow_p.view_mut(most), rows.shadow_ng.view_mut(most));
         let (mut sdir, sdraw) = (
-            lanes.shadow_dir.view_mut(most),
-            &mut lanes.shadow_draw[..most],
+            rows.shadow_dir.view_mut(most),
+            &mut rows.shadow_draw[..most],
         );
         for (i, (pt, pair)) in pts.iter().zip(draws.chunks_exact_mut(2)).enumerate() {
             for (s, d) in pair.iter_mut().enumerate() {
@@ -800,41 +795,41 @@ impl Batch<'_> {
                 r += 1;
             }
         }
-        lanes.shadow_p.truncate(r);
-        lanes.shadow_ng.truncate(r);
-        lanes.shadow_dir.truncate(r);
-        lanes.shadow_draw.truncate(r);
+        rows.shadow_p.truncate(r);
+        rows.shadow_ng.truncate(r);
+        rows.shadow_dir.truncate(r);
+        rows.shadow_draw.truncate(r);
         stats.rays += r as u64;
         spawn_many(
             self.level,
-            &lanes.shadow_p,
-            &lanes.shadow_ng,
-            &lanes.shadow_dir,
-            &mut lanes.rays,
+            &rows.shadow_p,
+            &rows.shadow_ng,
+            &rows.shadow_dir,
+            &mut rows.rays,
         );
-        scene.occluded_many(self.level, &lanes.rays, &mut lanes.blocked);
+        scene.occluded_many(self.level, &rows.rays, &mut rows.blocked);
         // The map at the BSDF directions that escape, for the whole block
         // (`EnvMap::lookup_many`); a blocked draw has no light.
-        lanes.bsdf_dirs.clear();
-        lanes.draw_index.clear();
-        for (&di, &blocked) in lanes.shadow_draw.iter().zip(&lanes.blocked) {
+        rows.bsdf_dirs.clear();
+        rows.draw_index.clear();
+        for (&di, &blocked) in rows.shadow_draw.iter().zip(&rows.blocked) {
             let d = &mut draws[di];
             if blocked {
                 d.ok = false;
             } else if d.slot == Slot::Bsdf {
-                lanes.bsdf_dirs.push(d.dir);
-                lanes.draw_index.push(di);
+                rows.bsdf_dirs.push(d.dir);
+                rows.draw_index.push(di);
             }
         }
-        let n = lanes.bsdf_dirs.len();
-        lanes.bsdf_env.resize(n, EnvLookup::default());
+        let n = rows.bsdf_dirs.len();
+        rows.bsdf_env.resize(n, EnvLookup::default());
         self.env
-            .lookup_many(&lanes.bsdf_dirs, &mut lanes.bsdf_env[..n]);
-        for (&di, &l) in lanes.draw_index.iter().zip(&lanes.bsdf_env[..n]) {
+            .lookup_many(&rows.bsdf_dirs, &mut rows.bsdf_env[..n]);
+        for (&di, &l) in rows.draw_index.iter().zip(&rows.bsdf_env[..n]) {
             draws[di].light = l;
         }
         // The estimates, in sample order.
-        let (px, value) = (&lanes.px[..], &mut lanes.value[..]);
+        let (px, value) = (&rows.px[..], &mut rows.value[..]);
         for (pt, pair) in pts.iter().zip(draws.chunks_exact(2)) {
             let mut sum = Rgb::ZERO;
             let mut n = 0.0;
@@ -895,17 +890,17 @@ impl Batch<'_> {
         }
     }
 
-    /// The draws of bucket `b` (`lanes.buckets[b]`, all of object `b / 2`
+    /// The draws of bucket `b` (`rows.buckets[b]`, all of object `b / 2`
     /// and of one kind) in one batch call: BSDF draws (`b` even) sampled,
     /// light draws evaluated.
     #[inline(always)]
-    fn batch_group(&self, b: usize, pts: &[Point], draws: &mut [Draw], lanes: &mut Lanes) {
+    fn batch_group(&self, b: usize, pts: &[Point], draws: &mut [Draw], rows: &mut RowBlock) {
         let (sampler, bsdf) = (&self.samplers[b / 2], b.is_multiple_of(2));
         // One lane per draw of the bucket (never empty).
-        let keys = &lanes.buckets[b];
+        let keys = &rows.buckets[b];
         let m = keys.len();
         {
-            let [a0, a1, a2, a3, a4, a5] = &mut lanes.a;
+            let [a0, a1, a2, a3, a4, a5] = &mut rows.a;
             let (a0, a1, a2) = (&mut a0[..m], &mut a1[..m], &mut a2[..m]);
             let (a3, a4, a5) = (&mut a3[..m], &mut a4[..m], &mut a5[..m]);
             for (k, &di) in keys.iter().enumerate() {
@@ -927,8 +922,8 @@ impl Batch<'_> {
                 }
             }
         }
-        let [a0, a1, a2, a3, a4, a5] = &lanes.a;
-        let [o0, o1, o2, o3, o4, o5, o6, o7, o8, o9] = &mut lanes.out;
+        let [a0, a1, a2, a3, a4, a5] = &rows.a;
+        let [o0, o1, o2, o3, o4, o5, o6, o7, o8, o9] = &mut rows.out;
         let wo = Dirs {
             x: &a0[..m],
             y: &a1[..m],
@@ -960,7 +955,7 @@ impl Batch<'_> {
                             g: &mut o8[..m],
                             b: &mut o9[..m],
                         },
-                        valid: &mut lanes.valid[..m],
+                        valid: &mut rows.valid[..m],
                     },
                 )
                 .expect("equal lengths, uc given");
@@ -984,8 +979,8 @@ impl Batch<'_> {
                 )
                 .expect("equal lengths");
         }
-        let o: [&[f32]; 10] = std::array::from_fn(|c| &lanes.out[c][..m]);
-        let valid = &lanes.valid[..m];
+        let o: [&[f32]; 10] = std::array::from_fn(|c| &rows.out[c][..m]);
+        let valid = &rows.valid[..m];
         for (k, &di) in keys.iter().enumerate() {
             let di = di as usize;
             debug_assert_eq!(draws[di].slot == Slot::Bsdf, bsdf);

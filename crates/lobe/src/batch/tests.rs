@@ -927,12 +927,12 @@ fn batch_errors_name_the_slice_and_the_unsupported() {
 #[cfg(feature = "stats")]
 #[test]
 fn batch_chi2() {
-    use crate::stats::chi2::{Chi2Config, chi2_test, chi2_test_cells, sidak};
+    use crate::stats::chi2::{Chi2Settings, chi2_test, chi2_test_cells, sidak};
     use crate::stats::quadrature::Estimate;
     use std::cell::Cell;
-    let cfg = Chi2Config {
+    let cfg = Chi2Settings {
         samples: 500_000,
-        ..Chi2Config::default()
+        ..Chi2Settings::default()
     };
     let cases = [
         ggx(0.02, 0.02, Fresnel::None, Rgb::ONE),

@@ -502,16 +502,16 @@ fn o_dirs<'a>(x: &'a [f32], y: &'a [f32], z: &'a [f32]) -> Dirs<'a> {
 #[cfg(feature = "stats")]
 #[test]
 fn grid_chi2_batch_pdf() {
-    use crate::stats::chi2::{Chi2Config, chi2_test_many, sidak};
+    use crate::stats::chi2::{Chi2Settings, chi2_test_many, sidak};
     use std::cell::Cell;
     // The f32 pdf's rounding (≈1e-7 relative) is above the cubature's 1e-8
     // relative goal, so cells would refine to the default budget (the θ = 89°
     // Beckmann and Blinn cases took most of a minute); 2000 evaluations give
     // each cell's probability far closer than 200 000 samples can resolve.
-    let cfg = Chi2Config {
+    let cfg = Chi2Settings {
         samples: 200_000,
         max_evals_per_cell: 2_000,
-        ..Chi2Config::default()
+        ..Chi2Settings::default()
     };
     let level = SimdLevel::best();
     let views = [0.0, 60.0, 89.0];

@@ -10,7 +10,7 @@
 //! Carlo falls as `N^-1/2` (slope −0.5); stratified and Sobol points fall
 //! faster on smooth integrands.
 //!
-//! Each estimate is a [`Plan`] of exactly `N` samples (as a renderer taking
+//! Each estimate is a [`EstimateSettings`] of exactly `N` samples (as a renderer taking
 //! `N` samples would use), never a prefix of one long run, and run `r` at
 //! `N = 2^k` has its own seed [`run_seed`]`(S, r, k)`, so that the estimates
 //! at different `N` are independent of each other and the least-squares fit
@@ -19,7 +19,7 @@
 //! its inputs, so the numbers do not depend on the thread count.
 
 use super::map_indices;
-use crate::estimator::{Plan, ShadingPoint, Strategy, estimate};
+use crate::estimator::{EstimateSettings, ShadingPoint, Strategy, estimate};
 use crate::progress::Progress;
 use crate::sequence::{Sequence, hash64};
 use crate::{Error, Light, Material};
@@ -119,14 +119,14 @@ pub fn curves(
     let errors: Vec<f64> = map_indices(tasks.len(), |t| {
         let (i, k, r) = tasks[t];
         let (strategy, sequence) = series[i];
-        let plan = Plan {
+        let estimate_settings = EstimateSettings {
             strategy,
             sequence,
             samples: 1usize << k,
             seed: run_seed(seed, r, k),
         };
-        let acc = estimate(m, sp, light, &plan).expect("checked above");
-        progress.advance(plan.samples as u64);
+        let acc = estimate(m, sp, light, &estimate_settings).expect("checked above");
+        progress.advance(estimate_settings.samples as u64);
         acc.lum.mean() - target
     });
     // Sum the squared errors in task order: the same sums on any thread count.

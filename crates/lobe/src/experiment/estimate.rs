@@ -1,10 +1,10 @@
 //! The settings of one estimate table (`lobe estimate`, Python's
 //! `lobe.estimate`), checked in one place, and the table they ask for.
 //! Each front end reads its own flags or keyword arguments into
-//! [`EstimateSettings`] and names a [`SettingsError`]'s [`Setting`] in its
+//! [`EstimateTableSettings`] and names a [`SettingsError`]'s [`Setting`] in its
 //! own spelling (`--mis-samples`, `mis_samples`).
 
-use super::table::{Table, TableOptions, TableSettings, run_table_with};
+use super::table::{Table, TableSettings, run_table};
 use crate::estimator::ShadingPoint;
 use crate::progress::{Clock, Progress};
 use crate::sequence::Sequence;
@@ -15,7 +15,7 @@ pub const MAX_MIS_SAMPLES: u32 = 64;
 
 /// The settings of one table, as given (names not yet parsed).
 #[derive(Debug, Clone, PartialEq, Eq)]
-pub struct EstimateSettings {
+pub struct EstimateTableSettings {
     /// `all` or strategy names ([`Strategy::parse_list`]).
     pub strategies: Vec<String>,
     /// The BSDF strategy MIS combines with light sampling; `None`: the
@@ -86,14 +86,14 @@ impl SettingsError {
 }
 
 /// The settings checked for `m`: the strategies to run and the table's
-/// options.
+/// settings.
 #[derive(Debug, Clone, PartialEq)]
 pub struct CheckedSettings {
     pub strategies: Vec<Strategy>,
-    pub options: TableOptions,
+    pub table: TableSettings,
 }
 
-impl EstimateSettings {
+impl EstimateTableSettings {
     /// Check every setting against `m`; the error names the first that
     /// cannot be used.
     pub fn check(&self, m: &Material) -> Result<CheckedSettings, SettingsError> {
@@ -181,20 +181,18 @@ impl EstimateSettings {
         }
         Ok(CheckedSettings {
             strategies,
-            options: TableOptions {
-                settings: TableSettings {
-                    sequence,
-                    samples: self.samples,
-                    seed: self.seed,
-                },
+            table: TableSettings {
+                sequence,
+                samples: self.samples,
+                seed: self.seed,
                 replicas: self.replicas,
             },
         })
     }
 }
 
-/// The table that settings checked for `m` ([`EstimateSettings::check`])
-/// ask for at `sp` under `light`: run ([`run_table_with`]), and refused if
+/// The table that settings checked for `m` ([`EstimateTableSettings::check`])
+/// ask for at `sp` under `light`: run ([`run_table`]), and refused if
 /// a row is not a finite number.
 pub fn estimate_table(
     m: &Material,
@@ -204,12 +202,12 @@ pub fn estimate_table(
     progress: &dyn Progress,
     clock: &dyn Clock,
 ) -> Result<Table, SettingsError> {
-    let table = run_table_with(
+    let table = run_table(
         m,
         sp,
         light,
         &checked.strategies,
-        checked.options,
+        checked.table,
         progress,
         clock,
     )
@@ -239,8 +237,8 @@ pub fn estimate_table(
 mod tests {
     use super::*;
 
-    fn settings() -> EstimateSettings {
-        EstimateSettings {
+    fn settings() -> EstimateTableSettings {
+        EstimateTableSettings {
             strategies: vec!["all".into()],
             mis_bsdf: None,
             mis_samples: (1, 1),
@@ -255,44 +253,44 @@ mod tests {
     fn each_bad_setting_is_named() {
         let m = Material::load(r#"{"type":"phong","exponent":20}"#).unwrap();
         assert!(settings().check(&m).is_ok());
-        let cases: [(EstimateSettings, Setting); 6] = [
+        let cases: [(EstimateTableSettings, Setting); 6] = [
             (
-                EstimateSettings {
+                EstimateTableSettings {
                     samples: 1,
                     ..settings()
                 },
                 Setting::Samples,
             ),
             (
-                EstimateSettings {
+                EstimateTableSettings {
                     mis_bsdf: Some("vndf".into()),
                     ..settings()
                 },
                 Setting::MisBsdf,
             ),
             (
-                EstimateSettings {
+                EstimateTableSettings {
                     mis_samples: (0, 1),
                     ..settings()
                 },
                 Setting::MisSamples,
             ),
             (
-                EstimateSettings {
+                EstimateTableSettings {
                     strategies: vec!["bogus".into()],
                     ..settings()
                 },
                 Setting::Strategies,
             ),
             (
-                EstimateSettings {
+                EstimateTableSettings {
                     sequence: "halton".into(),
                     ..settings()
                 },
                 Setting::Sequence,
             ),
             (
-                EstimateSettings {
+                EstimateTableSettings {
                     sequence: "sobol".into(),
                     replicas: 1,
                     ..settings()
@@ -307,7 +305,7 @@ mod tests {
             assert!(text.starts_with("SETTING"), "{text}");
         }
         // A message that names another setting names it in the caller's words.
-        let e = EstimateSettings {
+        let e = EstimateTableSettings {
             sequence: "sobol".into(),
             samples: 8,
             ..settings()

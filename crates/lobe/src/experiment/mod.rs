@@ -33,7 +33,8 @@ pub mod variance;
 pub mod warp_test;
 
 use crate::estimator::{
-    Accumulator, Plan, ShadingEstimator, ShadingPoint, estimate_chunk, reference, reference_env_row,
+    Accumulator, EstimateSettings, ShadingEstimator, ShadingPoint, estimate_chunk, reference,
+    reference_env_row,
 };
 use crate::progress::Progress;
 use crate::{Error, Light, Material, Rgb};
@@ -57,17 +58,17 @@ pub(crate) fn map_indices<T: Send>(n: usize, f: impl Fn(usize) -> T + Sync + Sen
 /// `parallel`) and merged in chunk order: the same numbers as the serial
 /// estimate, for any thread count. Calls `progress.advance(k)` after each
 /// chunk of `k` samples (it does not call `start`). The error says why the
-/// plan's strategy does not apply to `m`.
+/// settings's strategy does not apply to `m`.
 pub fn estimate_chunked(
     m: &Material,
     sp: &ShadingPoint,
     light: &Light,
-    plan: &Plan,
+    settings: &EstimateSettings,
     progress: &dyn Progress,
 ) -> Result<Accumulator, Error> {
-    let est = ShadingEstimator::new(plan.strategy, m)?.prepare(sp, light, plan);
-    let parts = map_indices(plan.chunks(), |c| {
-        let a = estimate_chunk(&est, sp, light, plan, c);
+    let est = ShadingEstimator::new(settings.strategy, m)?.prepare(sp, light, settings);
+    let parts = map_indices(settings.chunks(), |c| {
+        let a = estimate_chunk(&est, sp, light, settings, c);
         progress.advance(a.count() as u64);
         a
     });
@@ -119,16 +120,20 @@ mod tests {
             radiance: Rgb::ONE,
         };
         for sequence in Sequence::ALL {
-            let plan = Plan {
+            let settings = EstimateSettings {
                 strategy: Strategy::Bsdf(BsdfStrategy::Uniform),
                 sequence,
                 samples: 3 * crate::estimator::CHUNK + 17,
                 seed: 5,
             };
             let count = Count(AtomicU64::new(0));
-            let a = estimate_chunked(&m, &sp, &light, &plan, &count).unwrap();
-            assert_eq!(a, estimate(&m, &sp, &light, &plan).unwrap(), "{sequence}");
-            assert_eq!(count.0.load(Ordering::Relaxed), plan.samples as u64);
+            let a = estimate_chunked(&m, &sp, &light, &settings, &count).unwrap();
+            assert_eq!(
+                a,
+                estimate(&m, &sp, &light, &settings).unwrap(),
+                "{sequence}"
+            );
+            assert_eq!(count.0.load(Ordering::Relaxed), settings.samples as u64);
         }
     }
 

@@ -1,10 +1,10 @@
-//! The estimation table of one shading point: every technique with the same
+//! The estimation table of one shading point: every strategy with the same
 //! samples, sequence and seed, against a quadrature reference (what
 //! `lobe estimate` prints).
 
 use super::variance::{UniformVariance, uniform_variance};
 use super::{estimate_chunked, map_indices, reference_rows};
-use crate::estimator::{Accumulator, Plan, ShadingPoint, Strategy};
+use crate::estimator::{Accumulator, EstimateSettings, ShadingPoint, Strategy};
 use crate::math::{Rgb, luminance};
 use crate::progress::{Clock, Progress, timed};
 use crate::sequence::{Sequence, replica_seed};
@@ -19,34 +19,19 @@ pub const REFERENCE_TOLERANCE: f64 = 1e-9;
 /// whose spread gives its standard error ([`run_table`]).
 pub const REPLICAS: usize = 16;
 
-/// How every technique of a table is run.
+/// The settings of [`run_table`]: how every strategy of a table is run.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TableSettings {
     pub sequence: Sequence,
-    /// Samples per technique (each of `points_per_sample` directions).
+    /// Samples per strategy (each of `points_per_sample` directions).
     pub samples: usize,
-    /// Seed of the sample sequence, the same for every technique.
+    /// Seed of the sample sequence, the same for every strategy.
     pub seed: u64,
-}
-
-/// [`TableSettings`] with the number of replicas of a stratified or Sobol
-/// estimate ([`run_table_with`]); from `TableSettings`, [`REPLICAS`].
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct TableOptions {
-    pub settings: TableSettings,
     /// Under stratified and Sobol sequences, the `samples` are cut into this
     /// many independently randomized replicas of `samples / replicas` points
-    /// (at least 2; ignored on the independent sequence).
+    /// (at least 2; ignored on the independent sequence). [`REPLICAS`] is
+    /// what `lobe estimate` takes unless told otherwise.
     pub replicas: usize,
-}
-
-impl From<TableSettings> for TableOptions {
-    fn from(settings: TableSettings) -> Self {
-        TableOptions {
-            settings,
-            replicas: REPLICAS,
-        }
-    }
 }
 
 /// How the standard errors of a table were computed.
@@ -62,11 +47,14 @@ pub enum StderrMethod {
     Replicas,
 }
 
-/// One technique's result.
+/// One strategy's result.
 #[derive(Debug, Clone, PartialEq)]
 #[cfg_attr(feature = "desc", derive(serde::Serialize))]
 pub struct Row {
-    /// The technique's name ([`Strategy::name`]).
+    /// The strategy the row is of; find a row by it ([`Table::row`]).
+    #[cfg_attr(feature = "desc", serde(skip))]
+    pub strategy: Strategy,
+    /// The strategy's name ([`Strategy::name`]), for printing and JSON.
     pub name: String,
     pub samples: usize,
     /// The estimate of `L_o = ∫ f L cos dω` (RGB; the cosine is included).
@@ -79,7 +67,7 @@ pub struct Row {
     /// Per-sample variance of the luminance of `f·L·cos/p`.
     pub variance: f64,
     /// Whether this row's measured variance can be trusted: its estimate is
-    /// within 6 standard errors of the reference (a technique that never
+    /// within 6 standard errors of the reference (a strategy that never
     /// sampled where the integrand lives, uniform sampling of a narrow lobe
     /// say, measures a variance far too small and misses the reference).
     pub variance_reliable: bool,
@@ -105,7 +93,7 @@ pub struct Row {
     pub efficiency: Option<f64>,
 }
 
-/// A comparison of techniques at one shading point.
+/// A comparison of strategies at one shading point.
 #[derive(Debug, Clone, PartialEq)]
 #[cfg_attr(feature = "desc", derive(serde::Serialize))]
 pub struct Table {
@@ -123,8 +111,22 @@ pub struct Table {
     /// The baseline of every variance reduction: the exact per-sample
     /// variance of uniform sampling, by quadrature.
     pub uniform_variance: UniformVariance,
-    /// One row per requested technique, in the requested order.
+    /// One row per requested strategy, in the requested order.
     pub strategies: Vec<Row>,
+}
+
+impl Table {
+    /// The row of strategy `s`, if the table has one.
+    #[must_use]
+    pub fn row(&self, s: Strategy) -> Option<&Row> {
+        self.strategies.iter().find(|r| r.strategy == s)
+    }
+
+    /// The index of the row of strategy `s`, if the table has one.
+    #[must_use]
+    pub fn position(&self, s: Strategy) -> Option<usize> {
+        self.strategies.iter().position(|r| r.strategy == s)
+    }
 }
 
 /// How [`run_table`] computes its reference, in words, with the
@@ -152,22 +154,8 @@ pub fn reference_method(m: &Material, light: &Light) -> String {
     }
 }
 
-/// [`run_table_with`] with [`REPLICAS`] replicas under stratified and Sobol
-/// sequences.
-pub fn run_table(
-    m: &Material,
-    sp: &ShadingPoint,
-    light: &Light,
-    techniques: &[Strategy],
-    settings: TableSettings,
-    progress: &dyn Progress,
-    clock: &dyn Clock,
-) -> Result<Table, Error> {
-    run_table_with(m, sp, light, techniques, settings.into(), progress, clock)
-}
-
-/// Estimates `L_o(wo) = ∫ f_r(wo, wi) L(wi) cos θi dωi` with every technique
-/// of `techniques` (same samples, sequence and seed) and compares each with
+/// Estimates `L_o(wo) = ∫ f_r(wo, wi) L(wi) cos θi dωi` with every strategy
+/// of `strategies` (same samples, sequence and seed) and compares each with
 /// the quadrature reference ([`REFERENCE_TOLERANCE`]). The variance
 /// reduction is against the exact variance of `uniform` BSDF sampling by
 /// quadrature ([`uniform_variance`]), never a measured one (which misses a
@@ -177,23 +165,23 @@ pub fn run_table(
 /// ([`StderrMethod::IndependentSamples`]). Under stratified and Sobol
 /// sequences the samples are not independent and that formula is wrong by
 /// orders of magnitude; instead the `N` samples are cut into
-/// `options.replicas` independently randomized replicas
+/// `settings.replicas` independently randomized replicas
 /// ([`crate::sequence::replica_seed`]) of `N/R` points each (the first
 /// `N mod R` replicas one more), the estimate is the mean of the replica
 /// means and its standard error the standard deviation of those means over
 /// `√R` ([`StderrMethod::Replicas`]).
 ///
-/// Progress: one task `estimating` of `samples × techniques` steps (one per
+/// Progress: one task `estimating` of `samples × strategies` steps (one per
 /// sample). Each row's time is measured on `clock`; every other number
 /// depends only on the arguments, not on the thread count. The error says
-/// why a technique does not apply to `m`, or that there are too few samples
+/// why a strategy does not apply to `m`, or that there are too few samples
 /// for the replicas.
-pub fn run_table_with(
+pub fn run_table(
     m: &Material,
     sp: &ShadingPoint,
     light: &Light,
-    techniques: &[Strategy],
-    options: TableOptions,
+    strategies: &[Strategy],
+    settings: TableSettings,
     progress: &dyn Progress,
     clock: &dyn Clock,
 ) -> Result<Table, Error> {
@@ -201,8 +189,9 @@ pub fn run_table_with(
         sequence,
         samples,
         seed,
-    } = options.settings;
-    let replicas = (sequence != Sequence::Independent).then_some(options.replicas);
+        replicas,
+    } = settings;
+    let replicas = (sequence != Sequence::Independent).then_some(replicas);
     if let Some(r) = replicas {
         if r < 2 {
             return Err(Error::param(
@@ -222,22 +211,22 @@ pub fn run_table_with(
     let reference = reference_rows(m, sp, light, REFERENCE_TOLERANCE);
     let r_lum = luminance(reference);
     let exact_uniform = uniform_variance(m, sp, light, r_lum);
-    progress.start("estimating", (samples * techniques.len()) as u64);
+    progress.start("estimating", (samples * strategies.len()) as u64);
     let mut rows = Vec::new();
-    for &s in techniques {
+    for &s in strategies {
         let (result, time_s) = timed(clock, || -> Result<_, Error> {
             Ok(match replicas {
                 None => {
-                    let plan = Plan {
+                    let estimate_settings = EstimateSettings {
                         strategy: s,
                         sequence,
                         samples,
                         seed,
                     };
-                    let acc = estimate_chunked(m, sp, light, &plan, progress)?;
+                    let acc = estimate_chunked(m, sp, light, &estimate_settings, progress)?;
                     (acc.mean(), acc.std_error(), acc.lum)
                 }
-                Some(r) => replicated(m, sp, light, s, options.settings, r, progress)?,
+                Some(r) => replicated(m, sp, light, s, settings, r, progress)?,
             })
         });
         let (mean, stderr, lum) = result?;
@@ -251,6 +240,7 @@ pub fn run_table_with(
         let variance_reliable =
             abs_error <= 6.0 * luminance(stderr).abs() + 1e-7 * r_lum.abs().max(1e-12);
         rows.push(Row {
+            strategy: s,
             name: s.name(),
             samples,
             mean: mean.to_array(),
@@ -283,7 +273,7 @@ pub fn run_table_with(
 
 /// `(mean, standard error, moments of the luminance of all the samples)` of `s` from `r`
 /// independently randomized replicas of the settings' sequence: the mean of
-/// the replica means and the spread of those means (see [`run_table_with`]).
+/// the replica means and the spread of those means (see [`run_table`]).
 fn replicated(
     m: &Material,
     sp: &ShadingPoint,
@@ -295,13 +285,13 @@ fn replicated(
 ) -> Result<(Rgb, Rgb, Moments), Error> {
     let (base, extra) = (settings.samples / r, settings.samples % r);
     let parts = map_indices(r, |k| {
-        let plan = Plan {
+        let estimate_settings = EstimateSettings {
             strategy: s,
             sequence: settings.sequence,
             samples: base + usize::from(k < extra),
             seed: replica_seed(settings.seed, k),
         };
-        estimate_chunked(m, sp, light, &plan, progress)
+        estimate_chunked(m, sp, light, &estimate_settings, progress)
     });
     let mut all = Accumulator::default();
     let mut means = Vec::with_capacity(r);
@@ -354,6 +344,7 @@ mod tests {
             sequence: Sequence::Independent,
             samples,
             seed: 1,
+            replicas: REPLICAS,
         }
     }
 
@@ -385,7 +376,7 @@ mod tests {
         let wo = DVec3::new(0.5, 0.0, 0.75f64.sqrt());
         let sp = ShadingPoint::local(wo);
         let light = Light::Constant(Rgb::ONE);
-        let techniques = [
+        let strategies = [
             Strategy::Bsdf(BsdfStrategy::Uniform),
             Strategy::Bsdf(BsdfStrategy::Cosine),
         ];
@@ -394,7 +385,7 @@ mod tests {
             &m,
             &sp,
             &light,
-            &techniques,
+            &strategies,
             settings(10_000),
             &progress,
             &Ticks(Mutex::new(0)),
@@ -452,12 +443,12 @@ mod tests {
             n_bsdf: 1,
             n_light: 1,
         });
-        let techniques = [Strategy::Light, mis, Strategy::Bsdf(BsdfStrategy::Cosine)];
+        let strategies = [Strategy::Light, mis, Strategy::Bsdf(BsdfStrategy::Cosine)];
         let t = run_table(
             &m,
             &sp,
             &light,
-            &techniques,
+            &strategies,
             settings(8192),
             &(),
             &Ticks(Mutex::new(0)),
@@ -516,6 +507,7 @@ mod tests {
                 sequence: Sequence::Sobol,
                 samples: n,
                 seed,
+                replicas: REPLICAS,
             };
             let t = run_table(
                 &m,
@@ -565,8 +557,13 @@ mod tests {
             &Ticks(Mutex::new(0)),
         )
         .unwrap();
-        let acc =
-            crate::estimator::estimate(&m, &sp, &light, &Plan::independent(s, 10_000, 1)).unwrap();
+        let acc = crate::estimator::estimate(
+            &m,
+            &sp,
+            &light,
+            &EstimateSettings::independent(s, 10_000, 1),
+        )
+        .unwrap();
         let r = &t.strategies[0];
         assert_eq!(r.mean, acc.mean().to_array());
         assert_eq!(r.stderr, acc.std_error().to_array());
@@ -582,6 +579,7 @@ mod tests {
             sequence: Sequence::Stratified,
             samples: 8,
             seed: 1,
+            replicas: REPLICAS,
         };
         let e = run_table(
             &m,
@@ -611,7 +609,7 @@ mod tests {
         .unwrap();
         let m = Material::with_diffuse(Rgb::ZERO, crate::Glossy::CookTorrance(ct)).unwrap();
         let sp = ShadingPoint::local(DVec3::new(0.5, 0.0, 0.75f64.sqrt()));
-        let techniques = [
+        let strategies = [
             Strategy::Bsdf(BsdfStrategy::Uniform),
             Strategy::Bsdf(BsdfStrategy::Vndf),
         ];
@@ -619,7 +617,7 @@ mod tests {
             &m,
             &sp,
             &Light::Constant(Rgb::ONE),
-            &techniques,
+            &strategies,
             settings(1000),
             &(),
             &Ticks(Mutex::new(0)),
@@ -670,6 +668,7 @@ mod tests {
                 sequence: Sequence::Independent,
                 samples: 65_536,
                 seed,
+                replicas: REPLICAS,
             };
             run_table(m, sp, light, s, settings, &(), &Ticks(Mutex::new(0))).unwrap()
         };

@@ -6,7 +6,7 @@
 
 use super::histogram::{Histograms, projected_histograms};
 use crate::progress::Progress;
-use crate::stats::chi2::{Chi2Config, Chi2Result, TABLE_MAX_EVALS_PER_CELL, chi2_test};
+use crate::stats::chi2::{Chi2Result, Chi2Settings, TABLE_MAX_EVALS_PER_CELL, chi2_test};
 use crate::{BsdfSampler, Material};
 use glam::DVec3;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
@@ -16,10 +16,10 @@ use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 /// piecewise-constant pdf a cell straddling a bin edge would otherwise
 /// refine along at length).
 #[must_use]
-pub fn chi2_config(m: &Material) -> Chi2Config {
-    let base = Chi2Config::default();
+pub fn chi2_config(m: &Material) -> Chi2Settings {
+    let base = Chi2Settings::default();
     if m.measured().is_some() {
-        Chi2Config {
+        Chi2Settings {
             max_evals_per_cell: TABLE_MAX_EVALS_PER_CELL,
             ..base
         }
@@ -36,7 +36,7 @@ pub struct WarpTest {
     /// The chi-square test over the sphere.
     pub chi2: Chi2Result,
     /// The test's configuration (bins, samples, seed).
-    pub config: Chi2Config,
+    pub config: Chi2Settings,
 }
 
 /// The warp test of `sampler` at `wo`: `config.samples` draws from
@@ -50,7 +50,7 @@ pub struct WarpTest {
 pub fn warp_test(
     sampler: &BsdfSampler<'_>,
     wo: DVec3,
-    config: Chi2Config,
+    config: Chi2Settings,
     res: usize,
     progress: &dyn Progress,
 ) -> WarpTest {

@@ -39,7 +39,7 @@ fn cell_tolerance(max_evals: usize) -> Tolerance {
 
 /// Settings of [`chi2_test`].
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Chi2Config {
+pub struct Chi2Settings {
     /// Number of bins in `z = cos(theta)` over the whole sphere `[−1, 1]`.
     pub n_z: usize,
     /// Number of bins in `phi` over `[0, 2π)`.
@@ -57,7 +57,7 @@ pub struct Chi2Config {
     pub max_evals_per_cell: usize,
 }
 
-impl Default for Chi2Config {
+impl Default for Chi2Settings {
     /// 100 `z` bins (so `50 × 100` cells on the upper hemisphere), 100 `phi`
     /// bins, one million samples, `min_expected = 5`.
     fn default() -> Self {
@@ -72,14 +72,14 @@ impl Default for Chi2Config {
     }
 }
 
-/// [`Chi2Config::max_evals_per_cell`] for a measured table's samplers:
+/// [`Chi2Settings::max_evals_per_cell`] for a measured table's samplers:
 /// their pdfs are piecewise constant (or piecewise smooth), so a cell that
 /// straddles a bin edge would spend the default budget refining along it.
 /// With 4000 evaluations per cell the tables' chi-square tests
 /// (`crates/lobe/tests/integration/measured.rs`) pass at 400 000 samples.
 pub const TABLE_MAX_EVALS_PER_CELL: usize = 4000;
 
-impl Chi2Config {
+impl Chi2Settings {
     /// Bounds `(z0, z1, phi0, phi1)` of cell `(iz, iphi)`.
     #[must_use]
     pub fn cell_bounds(&self, iz: usize, iphi: usize) -> (f64, f64, f64, f64) {
@@ -163,7 +163,7 @@ impl Chi2Result {
     /// # Errors
     ///
     /// I/O errors, and `InvalidInput` when the table sizes do not match `cfg`.
-    pub fn write_tables(&self, cfg: &Chi2Config, path: &Path) -> std::io::Result<()> {
+    pub fn write_tables(&self, cfg: &Chi2Settings, path: &Path) -> std::io::Result<()> {
         let cells = cfg.n_z.checked_mul(cfg.n_phi);
         if cells != Some(self.observed.len()) || self.expected.len() != self.observed.len() {
             return Err(std::io::Error::new(
@@ -307,7 +307,7 @@ fn lattice_hits(hit: impl Fn(DVec2) -> bool, g: usize) -> usize {
 /// expectation, so that no observed mass escapes the statistic.
 #[must_use]
 pub fn chi2_test(
-    cfg: &Chi2Config,
+    cfg: &Chi2Settings,
     sample: impl Fn(f64, DVec2) -> Option<DVec3>,
     pdf: impl Fn(DVec3) -> f64,
 ) -> Chi2Result {
@@ -325,7 +325,7 @@ pub fn chi2_test(
 /// per lane.
 #[must_use]
 pub fn chi2_test_many(
-    cfg: &Chi2Config,
+    cfg: &Chi2Settings,
     sample: impl Fn(f64, DVec2) -> Option<DVec3>,
     pdf: impl Fn(&[DVec3], &mut [f64]),
 ) -> Chi2Result {
@@ -365,7 +365,7 @@ pub fn chi2_test_many(
 /// environment map whose texels line up with the cells).
 #[must_use]
 pub fn chi2_test_cells(
-    cfg: &Chi2Config,
+    cfg: &Chi2Settings,
     sample: impl Fn(f64, DVec2) -> Option<DVec3>,
     mut cell_probability: impl FnMut(f64, f64, f64, f64) -> Estimate,
 ) -> Chi2Result {
@@ -595,7 +595,7 @@ mod tests {
 
     #[test]
     fn uniform_sphere_passes() {
-        let cfg = Chi2Config::default();
+        let cfg = Chi2Settings::default();
         let r = chi2_test(&cfg, |_, u| Some(uniform_sphere(u)), |_| UNIFORM_PDF);
         assert!(r.passes(0.01), "{r:?}");
         assert!((r.pdf_integral - 1.0).abs() < 1e-9, "{}", r.pdf_integral);
@@ -608,7 +608,7 @@ mod tests {
 
     #[test]
     fn cosine_hemisphere_passes() {
-        let cfg = Chi2Config::default();
+        let cfg = Chi2Settings::default();
         let r = chi2_test(&cfg, |_, u| Some(cosine_hemisphere(u)), cosine_pdf);
         assert!(r.passes(0.01), "{r:?}");
         assert!((r.pdf_integral - 1.0).abs() < 1e-9);
@@ -629,7 +629,7 @@ mod tests {
 
     #[test]
     fn wrong_pdf_fails() {
-        let cfg = Chi2Config::default();
+        let cfg = Chi2Settings::default();
         // Cosine samples against the uniform-hemisphere pdf.
         let r = chi2_test(
             &cfg,
@@ -656,14 +656,14 @@ mod tests {
             }
         };
         let pdf = |e: f64| move |w: DVec3| (e + 1.0) / TAU * w.z.max(0.0).powf(e);
-        let cfg = Chi2Config::default();
+        let cfg = Chi2Settings::default();
         assert!(chi2_test(&cfg, sample(10.0), pdf(10.0)).passes(0.01));
         assert!(chi2_test(&cfg, sample(10.0), pdf(11.0)).p_value < 1e-6);
     }
 
     #[test]
     fn lost_samples_are_accounted_for() {
-        let cfg = Chi2Config::default();
+        let cfg = Chi2Settings::default();
         let sample = |uc: f64, u: DVec2| (uc >= 0.5).then(|| cosine_hemisphere(u));
         let r = chi2_test(&cfg, sample, |w| 0.5 * cosine_pdf(w));
         assert!(r.passes(0.01), "{r:?}");
@@ -709,7 +709,7 @@ mod tests {
 
     #[test]
     fn narrow_tilted_lobe_passes_and_detects_a_small_error() {
-        let cfg = Chi2Config::default();
+        let cfg = Chi2Settings::default();
         let (sample, pdf) = tilted_lobe(1e4, 40f64.to_radians());
         let r = chi2_test(&cfg, sample, pdf);
         assert!(r.passes(0.01), "{r:?}");
@@ -723,7 +723,7 @@ mod tests {
     fn lobe_clipped_by_the_horizon() {
         // A wide lobe tilted by 70°: a good part of it is lost below the
         // horizon, and the pdf integrates to the success probability.
-        let cfg = Chi2Config::default();
+        let cfg = Chi2Settings::default();
         let (sample, pdf) = tilted_lobe(10.0, 70f64.to_radians());
         let r = chi2_test(&cfg, sample, pdf);
         assert!(r.passes(0.01), "{r:?}");
@@ -741,7 +741,7 @@ mod tests {
     #[test]
     #[ignore = "timing report, not a check"]
     fn chi2_timings() {
-        let cfg = Chi2Config::default();
+        let cfg = Chi2Settings::default();
         let time = |name: &str, f: &dyn Fn() -> Chi2Result| {
             let t = std::time::Instant::now();
             let r = f();
@@ -775,9 +775,9 @@ mod tests {
 
     #[test]
     fn samples_where_pdf_is_zero_fail() {
-        let cfg = Chi2Config {
+        let cfg = Chi2Settings {
             samples: 100_000,
-            ..Chi2Config::default()
+            ..Chi2Settings::default()
         };
         // Samples the upper hemisphere uniformly but the pdf claims the
         // cap z > 0.98 (the top row of cells) is never sampled.
@@ -806,11 +806,11 @@ mod tests {
 
     #[test]
     fn non_unit_direction_and_bad_pdf_fail() {
-        let cfg = Chi2Config {
+        let cfg = Chi2Settings {
             samples: 10_000,
             n_z: 10,
             n_phi: 10,
-            ..Chi2Config::default()
+            ..Chi2Settings::default()
         };
         let r = chi2_test(&cfg, |_, u| Some(1.01 * uniform_sphere(u)), |_| UNIFORM_PDF);
         assert_eq!(r.p_value, 0.0);
@@ -827,7 +827,7 @@ mod tests {
             r.message
         );
         let r = chi2_test(
-            &Chi2Config { n_z: 0, ..cfg },
+            &Chi2Settings { n_z: 0, ..cfg },
             |_, u| Some(uniform_sphere(u)),
             |_| UNIFORM_PDF,
         );
@@ -836,16 +836,16 @@ mod tests {
 
     #[test]
     fn deterministic_per_seed() {
-        let cfg = Chi2Config {
+        let cfg = Chi2Settings {
             samples: 20_000,
             n_z: 20,
             n_phi: 20,
-            ..Chi2Config::default()
+            ..Chi2Settings::default()
         };
         let s = |_: f64, u: DVec2| Some(uniform_sphere(u));
         let a = chi2_test(&cfg, s, |_| UNIFORM_PDF);
         let b = chi2_test(&cfg, s, |_| UNIFORM_PDF);
-        let c = chi2_test(&Chi2Config { seed: 7, ..cfg }, s, |_| UNIFORM_PDF);
+        let c = chi2_test(&Chi2Settings { seed: 7, ..cfg }, s, |_| UNIFORM_PDF);
         assert_eq!(a, b);
         assert_ne!(a.observed, c.observed);
     }
@@ -854,16 +854,16 @@ mod tests {
     fn p_values_are_roughly_uniform_under_the_null() {
         // 40 small tests with different seeds: a valid sampler must not be
         // rejected often, and the p-values must spread over (0, 1).
-        let cfg = Chi2Config {
+        let cfg = Chi2Settings {
             samples: 20_000,
             n_z: 20,
             n_phi: 20,
-            ..Chi2Config::default()
+            ..Chi2Settings::default()
         };
         let ps: Vec<f64> = (0..40)
             .map(|s| {
                 chi2_test(
-                    &Chi2Config { seed: s, ..cfg },
+                    &Chi2Settings { seed: s, ..cfg },
                     |_, u| Some(cosine_hemisphere(u)),
                     cosine_pdf,
                 )
@@ -878,7 +878,7 @@ mod tests {
 
     #[test]
     fn binning_conventions() {
-        let cfg = Chi2Config::default();
+        let cfg = Chi2Settings::default();
         assert_eq!(cfg.cell_of(DVec3::Z), (99, 0));
         assert_eq!(cfg.cell_of(DVec3::new(0.0, 0.0, -1.0)), (0, 0));
         assert_eq!(cfg.cell_of(DVec3::new(0.0, -1.0, 0.0)), (50, 75));
@@ -971,11 +971,11 @@ mod tests {
 
     #[test]
     fn tables_are_written() {
-        let cfg = Chi2Config {
+        let cfg = Chi2Settings {
             samples: 1000,
             n_z: 4,
             n_phi: 3,
-            ..Chi2Config::default()
+            ..Chi2Settings::default()
         };
         let r = chi2_test(&cfg, |_, u| Some(uniform_sphere(u)), |_| UNIFORM_PDF);
         let path = std::env::temp_dir().join(format!("lobe-chi2-{}.csv", std::process::id()));
@@ -987,7 +987,7 @@ mod tests {
         assert_eq!(lines[0], "iz,iphi,z0,z1,phi0,phi1,observed,expected");
         assert!(lines[1].starts_with("0,0,-1,-0.5,0,"));
         assert!(lines[13].starts_with("lost,,,,,,0,"));
-        let wrong = Chi2Config { n_z: 5, ..cfg };
+        let wrong = Chi2Settings { n_z: 5, ..cfg };
         assert!(r.write_tables(&wrong, &path).is_err());
     }
 }

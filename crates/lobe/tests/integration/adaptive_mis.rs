@@ -10,7 +10,7 @@ use crate::common;
 
 use glam::DVec3;
 use lobe::estimator::{
-    Allocation, Plan, ShadingEstimator, ShadingPoint, Strategy, estimate, reference,
+    Allocation, EstimateSettings, ShadingEstimator, ShadingPoint, Strategy, estimate, reference,
 };
 use lobe::light::LightDistribution;
 use lobe::math::luminance;
@@ -92,7 +92,7 @@ fn adaptive_mis_is_never_worse_than_its_parts() {
             let sp = ShadingPoint::local(wo);
             for (name, light) in lights() {
                 let e = exact(&m, wo, &light);
-                let plan = Plan {
+                let plan = EstimateSettings {
                     strategy: Strategy::MIS,
                     sequence: Sequence::Independent,
                     samples: 1 << 16,
@@ -152,7 +152,7 @@ fn adaptive_mis_is_unbiased_with_the_predicted_variance() {
         for (name, light) in lights() {
             let wo = common::wo(60.0);
             let sp = ShadingPoint::local(wo);
-            let plan = Plan {
+            let plan = EstimateSettings {
                 strategy: Strategy::MIS,
                 sequence: Sequence::Independent,
                 samples: 1 << 17,

@@ -10,14 +10,14 @@ use crate::common;
 use common::{Case, plan};
 use glam::DVec2;
 use lobe::BsdfStrategy;
-use lobe::stats::chi2::{Chi2Config, chi2_test, sidak, success_probability};
+use lobe::stats::chi2::{Chi2Settings, chi2_test, sidak, success_probability};
 
 /// Every (case, strategy, θo) of `cases`, in parallel (each is independent
 /// and deterministic; the failures are listed in the grid's order).
 fn run(cases: Vec<Case>) {
     use rayon::prelude::*;
     let alpha = sidak(0.01, common::grid_size());
-    let cfg = Chi2Config::default();
+    let cfg = Chi2Settings::default();
     let jobs: Vec<(&Case, BsdfStrategy, f64)> = cases
         .iter()
         .flat_map(|c| plan(c).into_iter().map(move |(s, t)| (c, s, t)))
@@ -153,7 +153,7 @@ fn chi2_warps() {
         ));
     }
     let alpha = sidak(0.01, warps.len());
-    let cfg = Chi2Config::default();
+    let cfg = Chi2Settings::default();
     let mut failures = Vec::new();
     for (name, sample, pdf) in &warps {
         let r = chi2_test(&cfg, |_, u| Some(sample(u)), pdf);
@@ -181,7 +181,7 @@ fn chi2_catches_a_wrong_pdf() {
     let wo = common::wo(30.0);
     // The lecture's density over half vectors, used as if it were over wi.
     let r = chi2_test(
-        &Chi2Config::default(),
+        &Chi2Settings::default(),
         |uc, u| {
             m.sampler(BsdfStrategy::Brdf)
                 .unwrap()

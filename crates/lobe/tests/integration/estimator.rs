@@ -5,7 +5,7 @@
 use crate::common;
 
 use glam::DVec3;
-use lobe::estimator::{Plan, ShadingPoint, estimate, reference};
+use lobe::estimator::{EstimateSettings, ShadingPoint, estimate, reference};
 use lobe::math::luminance;
 use lobe::sequence::Sequence;
 use lobe::{BsdfStrategy, Light, Rgb};
@@ -60,7 +60,7 @@ fn every_estimate_is_within_four_standard_errors() {
                             &c.material,
                             &ShadingPoint::local(wo),
                             &light,
-                            &Plan {
+                            &EstimateSettings {
                                 strategy: s.into(),
                                 sequence: seq,
                                 samples: 1 << 16,
@@ -101,7 +101,7 @@ fn variance(json: &str, theta: f64, s: BsdfStrategy) -> f64 {
         &c.material,
         &ShadingPoint::local(wo),
         &Light::Constant(Rgb::ONE),
-        &Plan::independent(s, 1 << 18, 3),
+        &EstimateSettings::independent(s, 1 << 18, 3),
     )
     .unwrap();
     acc.lum.variance()
@@ -140,7 +140,7 @@ fn rmse_of(
     let r = luminance(reference(m, &sp, light, 1e-10));
     let mut sq = 0.0;
     for run in 0..runs {
-        let plan = Plan {
+        let plan = EstimateSettings {
             strategy: t,
             sequence: seq,
             samples: n,

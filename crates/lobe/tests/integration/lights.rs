@@ -6,11 +6,13 @@ use crate::common;
 
 use glam::DVec3;
 use lobe::envmap::EnvMap;
-use lobe::estimator::{Heuristic, MisForm, Plan, ShadingPoint, Strategy, estimate, reference};
+use lobe::estimator::{
+    EstimateSettings, Heuristic, MisForm, ShadingPoint, Strategy, estimate, reference,
+};
 use lobe::light::LightDistribution;
 use lobe::math::luminance;
 use lobe::sequence::Sequence;
-use lobe::stats::chi2::{Chi2Config, chi2_test, chi2_test_cells};
+use lobe::stats::chi2::{Chi2Settings, chi2_test, chi2_test_cells};
 use lobe::stats::quadrature::{Estimate, Tolerance, integrate_sphere};
 use lobe::{BsdfStrategy, Frame, Light, Rgb};
 use std::sync::Arc;
@@ -64,7 +66,7 @@ fn cell_probability(map: &EnvMap, z0: f64, z1: f64, p0: f64, p1: f64) -> Estimat
 
 #[test]
 fn environment_sampling_matches_its_pdf() {
-    let cfg = Chi2Config::default();
+    let cfg = Chi2Settings::default();
     for (name, map) in maps() {
         let r = chi2_test_cells(
             &cfg,
@@ -101,7 +103,7 @@ fn environment_sampling_matches_its_pdf() {
 
 #[test]
 fn light_samplers_of_analytic_lights_match_their_pdfs() {
-    let cfg = Chi2Config::default();
+    let cfg = Chi2Settings::default();
     for light in [
         Light::Constant(Rgb::ONE),
         Light::Beam {
@@ -137,7 +139,7 @@ fn rmse(
                 m,
                 sp,
                 light,
-                &Plan {
+                &EstimateSettings {
                     strategy: t,
                     sequence: Sequence::Independent,
                     samples: n,

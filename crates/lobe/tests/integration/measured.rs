@@ -4,12 +4,12 @@
 //! variance, relative paths, and every bad-file case.
 
 use glam::{DVec2, DVec3};
-use lobe::estimator::{Plan, ShadingPoint, estimate, reference};
+use lobe::estimator::{EstimateSettings, ShadingPoint, estimate, reference};
 use lobe::math::luminance;
 use lobe::models::measured::merl::{self, Merl};
 use lobe::models::measured::rgl::{self, Rgl};
 use lobe::models::measured::{Measured, Table};
-use lobe::stats::chi2::{Chi2Config, TABLE_MAX_EVALS_PER_CELL, chi2_test, sidak};
+use lobe::stats::chi2::{Chi2Settings, TABLE_MAX_EVALS_PER_CELL, chi2_test, sidak};
 use lobe::{BsdfStrategy, Glossy, Light, Material, Rgb};
 use std::path::PathBuf;
 use std::sync::OnceLock;
@@ -184,7 +184,7 @@ fn rgl_values_match_the_model_within_the_resolution() {
 /// half-vector cells (`sampler::tests`, every view) covers that case.
 #[test]
 fn chi2_of_the_tabulated_sampler() {
-    let cfg = Chi2Config {
+    let cfg = Chi2Settings {
         samples: 400_000,
         n_z: 40,
         n_phi: 80,
@@ -294,8 +294,13 @@ fn estimates_are_unbiased() {
                 let r = luminance(reference(m, &sp, light, 1e-6));
                 for s in m.strategies() {
                     seed += 1;
-                    let acc =
-                        estimate(m, &sp, light, &Plan::independent(s, 1 << 15, seed)).unwrap();
+                    let acc = estimate(
+                        m,
+                        &sp,
+                        light,
+                        &EstimateSettings::independent(s, 1 << 15, seed),
+                    )
+                    .unwrap();
                     let (mean, se) = (acc.lum.mean(), acc.lum.std_error());
                     if (mean - r).abs() > 4.0 * se + 1e-5 * r {
                         failures.push(format!(
@@ -318,7 +323,13 @@ fn tabulated_sampling_beats_cosine_on_a_glossy_table() {
     for theta in [0.0, 30.0, 60.0] {
         let sp = ShadingPoint::local(wo(theta));
         let var = |s: BsdfStrategy| {
-            let acc = estimate(m, &sp, &light, &Plan::independent(s, 1 << 16, 3)).unwrap();
+            let acc = estimate(
+                m,
+                &sp,
+                &light,
+                &EstimateSettings::independent(s, 1 << 16, 3),
+            )
+            .unwrap();
             acc.lum.variance()
         };
         let (vb, vc) = (var(BsdfStrategy::Brdf), var(BsdfStrategy::Cosine));
@@ -674,12 +685,12 @@ fn chi2_of_the_rgl_warps() {
         .unwrap_err()
         .to_string();
     assert!(e.contains("MERL table has no visible-normal warp"), "{e}");
-    let cfg = Chi2Config {
+    let cfg = Chi2Settings {
         samples: 200_000,
         n_z: 32,
         n_phi: 64,
         max_evals_per_cell: 2000,
-        ..Chi2Config::default()
+        ..Chi2Settings::default()
     };
     let alpha = sidak(0.01, 2);
     let mut failures = Vec::new();
@@ -732,13 +743,13 @@ fn chi2_of_the_rgl_warps() {
 /// itself.
 #[test]
 fn fit_recovers_a_conductor() {
-    use lobe::fit::{FitOptions, FresnelFit};
+    use lobe::fit::{FitSettings, FresnelFit};
     let json = r#"{"type":"cook-torrance","distribution":"ggx","alpha":0.2,"kd":[0.05,0.1,0.02],"fresnel":{"type":"conductor","eta":[0.2,0.5,1.4],"k":[3.5,2.4,1.8]}}"#;
     let m = merl_material(json, "fit-conductor.binary", "nearest");
     let t0 = std::time::Instant::now();
-    let opts = FitOptions {
+    let opts = FitSettings {
         fresnel: FresnelFit::Conductor,
-        ..FitOptions::default()
+        ..FitSettings::default()
     };
     let fit = lobe::fit::fit(&m, opts).unwrap();
     eprintln!(
@@ -768,10 +779,10 @@ fn fit_recovers_a_conductor() {
 /// isotropic), and `alpha_u ≈ alpha_v` for an isotropic MERL table.
 #[test]
 fn fit_recovers_anisotropic_alphas() {
-    use lobe::fit::FitOptions;
-    let opts = FitOptions {
+    use lobe::fit::FitSettings;
+    let opts = FitSettings {
         anisotropic: true,
-        ..FitOptions::default()
+        ..FitSettings::default()
     };
     let aniso = analytic(
         r#"{"type":"cook-torrance","distribution":"ggx","alpha_u":0.1,"alpha_v":0.3,"kd":0.1,"fresnel":{"type":"schlick","f0":[0.9,0.8,0.6]}}"#,

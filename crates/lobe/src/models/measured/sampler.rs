@@ -254,7 +254,7 @@ impl HalfVectorTable {
 #[cfg(all(test, feature = "stats"))]
 mod tests {
     use super::*;
-    use crate::stats::chi2::{Chi2Config, chi2_test_cells};
+    use crate::stats::chi2::{Chi2Settings, chi2_test_cells};
     use crate::stats::quadrature::Estimate;
 
     fn glossy() -> crate::Material {
@@ -286,11 +286,11 @@ mod tests {
             let hole = if (i.x * 40.0).floor() as i64 % 7 == 0 { 0.0 } else { 1.0 };
             m.eval(o, i) * bump * hole
         });
-        let cfg = Chi2Config {
+        let cfg = Chi2Settings {
             n_z: 2 * N_U,
             n_phi: N_V,
             samples: 1_000_000,
-            ..Chi2Config::default()
+            ..Chi2Settings::default()
         };
         let alpha = crate::stats::chi2::sidak(0.01, 4);
         for theta in [0.0f64, 20.0, 55.0, 85.0] {

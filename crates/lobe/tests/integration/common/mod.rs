@@ -132,7 +132,7 @@ pub fn grid_size() -> usize {
 /// `target/tmp/chi2-failures/<label>.csv` and return the path.
 pub fn write_failure(
     r: &lobe::stats::chi2::Chi2Result,
-    cfg: &lobe::stats::chi2::Chi2Config,
+    cfg: &lobe::stats::chi2::Chi2Settings,
     label: &str,
 ) -> std::path::PathBuf {
     let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("chi2-failures");

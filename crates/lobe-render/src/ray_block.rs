@@ -19,18 +19,18 @@ use crate::scene::{Scene, Shape};
 use glam::DVec3;
 use lobe::batch::{SimdLevel, Step};
 
-/// No object: [`HitLanes::obj`] of a ray that hits nothing.
+/// No object: [`HitBlock::obj`] of a ray that hits nothing.
 pub const NO_HIT: u32 = u32::MAX;
 
 /// Three coordinate arrays.
 #[derive(Debug, Clone, Default)]
-pub struct Vec3Lanes {
+pub struct Vec3Block {
     pub x: Vec<f64>,
     pub y: Vec<f64>,
     pub z: Vec<f64>,
 }
 
-impl Vec3Lanes {
+impl Vec3Block {
     pub fn clear(&mut self) {
         self.x.clear();
         self.y.clear();
@@ -96,7 +96,7 @@ impl Vec3Lanes {
         }
     }
 
-    /// [`Vec3Lanes::view`] to write.
+    /// [`Vec3Block::view`] to write.
     ///
     /// # Panics
     /// If there are fewer than `n` entries.
@@ -110,7 +110,7 @@ impl Vec3Lanes {
     }
 }
 
-/// Read access to the first entries of a [`Vec3Lanes`] ([`Vec3Lanes::view`]).
+/// Read access to the first entries of a [`Vec3Block`] ([`Vec3Block::view`]).
 #[derive(Debug, Clone, Copy)]
 pub struct Vec3View<'a> {
     x: &'a [f64],
@@ -126,8 +126,8 @@ impl Vec3View<'_> {
     }
 }
 
-/// Write access to the first entries of a [`Vec3Lanes`]
-/// ([`Vec3Lanes::view_mut`]).
+/// Write access to the first entries of a [`Vec3Block`]
+/// ([`Vec3Block::view_mut`]).
 #[derive(Debug)]
 pub struct Vec3ViewMut<'a> {
     x: &'a mut [f64],
@@ -146,12 +146,12 @@ impl Vec3ViewMut<'_> {
 
 /// A block of rays `origin + t dir`, `dir` unit.
 #[derive(Debug, Clone, Default)]
-pub struct RayLanes {
-    pub origin: Vec3Lanes,
-    pub dir: Vec3Lanes,
+pub struct RayBlock {
+    pub origin: Vec3Block,
+    pub dir: Vec3Block,
 }
 
-impl RayLanes {
+impl RayBlock {
     pub fn clear(&mut self) {
         self.origin.clear();
         self.dir.clear();
@@ -191,15 +191,15 @@ impl RayLanes {
 /// ray the fields of [`crate::Hit`] and the object, [`NO_HIT`] for a miss
 /// (its other fields are then unspecified).
 #[derive(Debug, Clone, Default)]
-pub struct HitLanes {
+pub struct HitBlock {
     pub t: Vec<f64>,
     pub obj: Vec<u32>,
-    pub p: Vec3Lanes,
-    pub ng: Vec3Lanes,
-    pub ns: Vec3Lanes,
+    pub p: Vec3Block,
+    pub ng: Vec3Block,
+    pub ns: Vec3Block,
 }
 
-impl HitLanes {
+impl HitBlock {
     fn resize(&mut self, n: usize) {
         self.t.resize(n, 0.0);
         self.obj.resize(n, NO_HIT);
@@ -221,7 +221,7 @@ impl Camera {
     ///
     /// # Panics
     /// If `xs` and `ys` differ in length.
-    pub fn rays_many(&self, level: SimdLevel, xs: &[f64], ys: &[f64], out: &mut RayLanes) {
+    pub fn rays_many(&self, level: SimdLevel, xs: &[f64], ys: &[f64], out: &mut RayBlock) {
         assert_eq!(xs.len(), ys.len(), "rays_many: lengths differ");
         out.resize(xs.len());
         level.run(CameraRays(self, xs, ys, out));
@@ -229,7 +229,7 @@ impl Camera {
 }
 
 /// [`Camera::rays_many`]'s loop.
-struct CameraRays<'a>(&'a Camera, &'a [f64], &'a [f64], &'a mut RayLanes);
+struct CameraRays<'a>(&'a Camera, &'a [f64], &'a [f64], &'a mut RayBlock);
 
 impl Step for CameraRays<'_> {
     #[inline(always)]
@@ -259,7 +259,7 @@ impl Step for CameraRays<'_> {
     }
 }
 
-/// Lanes of a chunk of [`sphere_chunk`].
+/// RowBlock of a chunk of [`sphere_chunk`].
 const CHUNK: usize = 8;
 
 /// A sphere's hits of the rays `start..start + m` (`m ≤ CHUNK`, its rays
@@ -273,7 +273,7 @@ const CHUNK: usize = 8;
 #[inline(always)]
 fn sphere_chunk<const NORMALS: bool>(
     s: &Sphere,
-    rays: &RayLanes,
+    rays: &RayBlock,
     start: usize,
     m: usize,
 ) -> ([f64; CHUNK], [[f64; CHUNK]; 3]) {
@@ -369,7 +369,7 @@ fn plane_lane(pl: &Plane, o: [f64; 3], d: [f64; 3]) -> (f64, [f64; 3]) {
 impl Scene {
     /// [`Scene::intersect`] of every ray of `rays` with `t_max = ∞`, into
     /// `out` (resized to their number): the same hits, bit for bit.
-    pub fn intersect_many(&self, level: SimdLevel, rays: &RayLanes, out: &mut HitLanes) {
+    pub fn intersect_many(&self, level: SimdLevel, rays: &RayBlock, out: &mut HitBlock) {
         self.intersect_many_where(level, rays, out, |_| true);
     }
 
@@ -380,8 +380,8 @@ impl Scene {
     pub fn intersect_many_where(
         &self,
         level: SimdLevel,
-        rays: &RayLanes,
-        out: &mut HitLanes,
+        rays: &RayBlock,
+        out: &mut HitBlock,
         may_hit: impl Fn(usize) -> bool,
     ) {
         let n = rays.len();
@@ -412,7 +412,7 @@ impl Scene {
 
     /// [`Scene::occluded`] of every ray of `rays`, into `out` (resized to
     /// their number).
-    pub fn occluded_many(&self, level: SimdLevel, rays: &RayLanes, out: &mut Vec<bool>) {
+    pub fn occluded_many(&self, level: SimdLevel, rays: &RayBlock, out: &mut Vec<bool>) {
         let n = rays.len();
         out.clear();
         out.resize(n, false);
@@ -434,7 +434,7 @@ impl Scene {
 
 /// `out[i] |= hit(origin, dir)` of every ray.
 #[inline(always)]
-fn lanes_each(rays: &RayLanes, out: &mut [bool], hit: impl Fn([f64; 3], [f64; 3]) -> bool) {
+fn lanes_each(rays: &RayBlock, out: &mut [bool], hit: impl Fn([f64; 3], [f64; 3]) -> bool) {
     let n = rays.len();
     let (o, d) = (&rays.origin, &rays.dir);
     let (ox, oy, oz) = (&o.x[..n], &o.y[..n], &o.z[..n]);
@@ -446,7 +446,7 @@ fn lanes_each(rays: &RayLanes, out: &mut [bool], hit: impl Fn([f64; 3], [f64; 3]
 }
 
 /// `out[i] |= ` whether the sphere blocks ray `i`.
-struct SphereBlocks<'a>(&'a Sphere, &'a RayLanes, &'a mut [bool]);
+struct SphereBlocks<'a>(&'a Sphere, &'a RayBlock, &'a mut [bool]);
 
 impl Step for SphereBlocks<'_> {
     #[inline(always)]
@@ -464,7 +464,7 @@ impl Step for SphereBlocks<'_> {
 }
 
 /// `out[i] |= ` whether the plane blocks ray `i`.
-struct PlaneBlocks<'a>(&'a Plane, &'a RayLanes, &'a mut [bool]);
+struct PlaneBlocks<'a>(&'a Plane, &'a RayBlock, &'a mut [bool]);
 
 impl Step for PlaneBlocks<'_> {
     #[inline(always)]
@@ -476,7 +476,7 @@ impl Step for PlaneBlocks<'_> {
 
 /// Sphere `k`'s hits of the rays that are nearer than the hits' so far,
 /// into them.
-struct SphereHits<'a>(&'a Sphere, u32, &'a RayLanes, &'a mut HitLanes);
+struct SphereHits<'a>(&'a Sphere, u32, &'a RayBlock, &'a mut HitBlock);
 
 impl Step for SphereHits<'_> {
     #[inline(always)]
@@ -529,7 +529,7 @@ impl Step for SphereHits<'_> {
 
 /// Plane `k`'s hits of the rays that are nearer than the hits' so far,
 /// into them.
-struct PlaneHits<'a>(&'a Plane, u32, &'a RayLanes, &'a mut HitLanes);
+struct PlaneHits<'a>(&'a Plane, u32, &'a RayBlock, &'a mut HitBlock);
 
 impl Step for PlaneHits<'_> {
     #[inline(always)]
@@ -570,10 +570,10 @@ impl Step for PlaneHits<'_> {
 /// If the three differ in length.
 pub fn spawn_many(
     level: SimdLevel,
-    p: &Vec3Lanes,
-    ng: &Vec3Lanes,
-    dir: &Vec3Lanes,
-    out: &mut RayLanes,
+    p: &Vec3Block,
+    ng: &Vec3Block,
+    dir: &Vec3Block,
+    out: &mut RayBlock,
 ) {
     let n = p.len();
     assert!(
@@ -627,10 +627,10 @@ fn spawn_lanes(
 
 /// [`spawn_many`]'s loop.
 struct Spawn<'a>(
-    &'a Vec3Lanes,
-    &'a Vec3Lanes,
-    &'a Vec3Lanes,
-    &'a mut RayLanes,
+    &'a Vec3Block,
+    &'a Vec3Block,
+    &'a Vec3Block,
+    &'a mut RayBlock,
 );
 
 impl Step for Spawn<'_> {
@@ -731,8 +731,8 @@ mod tests {
         out
     }
 
-    fn lanes_of(rays: &[Ray]) -> RayLanes {
-        let mut l = RayLanes::default();
+    fn block_of(rays: &[Ray]) -> RayBlock {
+        let mut l = RayBlock::default();
         for r in rays {
             l.push(r);
         }
@@ -744,11 +744,11 @@ mod tests {
         for with_mesh in [false, true] {
             let scene = scene(with_mesh);
             let rays = rays(&scene, 4000, 7);
-            let lanes = lanes_of(&rays);
-            let (mut hits, mut blocked) = (HitLanes::default(), Vec::new());
+            let block = block_of(&rays);
+            let (mut hits, mut blocked) = (HitBlock::default(), Vec::new());
             for level in levels() {
-                scene.intersect_many(level, &lanes, &mut hits);
-                scene.occluded_many(level, &lanes, &mut blocked);
+                scene.intersect_many(level, &block, &mut hits);
+                scene.occluded_many(level, &block, &mut blocked);
                 let mut n_hit = 0;
                 for (i, r) in rays.iter().enumerate() {
                     let want = scene.intersect(r, f64::INFINITY);
@@ -814,12 +814,12 @@ mod tests {
                 }
             }
         }
-        let lanes = lanes_of(&rays);
-        let (mut hits, mut blocked) = (HitLanes::default(), Vec::new());
+        let block = block_of(&rays);
+        let (mut hits, mut blocked) = (HitBlock::default(), Vec::new());
         let mut n_blocked = 0;
         for level in levels() {
-            scene.intersect_many(level, &lanes, &mut hits);
-            scene.occluded_many(level, &lanes, &mut blocked);
+            scene.intersect_many(level, &block, &mut hits);
+            scene.occluded_many(level, &block, &mut blocked);
             for (i, r) in rays.iter().enumerate() {
                 assert_eq!(blocked[i], scene.occluded(r), "{level:?} ray {i} {r:?}");
                 n_blocked += usize::from(blocked[i]);
@@ -843,9 +843,9 @@ mod tests {
         let xs: Vec<f64> = (0..1000).map(|_| rng.random_range(0.0..64.0)).collect();
         let ys: Vec<f64> = (0..1000).map(|_| rng.random_range(0.0..48.0)).collect();
         let (mut p, mut ng, mut dir) = (
-            Vec3Lanes::default(),
-            Vec3Lanes::default(),
-            Vec3Lanes::default(),
+            Vec3Block::default(),
+            Vec3Block::default(),
+            Vec3Block::default(),
         );
         for _ in 0..1000 {
             p.push(DVec3::new(
@@ -856,7 +856,7 @@ mod tests {
             ng.push(unit(&mut rng));
             dir.push(unit(&mut rng));
         }
-        let mut out = RayLanes::default();
+        let mut out = RayBlock::default();
         for level in levels() {
             cam.rays_many(level, &xs, &ys, &mut out);
             for i in 0..xs.len() {

@@ -8,7 +8,7 @@ use lobe::sequence::Sequence;
 
 /// Render settings.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct RenderOptions {
+pub struct RenderSettings {
     /// Samples (camera rays) per pixel, at least 1.
     pub spp: u64,
     /// How each hit estimates its reflected light: a BSDF strategy (falling
@@ -119,9 +119,9 @@ impl std::str::FromStr for RenderLoop {
     }
 }
 
-impl Default for RenderOptions {
+impl Default for RenderSettings {
     fn default() -> Self {
-        RenderOptions {
+        RenderSettings {
             spp: 64,
             strategy: Strategy::MIS,
             seed: 1,
