@@ -9,7 +9,7 @@
 //! the same f32.
 
 use crate::eval_line::{Failure, Request, parse_line, unit_interval_f32};
-use lobe::batch::{BatchSampler, Dirs, DirsMut, EvalPdfOutput, RgbMut, SampleInput, SampleOutput};
+use lobe::batch::{BatchSampler, DirPairs, EvalPdfBuffers, SampleBuffers, SampleInputs};
 use lobe::{BsdfStrategy, Material};
 use serde::Serialize;
 use std::io::{self, BufRead, Write};
@@ -17,64 +17,30 @@ use std::io::{self, BufRead, Write};
 /// Lines per block.
 pub const BLOCK: usize = 4096;
 
-/// Structure-of-arrays columns of one kind of line in a block.
+/// The eval lines of a block: their pairs, `f` from the first strategy's
+/// kernel and one pdf column per strategy.
 #[derive(Default)]
-struct Columns {
-    /// Position of each entry among the block's lines.
-    slot: Vec<usize>,
-    /// Input line number, for errors.
+struct EvalLines {
+    /// Input line number of each, for errors.
     line: Vec<usize>,
-    a: [Vec<f32>; 3],
-    b: [Vec<f32>; 3],
-    u1: Vec<f32>,
-    u2: Vec<f32>,
-    uc: Vec<f32>,
-    // Outputs.
-    f: [Vec<f32>; 3],
-    pdf: Vec<f32>,
-    weight: [Vec<f32>; 3],
-    valid: Vec<u8>,
-    /// One pdf column per strategy (eval lines).
+    pairs: DirPairs,
+    out: EvalPdfBuffers,
     pdfs: Vec<Vec<f32>>,
 }
 
-impl Columns {
-    fn clear(&mut self) {
-        self.slot.clear();
-        self.line.clear();
-        for v in self.a.iter_mut().chain(&mut self.b) {
-            v.clear();
-        }
-        self.u1.clear();
-        self.u2.clear();
-        self.uc.clear();
-    }
-
-    fn len(&self) -> usize {
-        self.slot.len()
-    }
-
-    /// Size the output columns to the inputs.
-    fn size_outputs(&mut self, pdf_columns: usize) {
-        let n = self.len();
-        for v in self.f.iter_mut().chain(&mut self.weight) {
-            v.resize(n, 0.0);
-        }
-        self.pdf.resize(n, 0.0);
-        self.valid.resize(n, 0);
-        self.pdfs.resize_with(pdf_columns, Vec::new);
-        for p in &mut self.pdfs {
-            p.resize(n, 0.0);
-        }
-    }
+/// The sample lines of one strategy in a block.
+#[derive(Default)]
+struct SampleLines {
+    /// Input line number of each, for errors.
+    line: Vec<usize>,
+    inputs: SampleInputs,
+    out: SampleBuffers,
 }
 
 /// A direction as the line gave it (checked to be unit within
 /// [`crate::eval_line::UNIT_TOLERANCE`]), rounded to f32.
-fn push3(cols: &mut [Vec<f32>; 3], v: [f64; 3]) {
-    cols[0].push(v[0] as f32);
-    cols[1].push(v[1] as f32);
-    cols[2].push(v[2] as f32);
+fn f32x3(v: [f64; 3]) -> [f32; 3] {
+    v.map(|x| x as f32)
 }
 
 /// Where each line of a block went.
@@ -99,8 +65,8 @@ pub fn process_batch<R: BufRead, W: Write>(
     // Built on first use, so that a material whose batch path lacks a
     // strategy still answers the lines that do not need it.
     let mut samplers: Vec<Option<BatchSampler>> = strategies.iter().map(|_| None).collect();
-    let mut evals = Columns::default();
-    let mut samples: Vec<Columns> = strategies.iter().map(|_| Columns::default()).collect();
+    let mut evals = EvalLines::default();
+    let mut samples: Vec<SampleLines> = strategies.iter().map(|_| SampleLines::default()).collect();
     let mut places: Vec<Place> = Vec::with_capacity(BLOCK);
     let mut line = String::with_capacity(256);
     let mut n = 0usize;
@@ -132,11 +98,9 @@ pub fn process_batch<R: BufRead, W: Write>(
                     Ok(Request::Eval {
                         given: [wo, wi], ..
                     }) => {
-                        places.push(Place::Eval(evals.len()));
-                        evals.slot.push(places.len() - 1);
+                        places.push(Place::Eval(evals.line.len()));
                         evals.line.push(n);
-                        push3(&mut evals.a, wo);
-                        push3(&mut evals.b, wi);
+                        evals.pairs.push(f32x3(wo), f32x3(wi));
                         continue;
                     }
                     Ok(Request::Sample {
@@ -151,13 +115,14 @@ pub fn process_batch<R: BufRead, W: Write>(
                             .position(|&s| s == strategy)
                             .expect("check() accepts only the material's strategies");
                         let c = &mut samples[k];
-                        places.push(Place::Sample(k, c.len()));
-                        c.slot.push(places.len() - 1);
+                        places.push(Place::Sample(k, c.line.len()));
                         c.line.push(n);
-                        push3(&mut c.a, wo);
-                        c.u1.push(unit_interval_f32(u.x));
-                        c.u2.push(unit_interval_f32(u.y));
-                        c.uc.push(unit_interval_f32(uc));
+                        c.inputs.push(
+                            f32x3(wo),
+                            unit_interval_f32(u.x),
+                            unit_interval_f32(u.y),
+                            unit_interval_f32(uc),
+                        );
                         continue;
                     }
                 }
@@ -208,8 +173,8 @@ fn run_block<W: Write>(
     strategies: &[BsdfStrategy],
     keys: &[String],
     samplers: &mut [Option<BatchSampler>],
-    evals: &mut Columns,
-    samples: &mut [Columns],
+    evals: &mut EvalLines,
+    samples: &mut [SampleLines],
     places: &mut Vec<Place>,
     out: &mut W,
 ) -> Result<(), Failure> {
@@ -219,69 +184,31 @@ fn run_block<W: Write>(
     // Eval lines: f from the first strategy's kernel (as the Python
     // package's `Material.eval`: GGX's vndf and brdf kernels compute f
     // another way, equal to rounding), and every strategy's pdf.
-    if evals.len() > 0 {
-        evals.size_outputs(strategies.len());
+    if !evals.pairs.is_empty() {
+        let n = evals.pairs.len();
+        evals.out.resize(n);
+        evals.pdfs.resize_with(strategies.len(), Vec::new);
         let first = evals.line[0];
         for (k, &s) in strategies.iter().enumerate() {
             let sampler = sampler(samplers, material, s, k, first)?;
-            let c = &mut *evals;
+            let (wo, wi) = (evals.pairs.wo(), evals.pairs.wi());
             if k == 0 {
-                let [fr, fg, fb] = &mut c.f;
-                sampler.eval_pdf(
-                    dirs(&c.a),
-                    dirs(&c.b),
-                    EvalPdfOutput {
-                        f: RgbMut {
-                            r: fr,
-                            g: fg,
-                            b: fb,
-                        },
-                        pdf: &mut c.pdfs[k],
-                    },
-                )
+                sampler.eval_pdf(wo, wi, evals.out.output())
             } else {
-                sampler.pdf(dirs(&c.a), dirs(&c.b), &mut c.pdfs[k])
+                evals.pdfs[k].resize(n, 0.0);
+                sampler.pdf(wo, wi, &mut evals.pdfs[k])
             }
             .expect("columns of one length");
         }
     }
     for (k, c) in samples.iter_mut().enumerate() {
-        if c.len() == 0 {
+        if c.inputs.is_empty() {
             continue;
         }
-        c.size_outputs(0);
+        c.out.resize(c.inputs.len());
         let sampler = sampler(samplers, material, strategies[k], k, c.line[0])?;
-        let uc = material.chooses_lobe(strategies[k]).then_some(&c.uc[..]);
-        let [wx, wy, wz] = &mut c.b;
-        for v in [&mut *wx, &mut *wy, &mut *wz] {
-            v.resize(c.slot.len(), 0.0);
-        }
-        let [fr, fg, fb] = &mut c.f;
-        let [r, g, b] = &mut c.weight;
         sampler
-            .sample(
-                SampleInput {
-                    wo: dirs(&c.a),
-                    u1: &c.u1,
-                    u2: &c.u2,
-                    uc,
-                },
-                SampleOutput {
-                    wi: DirsMut {
-                        x: wx,
-                        y: wy,
-                        z: wz,
-                    },
-                    f: RgbMut {
-                        r: fr,
-                        g: fg,
-                        b: fb,
-                    },
-                    pdf: &mut c.pdf,
-                    weight: RgbMut { r, g, b },
-                    valid: &mut c.valid,
-                },
-            )
+            .sample(c.inputs.input(sampler.chooses_lobe()), c.out.output())
             .expect("columns of one length");
     }
     // Write in input order.
@@ -289,7 +216,7 @@ fn run_block<W: Write>(
         match place {
             Place::Eval(i) => {
                 let c = &*evals;
-                let f = [c.f[0][i], c.f[1][i], c.f[2][i]];
+                let f = [c.out.f[0][i], c.out.f[1][i], c.out.f[2][i]];
                 if !f.iter().all(|x| x.is_finite()) {
                     return Err(Failure::Line(
                         c.line[i],
@@ -300,7 +227,7 @@ fn run_block<W: Write>(
                 write3(out, f)?;
                 out.write_all(b",\"pdf\":{")?;
                 for (k, key) in keys.iter().enumerate() {
-                    let p = c.pdfs[k][i];
+                    let p = if k == 0 { c.out.pdf[i] } else { c.pdfs[k][i] };
                     if !p.is_finite() {
                         return Err(Failure::Line(
                             c.line[i],
@@ -319,14 +246,14 @@ fn run_block<W: Write>(
                 out.write_all(b"}}\n")?;
             }
             Place::Sample(k, i) => {
-                let c = &samples[k];
-                if c.valid[i] == 0 {
+                let (c, o) = (&samples[k], &samples[k].out);
+                if o.valid[i] == 0 {
                     out.write_all(b"{\"wi\":null,\"pdf\":0,\"weight\":[0,0,0]}\n")?;
                     continue;
                 }
-                let wi = [c.b[0][i], c.b[1][i], c.b[2][i]];
-                let w = [c.weight[0][i], c.weight[1][i], c.weight[2][i]];
-                let p = c.pdf[i];
+                let wi = [o.wi[0][i], o.wi[1][i], o.wi[2][i]];
+                let w = [o.weight[0][i], o.weight[1][i], o.weight[2][i]];
+                let p = o.pdf[i];
                 if !(wi.iter().chain(&w).all(|x| x.is_finite()) && p.is_finite()) {
                     return Err(Failure::Line(
                         c.line[i],
@@ -346,19 +273,13 @@ fn run_block<W: Write>(
         }
     }
     places.clear();
-    evals.clear();
+    evals.line.clear();
+    evals.pairs.clear();
     for c in samples.iter_mut() {
-        c.clear();
+        c.line.clear();
+        c.inputs.clear();
     }
     Ok(())
-}
-
-fn dirs(c: &[Vec<f32>; 3]) -> Dirs<'_> {
-    Dirs {
-        x: &c[0],
-        y: &c[1],
-        z: &c[2],
-    }
 }
 
 /// A finite `f32`, shortest form that parses back to the same f32.

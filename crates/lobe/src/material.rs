@@ -96,14 +96,12 @@ impl Material {
     }
 
     /// Whether the sampler of `strategy` uses `uc` to choose between two
-    /// lobes: the material has a diffuse term and a glossy lobe, and the
-    /// strategy samples them (not `uniform` or `cosine`). Where it does not,
-    /// `uc` does not change the sample.
+    /// lobes ([`BsdfSampler::chooses_lobe`]); false for a strategy the
+    /// material does not have. Where it does not, `uc` does not change the
+    /// sample.
     #[must_use]
     pub fn chooses_lobe(&self, strategy: BsdfStrategy) -> bool {
-        !matches!(strategy, BsdfStrategy::Uniform | BsdfStrategy::Cosine)
-            && !matches!(self.glossy, Glossy::None)
-            && self.has_diffuse()
+        self.sampler(strategy).is_ok_and(|s| s.chooses_lobe())
     }
 
     /// Probability of choosing the glossy lobe for `wo`.
@@ -261,6 +259,16 @@ impl<'m> BsdfSampler<'m> {
     #[must_use]
     pub fn material(&self) -> &'m Material {
         self.material
+    }
+
+    /// Whether `sample` uses `uc` to choose between two lobes: the material
+    /// has a diffuse term and a glossy lobe, and the strategy samples them
+    /// (not `uniform` or `cosine`).
+    #[inline]
+    #[must_use]
+    pub fn chooses_lobe(&self) -> bool {
+        let m = self.material;
+        matches!(self.draw, Draw::Lobes(..)) && !matches!(m.glossy, Glossy::None) && m.has_diffuse()
     }
 
     /// Density in solid angle with which `sample(wo, ..)` returns `wi`;

@@ -239,6 +239,7 @@
 //! multiply-add at every level), so the three levels give the same bits.
 
 mod block;
+mod buffers;
 mod dispatch;
 mod kernel;
 mod lanes;
@@ -246,6 +247,8 @@ mod math;
 mod measured;
 #[cfg(test)]
 mod tests;
+
+pub use buffers::{DirPairs, EvalPdfBuffers, SampleBuffers, SampleInputs};
 
 use crate::models::{CookTorrance, Glossy};
 use crate::{BsdfStrategy, Fresnel, Material, Ndf, Rgb, Shadowing};
@@ -511,90 +514,6 @@ pub enum Store {
     #[default]
     Cached,
     Streamed,
-}
-
-/// Owned output arrays for blocks of `n` samples, allocated once.
-#[derive(Debug, Clone, PartialEq)]
-pub struct SampleBuffers {
-    pub wi: [Vec<f32>; 3],
-    pub f: [Vec<f32>; 3],
-    pub pdf: Vec<f32>,
-    pub weight: [Vec<f32>; 3],
-    pub valid: Vec<u8>,
-}
-
-impl SampleBuffers {
-    #[must_use]
-    pub fn new(n: usize) -> Self {
-        let v = || vec![0.0f32; n];
-        SampleBuffers {
-            wi: [v(), v(), v()],
-            f: [v(), v(), v()],
-            pdf: v(),
-            weight: [v(), v(), v()],
-            valid: vec![0; n],
-        }
-    }
-
-    /// The buffers as the output of one `sample` call.
-    #[must_use]
-    pub fn output(&mut self) -> SampleOutput<'_> {
-        let [wx, wy, wz] = &mut self.wi;
-        let [fr, fg, fb] = &mut self.f;
-        let [r, g, b] = &mut self.weight;
-        SampleOutput {
-            wi: DirsMut {
-                x: wx,
-                y: wy,
-                z: wz,
-            },
-            f: RgbMut {
-                r: fr,
-                g: fg,
-                b: fb,
-            },
-            pdf: &mut self.pdf,
-            weight: RgbMut { r, g, b },
-            valid: &mut self.valid,
-        }
-    }
-
-    /// The sampled directions, as the input of `eval_pdf`.
-    #[must_use]
-    pub fn wi(&self) -> Dirs<'_> {
-        Dirs {
-            x: &self.wi[0],
-            y: &self.wi[1],
-            z: &self.wi[2],
-        }
-    }
-}
-
-/// Owned output arrays of `eval_pdf` for blocks of `n` pairs.
-#[derive(Debug, Clone, PartialEq)]
-pub struct EvalPdfBuffers {
-    pub f: [Vec<f32>; 3],
-    pub pdf: Vec<f32>,
-}
-
-impl EvalPdfBuffers {
-    #[must_use]
-    pub fn new(n: usize) -> Self {
-        let v = || vec![0.0f32; n];
-        EvalPdfBuffers {
-            f: [v(), v(), v()],
-            pdf: v(),
-        }
-    }
-
-    #[must_use]
-    pub fn output(&mut self) -> EvalPdfOutput<'_> {
-        let [r, g, b] = &mut self.f;
-        EvalPdfOutput {
-            f: RgbMut { r, g, b },
-            pdf: &mut self.pdf,
-        }
-    }
 }
 
 /// A material and strategy prepared for the batch kernels at one level.
