@@ -188,13 +188,32 @@ pub fn load_material(spec: &str) -> Result<lobe::Material> {
     Ok(m)
 }
 
+/// [`warn_energy_gain`] for every object of a scene loaded from `path`,
+/// named by its place among the file's `[[object]]` tables.
+pub fn warn_scene_energy_gain(scene: &lobe_render::Scene, path: &std::path::Path) {
+    for (i, o) in scene.objects.iter().enumerate() {
+        warn_energy_gain(
+            &o.material,
+            &format!("{}: object {}'s material", path.display(), i + 1),
+        );
+    }
+}
+
 /// Warn once on stderr when `m` reflects more than it receives: its largest
 /// directional albedo ([`lobe::experiment::variance::max_albedo`]) is above 1.
 pub fn warn_energy_gain(m: &lobe::Material, what: &str) {
     let a = lobe::experiment::variance::max_albedo(m);
     if a.gains_energy() {
+        // Cook-Torrance without a Fresnel term (Mitsuba's default) reflects
+        // all of ks at every angle: the usual cause.
+        let hint = match &m.glossy {
+            lobe::Glossy::CookTorrance(ct) if ct.fresnel == lobe::Fresnel::None => {
+                "lower kd or ks, or give the Cook-Torrance lobe a fresnel term: its default, none, is F = 1"
+            }
+            _ => "lower kd or ks",
+        };
         eprintln!(
-            "lobe: warning: {what} reflects more light than it receives: its directional albedo is {:.3} at θo = {}° (above 1, so it gains energy; lower kd or ks)",
+            "lobe: warning: {what} reflects more light than it receives: its directional albedo is {:.3} at θo = {}° (above 1, so it gains energy; {hint})",
             a.albedo, a.theta_deg
         );
     }

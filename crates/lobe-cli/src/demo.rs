@@ -316,8 +316,11 @@ fn showcase_scene(width: u32, height: u32) -> Result<(Scene, Vec<Label>)> {
 fn showcase_caption(s: &CompareSettings) -> Vec<String> {
     vec![
         format!(
-            "Rows: the reference (mis-balance, {} spp), then each strategy at {} spp, its error map on the right; paths of up to {} bounces.",
-            s.reference_spp, s.spp, s.max_depth
+            "Rows: the reference ({}, {} spp), then each strategy at {} spp, its error map on the right; paths of up to {} bounces.",
+            lobe_render::compare::REFERENCE_STRATEGY.name(),
+            s.reference_spp,
+            s.spp,
+            s.max_depth
         ),
         "brdf samples the BSDF only: it rarely finds the small sun, so the ground shows the blue sky with sun fireflies.".to_string(),
         "light samples the sky and sun only: clean on the diffuse ground, noisy on glossy lobes, worst on sharp gold; mis gives each pixel's draws to BSDF sampling, the balance heuristic or the light, as its pilot finds best.".to_string(),
@@ -351,7 +354,11 @@ fn showcase(demo: &DemoSettings, dir: &Path, quiet: bool) -> Result<()> {
         "BSDF sampling (brdf), light sampling and MIS at {} spp, paths of up to {} bounces; the reference",
         settings.spp, settings.max_depth
     );
-    println!("is MIS at {} spp.", settings.reference_spp);
+    println!(
+        "is {} (MIS with the balance heuristic) at {} spp.",
+        lobe_render::compare::REFERENCE_STRATEGY.name(),
+        settings.reference_spp
+    );
     let cmp = run_with_progress(&scene, &settings, quiet);
     let png = dir.join("showcase.png");
     let json = dir.join("showcase.json");

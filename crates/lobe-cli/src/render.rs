@@ -182,6 +182,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             .build_global();
     }
     let mut scene = load_scene(&args.scene)?;
+    crate::common::warn_scene_energy_gain(&scene, &args.scene);
     let mut opts = scene.settings;
     if let Some(n) = args.spp {
         opts.spp = n;

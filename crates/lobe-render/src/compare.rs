@@ -13,7 +13,7 @@
 //!   when `mis` is not compared) at `max(spp, MIN_EQUAL_TIME_SPP)`, measured
 //!   without start-up; each strategy is rendered with the spp that bring its
 //!   time within [`EQUAL_TIME_TOLERANCE`] of it ([`run_comparison`]).
-//! * **Reference**: [`REFERENCE_METHOD`] at the reference spp, with the
+//! * **Reference**: [`REFERENCE_STRATEGY`] at the reference spp, with the
 //!   bitwise complement of the seed ([`reference_seed`]), so that its
 //!   samples are independent of the compared renders' (the same seed would
 //!   make `mis`'s first samples the reference's own and flatter its error).
@@ -31,7 +31,7 @@ use lobe::progress::{Clock, Progress, timed};
 use serde::Serialize;
 
 /// The strategy of the reference render.
-pub const REFERENCE_METHOD: Strategy = Strategy::mis(Heuristic::Balance);
+pub const REFERENCE_STRATEGY: Strategy = Strategy::mis(Heuristic::Balance);
 
 /// Most samples per pixel an equal-time render may take.
 pub const MAX_EQUAL_TIME_SPP: f64 = 1_048_576.0;
@@ -325,7 +325,12 @@ pub fn run_comparison(
         }
     });
     let seed = reference_seed(s.seed);
-    let mut reference = shot(REFERENCE_METHOD, s.reference_spp.max(1), seed, "reference");
+    let mut reference = shot(
+        REFERENCE_STRATEGY,
+        s.reference_spp.max(1),
+        seed,
+        "reference",
+    );
     reference.rmse = 0.0;
     let mut cmp = Comparison {
         reference,

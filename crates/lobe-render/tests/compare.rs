@@ -8,7 +8,7 @@ use lobe::estimator::{Heuristic, Strategy};
 use lobe::progress::{Clock, Progress};
 use lobe::{Material, Rgb};
 use lobe_render::compare::{
-    CompareSettings, EQUAL_TIME_TOLERANCE, LogScale, REFERENCE_METHOD, default_reference_spp,
+    CompareSettings, EQUAL_TIME_TOLERANCE, LogScale, REFERENCE_STRATEGY, default_reference_spp,
     default_strategies, error_epsilon, error_map, reference_seed, resample, rmse, run_comparison,
 };
 use lobe_render::{Camera, Image, Object, Scene};
@@ -219,7 +219,7 @@ fn a_comparison_under_a_fake_clock() {
             et.budget_s
         );
     }
-    assert_eq!(cmp.reference.strategy, REFERENCE_METHOD);
+    assert_eq!(cmp.reference.strategy, REFERENCE_STRATEGY);
     assert_eq!(cmp.reference.spp, 16);
     assert_eq!(cmp.reference_seed, reference_seed(9));
     assert_eq!(cmp.reference.rmse, 0.0);

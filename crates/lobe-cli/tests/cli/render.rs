@@ -627,3 +627,51 @@ fn a_scene_places_the_skys_sun() {
         "{e}"
     );
 }
+
+/// A scene's material that reflects more than it receives is warned about
+/// as `--material` is, naming the file and the object, with the hint that
+/// Cook-Torrance's default Fresnel term is F = 1; the example scene is not.
+#[test]
+fn a_scene_material_that_gains_energy_is_warned_about() {
+    let d = dir("energy");
+    let scene = d.join("scene.toml");
+    std::fs::write(
+        &scene,
+        common::sphere_scene(
+            8,
+            6,
+            r#"{ type = "cook-torrance", distribution = "ggx", alpha = 0.3, kd = 0.5 }"#,
+            r#"{ type = "lambert", albedo = 0.5 }"#,
+            64,
+        ),
+    )
+    .unwrap();
+    let run = |scene: &str, out: &Path| {
+        lobe(
+            &[
+                "render",
+                scene,
+                "--spp",
+                "1",
+                "--quiet",
+                "--out",
+                out.to_str().unwrap(),
+            ],
+            Some(&Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")),
+        )
+    };
+    let o = run(scene.to_str().unwrap(), &d.join("a"));
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let e = String::from_utf8_lossy(&o.stderr);
+    let warning: Vec<&str> = e.lines().filter(|l| l.contains("warning")).collect();
+    assert_eq!(warning.len(), 1, "{e}");
+    assert!(
+        warning[0].contains("scene.toml: object 1's material reflects more light than it receives")
+            && warning[0].contains("its default, none, is F = 1"),
+        "{e}"
+    );
+    let o = run("examples/scene.toml", &d.join("b"));
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(!e.contains("warning"), "{e}");
+}
