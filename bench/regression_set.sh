@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The regression set: renders, eval lines and estimate tables whose bytes a
+# The regression set: renders, eval lines (scalar and --batch) and estimate tables whose bytes a
 # change that claims "the same numbers" must keep. Run it with the binary
 # before and after the change, then compare the two folders:
 #
@@ -54,7 +54,7 @@ for m in "${materials[@]}"; do
     k=$((k + 1))
     "$lobe" estimate --material "$m" --theta 50 --light sky:20:70 --samples 20000 \
         --strategy all --json > "$out/estimate_$k.json" 2>/dev/null
-    python3 - <<'PY' | "$lobe" eval --material "$m" > "$out/eval_$k.jsonl"
+    python3 - > "$out/lines_$k.jsonl" <<'PY'
 import json, math, random
 random.seed(1)
 for i in range(2000):
@@ -64,5 +64,7 @@ for i in range(2000):
     t, p = random.random() * 1.5, random.random() * 6.28
     print(json.dumps({"wo": wo, "wi": [math.sin(t) * math.cos(p), math.sin(t) * math.sin(p), math.cos(t)]}))
 PY
+    "$lobe" eval --material "$m" < "$out/lines_$k.jsonl" > "$out/eval_$k.jsonl"
+    "$lobe" eval --batch --material "$m" < "$out/lines_$k.jsonl" > "$out/eval_batch_$k.jsonl"
 done
 echo "wrote $(ls "$out" | wc -l) files to $out"

@@ -148,6 +148,34 @@ def test_render_a_tiny_scene():
         lobe.render(scene, spp_allocation="even")
 
 
+@pytest.mark.skipif(sys.platform == "win32", reason="SIGINT to oneself is POSIX")
+def test_ctrl_c_stops_a_render():
+    """Ctrl-C (SIGINT) during lobe.render raises KeyboardInterrupt within a
+    second or so, instead of after the whole render (about a minute here)."""
+    import signal
+    import threading
+    import time
+
+    scene = {
+        "camera": {"origin": [0, 0, 4], "target": [0, 0, 0], "width": 64, "height": 48},
+        "environment": {"path": "sky"},
+        "object": [{"type": "sphere", "center": [0, 0, 0], "radius": 1,
+                    "material": {"type": "cook-torrance", "distribution": "ggx", "alpha": 0.3}}],
+    }
+    timer = threading.Timer(0.5, lambda: os.kill(os.getpid(), signal.SIGINT))
+    t0 = time.monotonic()
+    timer.start()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            lobe.render(scene, spp=1 << 18, seed=1)
+    finally:
+        timer.cancel()
+    elapsed = time.monotonic() - t0
+    assert elapsed < 10, f"the render went on for {elapsed:.1f} s after Ctrl-C"
+    # The package works afterwards.
+    assert lobe.render(scene, spp=1, seed=1).shape == (48, 64, 3)
+
+
 def test_the_lecture_example_runs():
     """examples/lecture_comparison.py (without its matplotlib plot): every
     strategy's estimate prints, and importance sampling has less variance

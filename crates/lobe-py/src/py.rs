@@ -812,6 +812,46 @@ fn _estimate_json(
 
 /// Render a scene (TOML text as if read from `path`) to an (H, W, 3)
 /// float32 linear image.
+/// Run `work` with the GIL released, on a thread of its own, while this
+/// thread (Python's main thread, where signal handlers run) checks for
+/// signals between waits of at most 50 ms: on Ctrl-C the flag `work` is
+/// given is set, `work` is awaited (it stops at its next check), and the
+/// signal's exception (`KeyboardInterrupt`) is raised instead of a result.
+fn interruptible<T: Send>(
+    py: Python<'_>,
+    work: impl FnOnce(&std::sync::atomic::AtomicBool) -> T + Send,
+) -> PyResult<T> {
+    use std::sync::atomic::{AtomicBool, Ordering};
+    let cancel = AtomicBool::new(false);
+    let (out, interrupted) = py.detach(|| {
+        std::thread::scope(|s| {
+            let (done, finished) = std::sync::mpsc::channel::<()>();
+            let flag = &cancel;
+            let worker = s.spawn(move || {
+                let out = work(flag);
+                let _ = done.send(());
+                out
+            });
+            let mut interrupted = None;
+            while let Err(std::sync::mpsc::RecvTimeoutError::Timeout) =
+                finished.recv_timeout(std::time::Duration::from_millis(50))
+            {
+                if interrupted.is_none() {
+                    if let Err(e) = Python::attach(|py| py.check_signals()) {
+                        cancel.store(true, Ordering::Relaxed);
+                        interrupted = Some(e);
+                    }
+                }
+            }
+            (worker.join(), interrupted)
+        })
+    });
+    if let Some(e) = interrupted {
+        return Err(e);
+    }
+    out.map_err(|_| pyo3::exceptions::PyRuntimeError::new_err("lobe: the work panicked"))
+}
+
 #[pyfunction]
 #[pyo3(signature = (text, path, spp, strategy, seed, max_depth, threads, spp_allocation))]
 #[allow(clippy::too_many_arguments)]
@@ -860,7 +900,11 @@ fn _render<'py>(
     opts.threads = threads;
     scene.settings = opts;
     let (w, h) = (scene.camera.width as usize, scene.camera.height as usize);
-    let img = py.detach(|| lobe_render::render(&scene, &opts, |_| {}));
+    // One pass, as `render` renders it (the same bits), stopped by Ctrl-C.
+    let img = interruptible(py, |cancel| {
+        lobe_render::integrator::render_until(&scene, &opts, None, 1, cancel, |_| {})
+    })?
+    .expect("a render that was not interrupted finishes its pass");
     let data = img.to_rgb32f();
     Ok(Array1::from_vec(data)
         .into_shape_with_order((h, w, 3))

@@ -58,7 +58,7 @@ pub(crate) fn map_indices<T: Send>(n: usize, f: impl Fn(usize) -> T + Sync + Sen
 /// `parallel`) and merged in chunk order: the same numbers as the serial
 /// estimate, for any thread count. Calls `progress.advance(k)` after each
 /// chunk of `k` samples (it does not call `start`). The error says why the
-/// settings's strategy does not apply to `m`.
+/// settings' strategy does not apply to `m`.
 pub fn estimate_chunked(
     m: &Material,
     sp: &ShadingPoint,
