@@ -11,7 +11,12 @@
 //! to the right and `y` up. With `wo = (sin θo, 0, cos θo)` the viewer is on
 //! the right and the mirror direction on the left.
 
-use anyhow::{Result, anyhow, bail};
+use crate::draw::{
+    DIM_TEXT, DResult, Figure, GRID, LIGHT_GRID, OUTLINE, Orientation, TEXT, colorbar_extent,
+    draw_colorbar, draw_title, fit_size, fmt_num, fmt_p, font, linear_ticks, log_ticks,
+    power_label, put_text, save_figure, text_style, text_width, viridis,
+};
+use anyhow::{Result, bail};
 use glam::{DVec2, DVec3};
 use lobe::BsdfSampler;
 use lobe::experiment::histogram::{WeightPixel, weight_pixels};
@@ -19,9 +24,8 @@ use lobe::experiment::polar::{CurveKind, PolarCurves};
 use plotters::coord::Shift;
 use plotters::coord::ranged1d::{DefaultFormatting, KeyPointHint, Ranged};
 use plotters::prelude::*;
-use plotters::style::text_anchor::{HPos, Pos, VPos};
+use plotters::style::text_anchor::{HPos, VPos};
 use std::path::Path;
-use std::sync::OnceLock;
 
 /// Size in pixels of a polar plot.
 pub const POLAR_SIZE: (u32, u32) = (800, 500);
@@ -33,10 +37,6 @@ pub const WEIGHTS_SIZE: (u32, u32) = (640, 600);
 /// Significance level of the pass/fail word of [`warp_histogram`]: the test
 /// passes when `p_value > PASS_LEVEL` (Nori's warp test uses 1 %).
 pub const PASS_LEVEL: f64 = 0.01;
-
-/// The font family every figure uses; DejaVu Sans is registered under it.
-const FONT: &str = "sans-serif";
-static FONT_BYTES: &[u8] = include_bytes!("../assets/DejaVuSans.ttf");
 
 // ---------------------------------------------------------------------------
 // Public API
@@ -216,346 +216,10 @@ pub fn weight_heatmap(
     )
 }
 
-/// The viridis colour map (perceptually uniform, readable in grey and by
-/// colour-blind readers) at `t ∈ [0, 1]` (clamped; NaN gives the low end).
-/// Linear interpolation between ten anchors of the published map.
-#[must_use]
-pub fn viridis(t: f64) -> RGBColor {
-    const ANCHORS: [(u8, u8, u8); 10] = [
-        (0x44, 0x01, 0x54),
-        (0x48, 0x28, 0x78),
-        (0x3e, 0x4a, 0x89),
-        (0x31, 0x68, 0x8e),
-        (0x26, 0x82, 0x8e),
-        (0x1f, 0x9e, 0x89),
-        (0x35, 0xb7, 0x79),
-        (0x6d, 0xcd, 0x59),
-        (0xb4, 0xde, 0x2c),
-        (0xfd, 0xe7, 0x25),
-    ];
-    let t = if t.is_nan() { 0.0 } else { t.clamp(0.0, 1.0) };
-    let s = t * (ANCHORS.len() - 1) as f64;
-    let k = (s.floor() as usize).min(ANCHORS.len() - 2);
-    let f = s - k as f64;
-    let (a, b) = (ANCHORS[k], ANCHORS[k + 1]);
-    let mix = |x: u8, y: u8| (f64::from(x) + f * (f64::from(y) - f64::from(x))).round() as u8;
-    RGBColor(mix(a.0, b.0), mix(a.1, b.1), mix(a.2, b.2))
-}
-
-// ---------------------------------------------------------------------------
-// Rendering to a file
-// ---------------------------------------------------------------------------
-
-type DResult<DB, T = ()> =
-    std::result::Result<T, DrawingAreaErrorKind<<DB as DrawingBackend>::ErrorType>>;
-
-/// A figure that can draw itself on any plotters backend.
-trait Figure {
-    fn size(&self) -> (u32, u32);
-    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DResult<DB>;
-}
-
-/// Writes RGB8 pixels (`size.0 × size.1`, row-major) as a PNG file.
-pub(crate) fn write_png(path: &Path, rgb: &[u8], size: (u32, u32)) -> Result<()> {
-    image::save_buffer_with_format(
-        path,
-        rgb,
-        size.0,
-        size.1,
-        image::ExtendedColorType::Rgb8,
-        image::ImageFormat::Png,
-    )
-    .map_err(|e| anyhow!("cannot write {}: {e}", path.display()))
-}
-
-/// Adds a white strip under the PNG at `path` holding `lines` of caption
-/// text (left-aligned, each shrunk to fit the width), rewrites the file and
-/// returns the new size.
-///
-/// # Errors
-///
-/// The file cannot be read, decoded or written.
-pub fn append_caption(path: &Path, lines: &[String]) -> Result<(u32, u32)> {
-    register_fonts()?;
-    let img = image::open(path)
-        .map_err(|e| anyhow!("cannot read {}: {e}", path.display()))?
-        .to_rgb8();
-    let (w, h) = img.dimensions();
-    let line_h = 22;
-    let strip = line_h * lines.len() as u32 + 14;
-    let size = (w, h + strip);
-    let mut buffer = vec![255u8; w as usize * size.1 as usize * 3];
-    buffer[..img.as_raw().len()].copy_from_slice(img.as_raw());
-    {
-        let root = BitMapBackend::with_buffer(&mut buffer, size).into_drawing_area();
-        let draw = || -> DResult<BitMapBackend<'_>> {
-            for (k, line) in lines.iter().enumerate() {
-                let fs = fit_size(&root, line, 16.0, w.saturating_sub(32))?;
-                put_text(
-                    &root,
-                    line,
-                    (16, (h + 6 + line_h * k as u32) as i32),
-                    fs,
-                    TEXT,
-                    (HPos::Left, VPos::Top),
-                )?;
-            }
-            Ok(())
-        };
-        draw().map_err(|e| anyhow!("drawing {}: {e}", path.display()))?;
-        root.present()
-            .map_err(|e| anyhow!("drawing {}: {e}", path.display()))?;
-    }
-    write_png(path, &buffer, size)?;
-    Ok(size)
-}
-
-/// Registers the embedded DejaVu Sans once; plotters' ab_glyph text needs it.
-pub(crate) fn register_fonts() -> Result<()> {
-    static DONE: OnceLock<bool> = OnceLock::new();
-    let ok = *DONE.get_or_init(|| {
-        ["sans-serif", "serif", "monospace"].iter().all(|family| {
-            plotters::style::register_font(family, FontStyle::Normal, FONT_BYTES).is_ok()
-        })
-    });
-    if ok {
-        Ok(())
-    } else {
-        Err(anyhow!("the embedded font could not be loaded"))
-    }
-}
-
-fn save_figure(path: &Path, fig: &impl Figure) -> Result<()> {
-    register_fonts()?;
-    let shown = path.display();
-    let ext = path
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(str::to_ascii_lowercase);
-    match ext.as_deref() {
-        Some("png") => {
-            let (w, h) = fig.size();
-            let mut buffer = vec![0u8; w as usize * h as usize * 3];
-            {
-                let root = BitMapBackend::with_buffer(&mut buffer, (w, h)).into_drawing_area();
-                fig.draw(&root)
-                    .map_err(|e| anyhow!("drawing {shown}: {e}"))?;
-                root.present()
-                    .map_err(|e| anyhow!("drawing {shown}: {e}"))?;
-            }
-            write_png(path, &buffer, (w, h))?;
-        }
-        Some("svg") => {
-            let root = SVGBackend::new(path, fig.size()).into_drawing_area();
-            fig.draw(&root)
-                .map_err(|e| anyhow!("drawing {shown}: {e}"))?;
-            root.present()
-                .map_err(|e| anyhow!("cannot write {shown}: {e}"))?;
-        }
-        _ => bail!("{shown}: a figure file name must end in .png or .svg"),
-    }
-    Ok(())
-}
-
-// ---------------------------------------------------------------------------
-// Small helpers: colours, text, numbers
-// ---------------------------------------------------------------------------
-
-const GRID: RGBColor = RGBColor(215, 215, 215);
-const LIGHT_GRID: RGBColor = RGBColor(238, 238, 238);
-const TEXT: RGBColor = RGBColor(30, 30, 30);
-const DIM_TEXT: RGBColor = RGBColor(100, 100, 100);
 /// Pixels where `f > 0` but `pdf = 0`.
 const UNSAMPLED: RGBColor = RGBColor(228, 26, 28);
 /// Pixels where `f = 0`.
 const ZERO_F: RGBColor = RGBColor(190, 190, 190);
-
-fn font(size: f64) -> FontDesc<'static> {
-    (FONT, size).into_font()
-}
-
-fn text_style(size: f64, color: RGBColor, h: HPos, v: VPos) -> TextStyle<'static> {
-    font(size).color(&color).pos(Pos::new(h, v))
-}
-
-/// Draws `s` at pixel `pos` of `area`, anchored by `h` and `v`.
-fn put_text<DB: DrawingBackend>(
-    area: &DrawingArea<DB, Shift>,
-    s: &str,
-    pos: (i32, i32),
-    size: f64,
-    color: RGBColor,
-    (h, v): (HPos, VPos),
-) -> DResult<DB> {
-    area.draw_text(s, &text_style(size, color, h, v), pos)
-}
-
-/// The largest font size ≤ `size` at which `s` fits in `width` pixels.
-fn fit_size<DB: DrawingBackend>(
-    area: &DrawingArea<DB, Shift>,
-    s: &str,
-    size: f64,
-    width: u32,
-) -> DResult<DB, f64> {
-    let mut size = size;
-    while size > 9.0 {
-        let (w, _) = area.estimate_text_size(s, &font(size).into_text_style(area))?;
-        if w <= width {
-            break;
-        }
-        size -= 1.0;
-    }
-    Ok(size)
-}
-
-/// Draws a title centred at the top of `area` (shrunk to fit) and returns
-/// the height it took.
-fn draw_title<DB: DrawingBackend>(
-    area: &DrawingArea<DB, Shift>,
-    title: &str,
-    size: f64,
-) -> DResult<DB, i32> {
-    let (w, _) = area.dim_in_pixel();
-    let size = fit_size(area, title, size, w.saturating_sub(40))?;
-    put_text(
-        area,
-        title,
-        (w as i32 / 2, 8),
-        size,
-        TEXT,
-        (HPos::Center, VPos::Top),
-    )?;
-    Ok(size.round() as i32 + 16)
-}
-
-/// `n` as Unicode superscript digits, with a real minus sign.
-pub(crate) fn superscript(n: i64) -> String {
-    n.to_string()
-        .chars()
-        .map(|c| match c {
-            '-' => '⁻',
-            '0' => '⁰',
-            '1' => '¹',
-            '2' => '²',
-            '3' => '³',
-            '4' => '⁴',
-            '5' => '⁵',
-            '6' => '⁶',
-            '7' => '⁷',
-            '8' => '⁸',
-            _ => '⁹',
-        })
-        .collect()
-}
-
-/// `base^k` for an integer-valued `k`, e.g. `2¹⁰`, `10⁻³`.
-fn power_label(base: u32, k: f64) -> String {
-    format!("{base}{}", superscript(k.round() as i64))
-}
-
-/// A short human number: `0.0123`, `4.5`, `1200`, `3.2e-7`, with `−`.
-fn fmt_num(v: f64) -> String {
-    if v == 0.0 || !v.is_finite() {
-        return if v == 0.0 { "0".into() } else { format!("{v}") };
-    }
-    let a = v.abs();
-    let s = if (1e-3..1e6).contains(&a) {
-        let decimals = (2 - a.log10().floor() as i32).clamp(0, 5) as usize;
-        let s = format!("{v:.decimals$}");
-        if s.contains('.') {
-            s.trim_end_matches('0').trim_end_matches('.').to_string()
-        } else {
-            s
-        }
-    } else {
-        let e = a.log10().floor();
-        let m = v / 10f64.powf(e);
-        let m = format!("{m:.1}");
-        let m = m.trim_end_matches('0').trim_end_matches('.');
-        format!("{m}e{}", e as i64)
-    };
-    s.replace('-', "−")
-}
-
-/// The p-value as text: four decimals, or scientific below 1e-4.
-fn fmt_p(p: f64) -> String {
-    if p == 0.0 {
-        "0".into()
-    } else if p < 1e-4 {
-        format!("{p:.1e}").replace('-', "−")
-    } else {
-        format!("{p:.4}")
-    }
-}
-
-/// A "nice" step (1, 2 or 5 × 10^k) giving about `count` steps over `span`.
-fn nice_step(span: f64, count: f64) -> f64 {
-    let raw = (span / count).max(f64::MIN_POSITIVE);
-    let p = 10f64.powf(raw.log10().floor());
-    let m = raw / p;
-    let m = if m <= 1.0 {
-        1.0
-    } else if m <= 2.0 {
-        2.0
-    } else if m <= 5.0 {
-        5.0
-    } else {
-        10.0
-    };
-    m * p
-}
-
-/// Ticks (position in [0, 1] along a colour bar, label) for a log10 scale
-/// from `lo` to `hi` (in log10 units): decades over a wide range, else
-/// 1-2-5 (or finer) multiples.
-fn log_ticks(lo: f64, hi: f64) -> Vec<(f64, String)> {
-    let span = hi - lo;
-    let eps = 0.01 * span;
-    let mut ticks = Vec::new();
-    if span >= 3.0 {
-        let step = (span / 8.0).ceil().max(1.0);
-        let mut k = ((lo - eps) / step).ceil() * step;
-        while k <= hi + eps {
-            let v = 10f64.powf(k);
-            let label = if (1e-2..1e4).contains(&v) {
-                fmt_num(v)
-            } else {
-                power_label(10, k)
-            };
-            ticks.push((((k - lo) / span).clamp(0.0, 1.0), label));
-            k += step;
-        }
-    } else {
-        let mantissas: &[f64] = if span < 0.6 {
-            &[1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0]
-        } else if span < 1.5 {
-            &[1.0, 2.0, 3.0, 5.0]
-        } else {
-            &[1.0, 2.0, 5.0]
-        };
-        for d in (lo.floor() as i64)..=(hi.ceil() as i64) {
-            for &m in mantissas {
-                let t = (d as f64) + f64::log10(m);
-                if t >= lo - eps && t <= hi + eps {
-                    ticks.push((((t - lo) / span).clamp(0.0, 1.0), fmt_num(10f64.powf(t))));
-                }
-            }
-        }
-    }
-    ticks
-}
-
-/// Ticks for a linear scale from 0 to `hi`.
-fn linear_ticks(hi: f64) -> Vec<(f64, String)> {
-    let step = nice_step(hi, 5.0);
-    let mut ticks = Vec::new();
-    let mut k = 0.0;
-    while k <= hi * (1.0 + 1e-9) {
-        ticks.push((k / hi, fmt_num(k)));
-        k += step;
-    }
-    ticks
-}
 
 // ---------------------------------------------------------------------------
 // Convergence plot
@@ -723,7 +387,7 @@ impl Figure for Convergence<'_> {
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DResult<DB> {
         root.fill(&WHITE)?;
         let (width, _) = root.dim_in_pixel();
-        let title_size = fit_size(root, self.title, 22.0, width.saturating_sub(30))?;
+        let title_size = fit_size(self.title, 22.0, width as i32 - 30);
         put_text(
             root,
             self.title,
@@ -734,7 +398,7 @@ impl Figure for Convergence<'_> {
         )?;
         let key = "one panel per sample sequence, one colour per strategy; \
                    grey dashes: slope −1/2 (RMSE ∝ 1/√N, plain Monte Carlo)";
-        let key_size = fit_size(root, key, 15.0, width.saturating_sub(30))?;
+        let key_size = fit_size(key, 15.0, width as i32 - 30);
         put_text(
             root,
             key,
@@ -1007,7 +671,7 @@ impl Figure for Polar<'_> {
                 fmt_num(self.curves.albedo)
             ),
         };
-        let csize = fit_size(root, &caption, 14.0, w.saturating_sub(30))?;
+        let csize = fit_size(&caption, 14.0, w as i32 - 30);
         put_text(
             root,
             &caption,
@@ -1154,7 +818,7 @@ impl Figure for Polar<'_> {
                 CurveKind::Pdf(s) => format!("pdf {s}"),
             };
             let text = format!("{label} (max {})", fmt_num(c.max()));
-            let size = fit_size(root, &text, 14.0, (col_w - 40) as u32)?;
+            let size = fit_size(&text, 14.0, col_w - 40);
             put_text(
                 root,
                 &text,
@@ -1211,10 +875,9 @@ fn draw_disk_map<DB: DrawingBackend>(
             }
         }
     }
-    let outline = RGBColor(120, 120, 120);
     area.draw(&Rectangle::new(
         [(b.x0, b.y0), (b.x0 + b.size, b.y0 + b.size)],
-        outline.mix(0.5).stroke_width(1),
+        OUTLINE.mix(0.5).stroke_width(1),
     ))?;
     let circle: Vec<(i32, i32)> = (0..=256)
         .map(|k| {
@@ -1222,18 +885,18 @@ fn draw_disk_map<DB: DrawingBackend>(
             b.to_px(a.cos(), a.sin())
         })
         .collect();
-    area.draw(&PathElement::new(circle, outline.stroke_width(1)))?;
+    area.draw(&PathElement::new(circle, OUTLINE.stroke_width(1)))?;
     for v in [-1.0, 0.0, 1.0] {
         let (x, _) = b.to_px(v, 0.0);
         let (_, y) = b.to_px(0.0, v);
         let bottom = b.y0 + b.size;
         area.draw(&PathElement::new(
             vec![(x, bottom), (x, bottom + 4)],
-            outline.stroke_width(1),
+            OUTLINE.stroke_width(1),
         ))?;
         area.draw(&PathElement::new(
             vec![(b.x0 - 4, y), (b.x0, y)],
-            outline.stroke_width(1),
+            OUTLINE.stroke_width(1),
         ))?;
         let label = fmt_num(v);
         put_text(
@@ -1271,76 +934,6 @@ fn draw_disk_map<DB: DrawingBackend>(
         TEXT,
         (HPos::Right, VPos::Center),
     )?;
-    Ok(())
-}
-
-/// Width in pixels that [`draw_colorbar`] takes with a bar `width` wide:
-/// the bar, its tick labels and its rotated label.
-fn colorbar_width<DB: DrawingBackend>(
-    area: &DrawingArea<DB, Shift>,
-    width: i32,
-    ticks: &[(f64, String)],
-) -> DResult<DB, i32> {
-    let mut widest = 0u32;
-    for (_, s) in ticks {
-        widest = widest.max(
-            area.estimate_text_size(s, &font(12.0).into_text_style(area))?
-                .0,
-        );
-    }
-    Ok(width + 12 + widest as i32 + 22)
-}
-
-/// Draws a vertical viridis colour bar `width` wide at `(x, top)` down to
-/// `bottom`, its `ticks` (position 0 at the bottom, 1 at the top, label) to
-/// the right, and `label` rotated along its right side.
-fn draw_colorbar<DB: DrawingBackend>(
-    area: &DrawingArea<DB, Shift>,
-    (x, top, bottom): (i32, i32, i32),
-    width: i32,
-    ticks: &[(f64, String)],
-    label: &str,
-) -> DResult<DB> {
-    let h = (bottom - top).max(1);
-    for k in 0..h {
-        let t = 1.0 - (f64::from(k) + 0.5) / f64::from(h);
-        area.draw(&Rectangle::new(
-            [(x, top + k), (x + width, top + k + 1)],
-            viridis(t).filled(),
-        ))?;
-    }
-    area.draw(&Rectangle::new(
-        [(x, top), (x + width, bottom)],
-        RGBColor(120, 120, 120).stroke_width(1),
-    ))?;
-    let mut widest = 0u32;
-    for (t, s) in ticks {
-        let y = bottom - (t * f64::from(h)).round() as i32;
-        area.draw(&PathElement::new(
-            vec![(x + width, y), (x + width + 4, y)],
-            BLACK.stroke_width(1),
-        ))?;
-        put_text(
-            area,
-            s,
-            (x + width + 6, y),
-            12.0,
-            TEXT,
-            (HPos::Left, VPos::Center),
-        )?;
-        widest = widest.max(
-            area.estimate_text_size(s, &font(12.0).into_text_style(area))?
-                .0,
-        );
-    }
-    // Rotated to read upwards; VPos::Top puts the text to the right of the
-    // anchor.
-    let style = font(13.0)
-        .transform(FontTransform::Rotate270)
-        .color(&TEXT)
-        .pos(Pos::new(HPos::Center, VPos::Top));
-    let lx = x + width + 12 + widest as i32;
-    area.draw_text(label, &style, (lx, (top + bottom) / 2))?;
     Ok(())
 }
 
@@ -1397,7 +990,7 @@ impl Figure for WarpHistogram<'_> {
         let (w, _) = root.dim_in_pixel();
         // Room for the tick labels at the left, the gap, and the colour bar.
         let ticks = linear_ticks(vmax);
-        let bar_w = colorbar_width(root, 16, &ticks)?;
+        let bar_w = colorbar_extent(16, &ticks);
         // Room for the tick labels at the left, the gap, and the colour bar.
         let size =
             (h as i32 - title_h - label_h - 34).min((w as i32 - 44 - 50 - 24 - bar_w - 8) / 2);
@@ -1433,10 +1026,12 @@ impl Figure for WarpHistogram<'_> {
         }
         draw_colorbar(
             root,
-            (right.x0 + size + 24, top, top + size),
-            16,
+            (right.x0 + size + 24, top),
+            (16, size),
+            Orientation::Vertical {
+                name: &format!("samples per pixel ({res}×{res} pixels)"),
+            },
             &ticks,
-            &format!("samples per pixel ({res}×{res} pixels)"),
         )?;
         Ok(())
     }
@@ -1502,7 +1097,7 @@ impl Figure for WeightMap<'_> {
         }
         let (w, h) = root.dim_in_pixel();
         let legend_h = 44;
-        let bar_w = colorbar_width(root, 16, &ticks)?;
+        let bar_w = colorbar_extent(16, &ticks);
         let size = (h as i32 - title_h - legend_h - 30).min(w as i32 - 44 - 24 - bar_w - 8);
         let b = MapBox {
             x0: 44,
@@ -1526,10 +1121,12 @@ impl Figure for WeightMap<'_> {
 
         draw_colorbar(
             root,
-            (b.x0 + size + 24, b.y0, b.y0 + size),
-            16,
+            (b.x0 + size + 24, b.y0),
+            (16, size),
+            Orientation::Vertical {
+                name: "weight f·cos θi / pdf (log scale)",
+            },
             &ticks,
-            "weight f·cos θi / pdf (log scale)",
         )?;
 
         // Legend and range.
@@ -1549,7 +1146,7 @@ impl Figure for WeightMap<'_> {
             root.draw(&Rectangle::new([(x, y - 6), (x + 12, y + 6)], c.filled()))?;
             root.draw(&Rectangle::new(
                 [(x, y - 6), (x + 12, y + 6)],
-                RGBColor(120, 120, 120).stroke_width(1),
+                OUTLINE.stroke_width(1),
             ))
         };
         swatch(x, y1, UNSAMPLED)?;
@@ -1566,11 +1163,7 @@ impl Figure for WeightMap<'_> {
             TEXT,
             (HPos::Left, VPos::Center),
         )?;
-        x += 18
-            + root
-                .estimate_text_size(&s, &font(13.0).into_text_style(root))?
-                .0 as i32
-            + 18;
+        x += 18 + text_width(&s, 13.0) + 18;
         swatch(x, y1, ZERO_F)?;
         let s = format!("f = 0: {zero_f} px");
         put_text(
@@ -1607,23 +1200,6 @@ impl Figure for WeightMap<'_> {
 mod tests {
     use super::*;
     use lobe::{BsdfStrategy, Material};
-
-    #[test]
-    fn numbers_read_well() {
-        assert_eq!(fmt_num(0.0123), "0.0123");
-        assert_eq!(fmt_num(1200.0), "1200");
-        assert_eq!(fmt_num(-0.5), "−0.5");
-        assert_eq!(fmt_num(3.2e-7), "3.2e−7");
-        assert_eq!(superscript(-12), "⁻¹²");
-        assert_eq!(power_label(2, 10.0), "2¹⁰");
-    }
-
-    #[test]
-    fn viridis_ends() {
-        assert_eq!(viridis(0.0), RGBColor(0x44, 0x01, 0x54));
-        assert_eq!(viridis(1.0), RGBColor(0xfd, 0xe7, 0x25));
-        assert_eq!(viridis(f64::NAN), viridis(0.0));
-    }
 
     /// Draws every figure as PNG and SVG (into `LOBE_FIGURES_DIR` when set,
     /// to look at them).

@@ -141,11 +141,7 @@ fn draw(
     fit: &lobe::Material,
 ) -> Result<()> {
     use plotters::prelude::*;
-    crate::figures::register_fonts()?;
-    let (w, h) = (1200u32, 900u32);
-    let mut buffer = vec![0u8; (w * h * 3) as usize];
-    {
-        let root = BitMapBackend::with_buffer(&mut buffer, (w, h)).into_drawing_area();
+    crate::draw::paint_png(path, Vec::new(), (1200, 900), |root| {
         root.fill(&WHITE).map_err(|e| anyhow::anyhow!("{e}"))?;
         let root = root
             .titled(title, ("sans-serif", 24))
@@ -195,11 +191,7 @@ fn draw(
                 .draw()
                 .map_err(|e| anyhow::anyhow!("{e}"))?;
         }
-        root.present().map_err(|e| anyhow::anyhow!("{e}"))?;
-    }
-    image::RgbImage::from_raw(w, h, buffer)
-        .ok_or_else(|| anyhow::anyhow!("image buffer"))?
-        .save(path)
-        .with_context(|| format!("--plot {}", path.display()))?;
-    Ok(())
+        Ok(())
+    })
+    .with_context(|| format!("--plot {}", path.display()))
 }

@@ -14,6 +14,7 @@
 
 use crate::common::load_material;
 use crate::common::{Bar, ViewArgs};
+use crate::draw::paint_png;
 use crate::figures;
 use anyhow::{Context, Result, anyhow, bail};
 use clap::Args;
@@ -362,11 +363,7 @@ fn fit_polar(
 ) -> Result<()> {
     use plotters::prelude::*;
     let e = |e: &dyn std::fmt::Display| anyhow!("{path:?}: {e}");
-    figures::register_fonts()?;
-    let (w, h) = (1200u32, 760u32);
-    let mut buffer = vec![0u8; (w * h * 3) as usize];
-    {
-        let root = BitMapBackend::with_buffer(&mut buffer, (w, h)).into_drawing_area();
+    paint_png(path, Vec::new(), (1200, 760), |root| {
         root.fill(&WHITE).map_err(|x| e(&x))?;
         let root = root.titled(title, ("sans-serif", 20)).map_err(|x| e(&x))?;
         for (panel, theta) in root
@@ -469,11 +466,6 @@ fn fit_polar(
                 .draw()
                 .map_err(|x| e(&x))?;
         }
-        root.present().map_err(|x| e(&x))?;
-    }
-    image::RgbImage::from_raw(w, h, buffer)
-        .ok_or_else(|| anyhow!("image buffer"))?
-        .save(path)
-        .with_context(|| format!("--out {}", path.display()))?;
-    Ok(())
+        Ok(())
+    })
 }
