@@ -2,7 +2,7 @@
 //! frame, and its tick labels; vertical beside a map (with a rotated name)
 //! or horizontal in a box.
 
-use super::DResult;
+use super::error::DResult;
 use super::palette::{OUTLINE, TEXT, viridis};
 use super::text::{font, put_text, text_width};
 use plotters::coord::Shift;

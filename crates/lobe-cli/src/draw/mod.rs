@@ -4,24 +4,15 @@
 //! colours and the colour bar, and writing PNG (or SVG) files.
 
 mod colorbar;
+mod error;
 mod numbers;
 mod output;
 mod palette;
 mod text;
 
 pub use colorbar::{Orientation, colorbar_extent, draw_colorbar};
+pub use error::{DResult, drawing_error};
 pub use numbers::{fmt_num, fmt_p, fmt_time, linear_ticks, log_ticks, power_label, sig3};
 pub use output::{Figure, append_caption, paint_png, save_figure};
 pub use palette::{DIM_TEXT, GRID, LIGHT_GRID, OUTLINE, TEXT, viridis};
 pub use text::{draw_title, fit_size, font, put_text, text_style, text_width};
-
-use plotters::prelude::{DrawingAreaErrorKind, DrawingBackend};
-
-/// The result of a drawing call on a plotters backend `DB`.
-pub type DResult<DB, T = ()> =
-    std::result::Result<T, DrawingAreaErrorKind<<DB as DrawingBackend>::ErrorType>>;
-
-/// A plotters error as an [`anyhow::Error`] (its own message).
-pub fn drawing_error(e: impl std::fmt::Display) -> anyhow::Error {
-    anyhow::anyhow!("{e}")
-}

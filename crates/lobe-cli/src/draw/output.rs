@@ -2,7 +2,7 @@
 //! [`Figure`] to PNG or SVG by the file's extension, and a caption strip
 //! added under a PNG.
 
-use super::DResult;
+use super::error::DResult;
 use super::palette::TEXT;
 use super::text::{fit_size, put_text, register_fonts};
 use anyhow::{Result, anyhow, bail};

@@ -1,7 +1,7 @@
 //! Text: the embedded DejaVu Sans, measuring a string, shrinking it to a
 //! width, and drawing it at an anchor.
 
-use super::DResult;
+use super::error::DResult;
 use super::palette::TEXT;
 use anyhow::{Result, anyhow};
 use plotters::coord::Shift;
