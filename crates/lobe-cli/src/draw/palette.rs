@@ -40,6 +40,47 @@ pub fn viridis(t: f64) -> RGBColor {
     RGBColor(mix(a.0, b.0), mix(a.1, b.1), mix(a.2, b.2))
 }
 
+/// The names whose colour is fixed, so that a strategy has the same colour
+/// in every figure: every strategy lobe knows, in [`lobe::Strategy::all`] order.
+fn strategy_order() -> Vec<String> {
+    lobe::Strategy::all().iter().map(|s| s.name()).collect()
+}
+
+/// Twelve colours that stay apart: Okabe–Ito's seven (yellow left out),
+/// then purple, brown, crimson, olive and indigo.
+const STRATEGY_PALETTE: [RGBColor; 12] = [
+    RGBColor(0, 114, 178),
+    RGBColor(213, 94, 0),
+    RGBColor(0, 158, 115),
+    RGBColor(204, 121, 167),
+    RGBColor(230, 159, 0),
+    RGBColor(86, 180, 233),
+    RGBColor(0, 0, 0),
+    RGBColor(117, 60, 160),
+    RGBColor(140, 86, 40),
+    RGBColor(170, 30, 60),
+    RGBColor(110, 130, 0),
+    RGBColor(50, 50, 140),
+];
+
+/// The colour of the strategy `names[k]`: fixed for the known names, else
+/// the next colour after them in order of first appearance.
+pub fn strategy_color(names: &[&str], k: usize) -> RGBColor {
+    let name = names[k];
+    let order = strategy_order();
+    if let Some(i) = order.iter().position(|n| n == name) {
+        return STRATEGY_PALETTE[i];
+    }
+    let mut unknown: Vec<&str> = Vec::new();
+    for n in names {
+        if !order.iter().any(|o| o == n) && !unknown.contains(n) {
+            unknown.push(n);
+        }
+    }
+    let i = unknown.iter().position(|n| *n == name).unwrap_or(0);
+    STRATEGY_PALETTE[(order.len() + i) % STRATEGY_PALETTE.len()]
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
