@@ -11,9 +11,9 @@
 //!    RMSE, and a caption that says what each row shows.
 
 use crate::common::Bar;
-use crate::compare::{
-    FigureSpec, Label, print_table, run_with_progress, summary, write_grid, write_json,
-};
+use crate::compare::{print_table, run_with_progress, summary, write_json};
+use crate::compare_figure::{FigureSpec, Label, write_grid};
+use crate::draw::{append_caption, fmt_time};
 use anyhow::Result;
 use clap::Args;
 use glam::DVec3;
@@ -121,10 +121,7 @@ pub fn run(args: &DemoArgs) -> Result<()> {
     crate::common::prepare_output_dir("--out", &args.out)?;
     tour(&demo, args.quiet)?;
     showcase(&demo, &args.out, args.quiet)?;
-    println!(
-        "\ndone in {}",
-        crate::compare::fmt_time(t0.elapsed().as_secs_f64())
-    );
+    println!("\ndone in {}", fmt_time(t0.elapsed().as_secs_f64()));
     Ok(())
 }
 
@@ -374,7 +371,7 @@ fn showcase(demo: &DemoSettings, dir: &Path, quiet: bool) -> Result<()> {
         },
     )?;
     let caption = showcase_caption(&settings);
-    (figure.width, figure.height) = crate::figures::append_caption(&png, &caption)?;
+    (figure.width, figure.height) = append_caption(&png, &caption)?;
     write_json(
         &json,
         &summary("built-in showcase", &settings, &cmp, figure),

@@ -103,7 +103,7 @@ pub fn run(args: &FitArgs) -> Result<()> {
             fit_label(&fit),
             fit.error
         );
-        draw(path, &title, &m, &fitted)?;
+        crate::figures::fit_curves_plot(path, &title, &m, &fitted)?;
         eprintln!("wrote {}", path.display());
     }
     Ok(())
@@ -130,76 +130,4 @@ pub fn fit_label(fit: &lobe::fit::Fit) -> String {
         fit.settings.distribution.name(),
         fit.settings.fresnel.name()
     )
-}
-
-/// Four panels, one per view: the data and the fit, `lum(f cos θi)` over
-/// the signed `θi` of the plane of incidence.
-fn draw(
-    path: &std::path::Path,
-    title: &str,
-    data: &lobe::Material,
-    fit: &lobe::Material,
-) -> Result<()> {
-    use plotters::prelude::*;
-    crate::figures::register_fonts()?;
-    let (w, h) = (1200u32, 900u32);
-    let mut buffer = vec![0u8; (w * h * 3) as usize];
-    {
-        let root = BitMapBackend::with_buffer(&mut buffer, (w, h)).into_drawing_area();
-        root.fill(&WHITE).map_err(|e| anyhow::anyhow!("{e}"))?;
-        let root = root
-            .titled(title, ("sans-serif", 24))
-            .map_err(|e| anyhow::anyhow!("{e}"))?;
-        let panels = root.split_evenly((2, 2));
-        for (panel, theta) in panels.iter().zip([0.0, 30.0, 60.0, 75.0]) {
-            let d = lobe::fit::incidence_plane(data, theta, 360);
-            let f = lobe::fit::incidence_plane(fit, theta, 360);
-            let ymax = d
-                .iter()
-                .chain(&f)
-                .map(|p| p.1)
-                .fold(0.0f64, f64::max)
-                .max(1e-9)
-                * 1.08;
-            let mut chart = ChartBuilder::on(panel)
-                .caption(format!("θo = {theta}°"), ("sans-serif", 20))
-                .margin(12)
-                .x_label_area_size(40)
-                .y_label_area_size(60)
-                .build_cartesian_2d(-90f64..90f64, 0f64..ymax)
-                .map_err(|e| anyhow::anyhow!("{e}"))?;
-            chart
-                .configure_mesh()
-                .x_desc("θi in the plane of incidence (°; negative: the mirror side)")
-                .y_desc("lum(f · cos θi)")
-                .label_style(("sans-serif", 14))
-                .draw()
-                .map_err(|e| anyhow::anyhow!("{e}"))?;
-            chart
-                .draw_series(LineSeries::new(d, BLACK.stroke_width(3)))
-                .map_err(|e| anyhow::anyhow!("{e}"))?
-                .label("data")
-                .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], BLACK.stroke_width(3)));
-            chart
-                .draw_series(LineSeries::new(f, RGBColor(220, 50, 30).stroke_width(2)))
-                .map_err(|e| anyhow::anyhow!("{e}"))?
-                .label("fit")
-                .legend(|(x, y)| {
-                    PathElement::new([(x, y), (x + 20, y)], RGBColor(220, 50, 30).stroke_width(2))
-                });
-            chart
-                .configure_series_labels()
-                .border_style(BLACK)
-                .background_style(WHITE)
-                .label_font(("sans-serif", 16))
-                .draw()
-                .map_err(|e| anyhow::anyhow!("{e}"))?;
-        }
-        root.present().map_err(|e| anyhow::anyhow!("{e}"))?;
-    }
-    image::RgbImage::from_raw(w, h, buffer)
-        .ok_or_else(|| anyhow::anyhow!("image buffer"))?
-        .save(path)
-        .with_context(|| format!("--plot {}", path.display()))?;
-    Ok(())
 }
