@@ -331,6 +331,7 @@ pub fn run(args: &CompareArgs) -> Result<()> {
         &["png", "json"].map(|e| crate::common::with_ext(&base, e)),
     )?;
     let scene = load_scene(&args.scene)?;
+    crate::common::warn_scene_energy_gain(&scene, &args.scene);
     let strategies = strategies.unwrap_or_else(|| default_strategies(&scene));
     let spp = args
         .spp
