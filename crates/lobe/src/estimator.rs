@@ -860,29 +860,28 @@ pub fn reference(m: &Material, sp: &ShadingPoint, light: &Light, rel: f64) -> Rg
     Rgb::new(channel(0), channel(1), channel(2))
 }
 
-/// Row `j` of the environment-map reference: `Σ_i L(i, j) ∫_texel f cos dω`.
-/// Each texel integral is a 4 × 4 Gauss–Legendre rule in `(cos θ, φ)`,
-/// compared with the same rule on the texel's four quarters and refined
-/// where they differ by more than `rel` (up to 6 levels).
+/// Row `j` of the environment-map reference: `Σ_i L(i, j) ∫_texel f cos dω`,
+/// or for a smooth map ([`EnvMap::smooth`]) `Σ_i ∫_texel L f cos dω` over
+/// the texel's four quarters, where the interpolated `L` is smooth. Each
+/// integral is a 4 × 4 Gauss–Legendre rule in `(cos θ, φ)`, compared with
+/// the same rule on the cell's four quarters and refined where they differ
+/// by more than `rel` (up to 6 levels).
 #[must_use]
 pub fn reference_env_row(m: &Material, sp: &ShadingPoint, map: &EnvMap, j: usize, rel: f64) -> Rgb {
     let (wo, frame) = (sp.wo, &sp.frame);
     let (w, _) = map.size();
+    let smooth = map.is_smooth();
     let mut sum = Rgb::ZERO;
     for i in 0..w {
         let l = map.texel(i, j);
-        if l == Rgb::ZERO {
+        if l == Rgb::ZERO && !smooth {
             continue;
         }
-        let ((t0, t1), (p0, p1)) = map.texel_region(i, j);
-        let g = |c: f64, phi: f64| {
-            let d = map.spherical_to_direction(crate::math::safe_acos(c), phi);
-            let wi = frame.to_local(d);
-            if wi.z <= 0.0 {
-                0.0
-            } else {
-                luminance(m.eval(wo, wi)) * wi.z
-            }
+        // (A smooth map's radiance in the integrand, a texel's outside.)
+        let (l, radiance) = if smooth {
+            (Rgb::ONE, Some(map))
+        } else {
+            (l, None)
         };
         let gc = |c: f64, phi: f64| {
             let d = map.spherical_to_direction(crate::math::safe_acos(c), phi);
@@ -890,11 +889,25 @@ pub fn reference_env_row(m: &Material, sp: &ShadingPoint, map: &EnvMap, j: usize
             if wi.z <= 0.0 {
                 Rgb::ZERO
             } else {
-                m.eval(wo, wi) * wi.z
+                let f = m.eval(wo, wi) * wi.z;
+                radiance.map_or(f, |map| f * map.eval(d))
             }
         };
+        let g = |c: f64, phi: f64| luminance(gc(c, phi));
+        let ((t0, t1), (p0, p1)) = map.texel_region(i, j);
+        let cells = if smooth {
+            let (tm, pm) = (0.5 * (t0 + t1), 0.5 * (p0 + p1));
+            vec![
+                (t0.cos(), tm.cos(), p0, pm, 0u32),
+                (tm.cos(), t1.cos(), p0, pm, 0),
+                (t0.cos(), tm.cos(), pm, p1, 0),
+                (tm.cos(), t1.cos(), pm, p1, 0),
+            ]
+        } else {
+            vec![(t0.cos(), t1.cos(), p0, p1, 0u32)]
+        };
         // Refine on luminance, integrate RGB on the accepted cells.
-        let mut stack = vec![(t0.cos(), t1.cos(), p0, p1, 0u32)];
+        let mut stack = cells;
         while let Some((c0, c1, a, b, depth)) = stack.pop() {
             let whole = gauss_legendre_4x4(g, c0, c1, a, b);
             let (cm, pm) = (0.5 * (c0 + c1), 0.5 * (a + b));

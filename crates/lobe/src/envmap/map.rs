@@ -23,6 +23,11 @@ pub struct EnvMap {
     /// aligned block, and computes the luminance the densities are
     /// functions of ([`TexelSampler::weight`]) from it.
     pub(super) texels: Vec<Texel>,
+    /// For a smooth map ([`EnvMap::smooth`]), the texels its densities are
+    /// functions of: each texel's average of the bilinear radiance over it
+    /// (a 3 × 3 tent filter); `None` for a map of nearest texels, whose
+    /// densities are functions of `texels`.
+    pub(super) sampling: Option<Vec<Texel>>,
     scale: f64,
     /// cos and sin of the rotation about +Y.
     rot: (f64, f64),
@@ -208,14 +213,7 @@ impl EnvMap {
     ) -> Self {
         // The plain density's tables only when something draws from it (light
         // sampling alone; MIS draws from the compensated one).
-        let plain = TexelSampler::new(width, height, None, &texels, false);
-        // Mean luminance over the sphere, then the part above it.
-        let mean = plain.norm / (4.0 * PI);
-        let compensated = if texels.iter().any(|t| (t.lum() - mean).max(0.0) > 0.0) {
-            TexelSampler::new(width, height, Some(mean), &texels, true)
-        } else {
-            plain.clone()
-        };
+        let (plain, compensated) = Self::samplers(width, height, &texels);
         let r = rotation_y_deg.to_radians();
         EnvMap {
             width,
@@ -227,11 +225,104 @@ impl EnvMap {
                 .map(|i| (2.0 * PI * i as f64 / width as f64).sin_cos())
                 .collect(),
             texels,
+            sampling: None,
             scale,
             rot: (r.cos(), r.sin()),
             plain,
             compensated,
         }
+    }
+
+    /// The plain and the compensated densities of texels of these weights.
+    fn samplers(width: usize, height: usize, texels: &[Texel]) -> (TexelSampler, TexelSampler) {
+        // The plain density's tables only when something draws from it (light
+        // sampling alone; MIS draws from the compensated one).
+        let plain = TexelSampler::new(width, height, None, texels, false);
+        // Mean luminance over the sphere, then the part above it.
+        let mean = plain.norm / (4.0 * PI);
+        let compensated = if texels.iter().any(|t| (t.lum() - mean).max(0.0) > 0.0) {
+            TexelSampler::new(width, height, Some(mean), texels, true)
+        } else {
+            plain.clone()
+        };
+        (plain, compensated)
+    }
+
+    /// This map with a smooth radiance: [`EnvMap::eval`] interpolates the
+    /// texels bilinearly in `(u, v)` between their centres (columns
+    /// wrapped, rows clamped at the poles), continuous everywhere but at
+    /// the poles themselves, instead of the nearest texel's piecewise
+    /// constant radiance, which puts the texel edges into images.
+    ///
+    /// Light sampling stays piecewise constant over the texels, with each
+    /// texel's weight the average of the interpolated radiance over it (in
+    /// `(u, v)`: the texel and its 8 neighbours with weights `(1, 6, 36)/64`
+    /// for corner, edge and centre); the pdfs are exactly the densities of
+    /// the draws, positive wherever the radiance is (the interpolation uses
+    /// only texels of that neighbourhood), and within a small factor of
+    /// the radiance over it.
+    #[must_use]
+    pub fn smooth(mut self) -> Self {
+        let (w, h) = (self.width, self.height);
+        let tent = [0.125, 0.75, 0.125];
+        let mut filtered = Vec::with_capacity(w * h);
+        for j in 0..h {
+            for i in 0..w {
+                let mut c = [0.0f64; 3];
+                for (dj, wj) in tent.iter().enumerate() {
+                    let jj = (j + dj).saturating_sub(1).min(h - 1);
+                    for (di, wi) in tent.iter().enumerate() {
+                        let ii = (i + w + di - 1) % w;
+                        let t = self.texels[jj * w + ii].rgb;
+                        for k in 0..3 {
+                            c[k] += wj * wi * f64::from(t[k]);
+                        }
+                    }
+                }
+                filtered.push(Texel {
+                    rgb: c.map(|x| x as f32),
+                });
+            }
+        }
+        (self.plain, self.compensated) = Self::samplers(w, h, &filtered);
+        self.sampling = Some(filtered);
+        self
+    }
+
+    /// Whether [`EnvMap::eval`] interpolates ([`EnvMap::smooth`]).
+    #[must_use]
+    pub fn is_smooth(&self) -> bool {
+        self.sampling.is_some()
+    }
+
+    /// The texels the densities are functions of.
+    #[inline]
+    pub(super) fn sampling_texels(&self) -> &[Texel] {
+        self.sampling.as_deref().unwrap_or(&self.texels)
+    }
+
+    /// The scaled radiance at world direction `d` (unit), of texel `k`
+    /// (`d`'s, by [`EnvMap::texel_index`]): the texel's for a map of
+    /// nearest texels, interpolated for a smooth one.
+    #[inline]
+    pub(super) fn radiance_in(&self, k: usize, d: DVec3) -> Rgb {
+        if self.sampling.is_none() {
+            return self.radiance_at(k);
+        }
+        let uv = self.direction_to_uv(d);
+        let (w, h) = (self.width, self.height);
+        let x = uv.x * w as f64 - 0.5;
+        let y = (uv.y * h as f64 - 0.5).clamp(0.0, (h - 1) as f64);
+        let (xf, yf) = (x.floor(), y.floor());
+        let (fx, fy) = (x - xf, y - yf);
+        let i0 = (xf as i64).rem_euclid(w as i64) as usize;
+        let i1 = (i0 + 1) % w;
+        let j0 = (yf as usize).min(h - 1);
+        let j1 = (j0 + 1).min(h - 1);
+        let at = |i: usize, j: usize| self.texels[j * w + i].rgb();
+        let top = at(i0, j0) * (1.0 - fx) + at(i1, j0) * fx;
+        let bottom = at(i0, j1) * (1.0 - fx) + at(i1, j1) * fx;
+        (top * (1.0 - fy) + bottom * fy) * self.scale
     }
 
     /// A map of one constant radiance (one texel).
@@ -360,7 +451,7 @@ impl EnvMap {
     #[must_use]
     pub fn eval(&self, d: DVec3) -> Rgb {
         let (i, j) = self.texel_index(d);
-        self.texel(i, j)
+        self.radiance_in(j * self.width + i, d)
     }
 
     /// Build the tables that drawing from the map needs now, for both
@@ -368,8 +459,8 @@ impl EnvMap {
     /// from it): on rayon's threads, where a first draw on one of them
     /// builds them on that thread alone. The same draws either way.
     pub fn prepare_sampling(&self) {
-        let _ = self.plain.columns(&self.texels);
-        let _ = self.compensated.columns(&self.texels);
+        let _ = self.plain.columns(self.sampling_texels());
+        let _ = self.compensated.columns(self.sampling_texels());
     }
 
     /// Draw a world direction with density ∝ luminance; `None` for a black map.
@@ -403,7 +494,7 @@ impl EnvMap {
 
     fn sample_with(&self, t: &TexelSampler, u: DVec2) -> Option<(DVec3, f64)> {
         let (j, ru) = t.rows.sample(u.x)?;
-        let (i, rv) = t.columns(&self.texels).row(j).sample(u.y)?;
+        let (i, rv) = t.columns(self.sampling_texels()).row(j).sample(u.y)?;
         // Uniform in solid angle inside the texel: uniform in cos θ and φ.
         let t0 = PI * j as f64 / self.height as f64;
         let t1 = PI * (j + 1) as f64 / self.height as f64;
@@ -422,7 +513,7 @@ impl EnvMap {
             return 0.0;
         }
         let (i, j) = self.texel_index(d);
-        t.weight(self.texels[j * self.width + i].lum()) / t.norm
+        t.weight(self.sampling_texels()[j * self.width + i].lum()) / t.norm
     }
 
     /// The solid-angle region of texel `(i, j)`: `(θ₀, θ₁)`, `(φ₀, φ₁)` in the
@@ -446,6 +537,7 @@ impl EnvMap {
     /// A procedural sky with a sun, the embedded default: a blue gradient
     /// above the horizon, a dim ground, and a small bright sun at elevation
     /// `sun_elevation_deg` toward azimuth `sun_azimuth_deg` (degrees; 0 is −Z).
+    /// Its radiance is smooth ([`EnvMap::smooth`]): no texel edges.
     #[must_use]
     pub fn sky(width: usize, height: usize, sun_elevation_deg: f64, sun_azimuth_deg: f64) -> Self {
         let (el, az) = (sun_elevation_deg.to_radians(), sun_azimuth_deg.to_radians());
@@ -477,6 +569,7 @@ impl EnvMap {
         EnvMap::new(width, height, tex, 1.0, 0.0)
             .expect("the sky is a valid map")
             .0
+            .smooth()
     }
 }
 
@@ -646,6 +739,77 @@ mod tests {
                 let (i, j) = m.texel_index(d);
                 assert!(i < w && j < h);
             }
+        }
+    }
+
+    /// Issue 41: the built-in sky has no stripes. Along a great circle
+    /// that crosses rows and columns, in steps of a sixteenth of a texel,
+    /// no step changes the radiance by more than a quarter of its range
+    /// over the 16 steps around it: no jumps at the texel edges (the
+    /// nearest texels, before, jumped by all of it in one step). Away
+    /// from the sun.
+    #[test]
+    fn the_sky_has_no_stripes() {
+        let (el, az) = (30.0f64, 40.0f64);
+        let sky = EnvMap::sky(64, 32, el, az);
+        assert!(sky.is_smooth());
+        let sun = {
+            let (e, a) = (el.to_radians(), az.to_radians());
+            DVec3::new(e.cos() * a.sin(), e.sin(), -e.cos() * a.cos())
+        };
+        let nearest = EnvMap::new(
+            64,
+            32,
+            (0..32 * 64).map(|k| sky.texel(k % 64, k / 64)).collect(),
+            1.0,
+            0.0,
+        )
+        .unwrap()
+        .0;
+        let a = DVec3::new(0.3, 0.8, -0.5).normalize();
+        let b = a.cross(DVec3::new(0.6, 0.1, 0.8)).normalize();
+        let steps = 64 * 16;
+        let dirs: Vec<DVec3> = (0..=steps)
+            .map(|k| {
+                let t = std::f64::consts::TAU * k as f64 / steps as f64;
+                a * t.cos() + b * t.sin()
+            })
+            .collect();
+        let worst = |m: &EnvMap| {
+            let lum: Vec<f64> = dirs
+                .iter()
+                .map(|&d| crate::math::luminance(m.eval(d)))
+                .collect();
+            let mut worst: f64 = 0.0;
+            for k in 8..steps - 8 {
+                if dirs[k].dot(sun) > 10f64.to_radians().cos() {
+                    continue;
+                }
+                let step = (lum[k + 1] - lum[k]).abs();
+                let window = &lum[k - 8..=k + 8];
+                let range = window.iter().copied().fold(f64::MIN, f64::max)
+                    - window.iter().copied().fold(f64::MAX, f64::min);
+                if range > 1e-9 {
+                    worst = worst.max(step / range);
+                }
+            }
+            worst
+        };
+        let (smooth, stepped) = (worst(&sky), worst(&nearest));
+        eprintln!(
+            "largest step / its window's range: smooth {smooth:.3}, nearest texels {stepped:.3}"
+        );
+        assert!(
+            smooth <= 0.25,
+            "smooth sky: a step of {smooth} of its texel's change"
+        );
+        assert!(stepped > 0.9, "nearest texels: {stepped}");
+        // The pdf is positive wherever the radiance is, and the radiance
+        // over the pdf is bounded (a small factor of the map's total).
+        for &d in &dirs {
+            let (l, p) = (crate::math::luminance(sky.eval(d)), sky.pdf(d));
+            assert!(l > 0.0 && p > 0.0);
+            assert!(l / p < 20.0 * sky.plain.norm, "{d}: {l} / {p}");
         }
     }
 }

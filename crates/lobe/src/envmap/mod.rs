@@ -11,7 +11,10 @@
 //! `u = atan2(d.x, −d.z) / (2π)` wrapped into [0, 1) and `v = acos(d.y) / π`;
 //! texel `(i, j)` covers `u ∈ [i, i+1)/width`, `v ∈ [j, j+1)/height`, and the
 //! radiance is constant over it (nearest texel), so that light sampling can be
-//! exactly proportional to it.
+//! exactly proportional to it. A smooth map ([`EnvMap::smooth`]; the
+//! built-in sky, [`EnvMap::sky`]) interpolates its texels bilinearly
+//! instead, and its densities are those below with each texel's luminance
+//! replaced by its average of the interpolated radiance.
 //!
 //! Light sampling picks a texel with probability proportional to its
 //! luminance times its solid angle `(2π/width)(cos θ₀ − cos θ₁)` (the sin θ

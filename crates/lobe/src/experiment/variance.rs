@@ -111,14 +111,17 @@ pub fn uniform_variance(
     }
 }
 
-/// Row `j` of the environment map's `∫ lum(f L cos)² dω` (without the 2π).
+/// Row `j` of the environment map's `∫ lum(f L cos)² dω` (without the 2π);
+/// a smooth map's ([`EnvMap::smooth`]) interpolated `L` over each texel's
+/// four quarters, where it is smooth.
 fn env_row_second_moment(m: &Material, sp: &ShadingPoint, map: &EnvMap, j: usize) -> f64 {
     let (wo, frame) = (sp.wo, &sp.frame);
     let (w, _) = map.size();
+    let smooth = map.is_smooth();
     let mut sum = 0.0;
     for i in 0..w {
         let l: Rgb = map.texel(i, j);
-        if l == Rgb::ZERO {
+        if l == Rgb::ZERO && !smooth {
             continue;
         }
         let ((t0, t1), (p0, p1)) = map.texel_region(i, j);
@@ -128,11 +131,22 @@ fn env_row_second_moment(m: &Material, sp: &ShadingPoint, map: &EnvMap, j: usize
             if wi.z <= 0.0 {
                 0.0
             } else {
+                let l = if smooth { map.eval(d) } else { l };
                 let y = luminance(m.eval(wo, wi) * l) * wi.z;
                 y * y
             }
         };
-        let mut stack = vec![(t0.cos(), t1.cos(), p0, p1, 0u32)];
+        let mut stack = if smooth {
+            let (tm, pm) = (0.5 * (t0 + t1), 0.5 * (p0 + p1));
+            vec![
+                (t0.cos(), tm.cos(), p0, pm, 0u32),
+                (tm.cos(), t1.cos(), p0, pm, 0),
+                (t0.cos(), tm.cos(), pm, p1, 0),
+                (tm.cos(), t1.cos(), pm, p1, 0),
+            ]
+        } else {
+            vec![(t0.cos(), t1.cos(), p0, p1, 0u32)]
+        };
         while let Some((c0, c1, a, b, depth)) = stack.pop() {
             let whole = gauss_legendre_4x4(g, c0, c1, a, b);
             let (cm, pm) = (0.5 * (c0 + c1), 0.5 * (a + b));
