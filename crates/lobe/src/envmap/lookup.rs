@@ -75,7 +75,7 @@ impl Step for SampleLookups<'_> {
                 let j = rj[k] as usize;
                 if let Some((i, r)) = map
                     .sampler(comp)
-                    .columns(map.sampling_texels())
+                    .columns(map.weights(comp))
                     .row(j)
                     .sample(u.y)
                 {
@@ -180,7 +180,15 @@ impl EnvMap {
     /// The lookup of direction `d` in its texel `k`.
     #[inline(always)]
     fn texel_lookup(&self, k: usize, d: DVec3) -> EnvLookup {
-        let lum = self.sampling_texels()[k].lum();
+        if self.smooth.is_some() {
+            let (radiance, s, t) = self.smooth_at(k, d);
+            return EnvLookup {
+                radiance,
+                pdf: self.smooth_pdf(false, k, s, t),
+                pdf_compensated: self.smooth_pdf(true, k, s, t),
+            };
+        }
+        let lum = self.texels[k].lum();
         let pdf = |t: &TexelSampler| {
             if t.norm > 0.0 {
                 t.weight(lum) / t.norm
@@ -207,16 +215,8 @@ impl EnvMap {
     pub fn sample_lookup(&self, compensated: bool, u: DVec2) -> Option<(DVec3, EnvLookup)> {
         let t = self.sampler(compensated);
         let (j, ru) = t.rows.sample(u.x)?;
-        let (i, rv) = t.columns(self.sampling_texels()).row(j).sample(u.y)?;
+        let (i, rv) = t.columns(self.weights(compensated)).row(j).sample(u.y)?;
         self.finish_sample(compensated, (j, ru), (i, rv))
-    }
-
-    fn sampler(&self, compensated: bool) -> &TexelSampler {
-        if compensated {
-            &self.compensated
-        } else {
-            &self.plain
-        }
     }
 
     /// [`EnvMap::sample_lookup`] of many draws `(compensated, u)`:
@@ -330,6 +330,7 @@ impl EnvMap {
         (j, ru): (usize, f64),
         (i, rv): (usize, f64),
     ) -> Option<(DVec3, EnvLookup)> {
+        let (rv, ru) = self.place_in_texel(compensated, (i, j), ru, rv);
         let (c0, c1) = (self.row_cos[j], self.row_cos[j + 1]);
         let ct = (c0 + (c1 - c0) * ru).clamp(c1.min(c0), c0.max(c1));
         let st = (1.0 - ct * ct).max(0.0).sqrt();

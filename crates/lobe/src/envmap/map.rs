@@ -4,7 +4,8 @@
 //! and one direction's radiance, draw and density.
 
 use super::error::EnvMapError;
-use super::sampler::TexelSampler;
+use super::sampler::{TexelSampler, Weights};
+use super::smooth::{BilinearCell, Smooth};
 use super::texels::{Texel, TexelBuffer};
 use crate::math::Rgb;
 use glam::{DVec2, DVec3};
@@ -23,11 +24,10 @@ pub struct EnvMap {
     /// aligned block, and computes the luminance the densities are
     /// functions of ([`TexelSampler::weight`]) from it.
     pub(super) texels: Vec<Texel>,
-    /// For a smooth map ([`EnvMap::smooth`]), the texels its densities are
-    /// functions of: each texel's average of the bilinear radiance over it
-    /// (a 3 × 3 tent filter); `None` for a map of nearest texels, whose
-    /// densities are functions of `texels`.
-    pub(super) sampling: Option<Vec<Texel>>,
+    /// For a smooth map ([`EnvMap::smooth`]), its densities, piecewise
+    /// bilinear over each texel's quarters; `None` for a map of nearest
+    /// texels, whose densities are functions of `texels`.
+    pub(super) smooth: Option<Box<Smooth>>,
     scale: f64,
     /// cos and sin of the rotation about +Y.
     rot: (f64, f64),
@@ -225,7 +225,7 @@ impl EnvMap {
                 .map(|i| (2.0 * PI * i as f64 / width as f64).sin_cos())
                 .collect(),
             texels,
-            sampling: None,
+            smooth: None,
             scale,
             rot: (r.cos(), r.sin()),
             plain,
@@ -237,11 +237,11 @@ impl EnvMap {
     fn samplers(width: usize, height: usize, texels: &[Texel]) -> (TexelSampler, TexelSampler) {
         // The plain density's tables only when something draws from it (light
         // sampling alone; MIS draws from the compensated one).
-        let plain = TexelSampler::new(width, height, None, texels, false);
+        let plain = TexelSampler::new(width, height, None, texels.into(), false);
         // Mean luminance over the sphere, then the part above it.
         let mean = plain.norm / (4.0 * PI);
         let compensated = if texels.iter().any(|t| (t.lum() - mean).max(0.0) > 0.0) {
-            TexelSampler::new(width, height, Some(mean), texels, true)
+            TexelSampler::new(width, height, Some(mean), texels.into(), true)
         } else {
             plain.clone()
         };
@@ -254,51 +254,47 @@ impl EnvMap {
     /// the poles themselves, instead of the nearest texel's piecewise
     /// constant radiance, which puts the texel edges into images.
     ///
-    /// Light sampling stays piecewise constant over the texels, with each
-    /// texel's weight the average of the interpolated radiance over it (in
-    /// `(u, v)`: the texel and its 8 neighbours with weights `(1, 6, 36)/64`
-    /// for corner, edge and centre); the pdfs are exactly the densities of
-    /// the draws, positive wherever the radiance is (the interpolation uses
-    /// only texels of that neighbourhood), and within a small factor of
-    /// the radiance over it.
+    /// Light sampling follows it: its density is piecewise bilinear over
+    /// the texels' quarters, equal to the interpolated luminance at their
+    /// corners (and within the curvature of `cos θ` over half a texel
+    /// between them), the compensated one the same of `max(0, lum − mean)`;
+    /// the pdfs are exactly the densities of the draws, and positive
+    /// wherever the radiance is (the notes of `envmap/smooth.rs`).
     #[must_use]
     pub fn smooth(mut self) -> Self {
-        let (w, h) = (self.width, self.height);
-        let tent = [0.125, 0.75, 0.125];
-        let mut filtered = Vec::with_capacity(w * h);
-        for j in 0..h {
-            for i in 0..w {
-                let mut c = [0.0f64; 3];
-                for (dj, wj) in tent.iter().enumerate() {
-                    let jj = (j + dj).saturating_sub(1).min(h - 1);
-                    for (di, wi) in tent.iter().enumerate() {
-                        let ii = (i + w + di - 1) % w;
-                        let t = self.texels[jj * w + ii].rgb;
-                        for k in 0..3 {
-                            c[k] += wj * wi * f64::from(t[k]);
-                        }
-                    }
-                }
-                filtered.push(Texel {
-                    rgb: c.map(|x| x as f32),
-                });
-            }
-        }
-        (self.plain, self.compensated) = Self::samplers(w, h, &filtered);
-        self.sampling = Some(filtered);
+        let (sm, plain, compensated) =
+            Smooth::new(self.width, self.height, &self.texels, &self.row_cos);
+        self.plain = plain;
+        self.compensated = compensated;
+        self.smooth = Some(Box::new(sm));
         self
     }
 
     /// Whether [`EnvMap::eval`] interpolates ([`EnvMap::smooth`]).
     #[must_use]
     pub fn is_smooth(&self) -> bool {
-        self.sampling.is_some()
+        self.smooth.is_some()
     }
 
-    /// The texels the densities are functions of.
+    /// What the plain (`compensated = false`) or the compensated density's
+    /// texel weights are functions of.
     #[inline]
-    pub(super) fn sampling_texels(&self) -> &[Texel] {
-        self.sampling.as_deref().unwrap_or(&self.texels)
+    pub(super) fn weights(&self, compensated: bool) -> Weights<'_> {
+        match &self.smooth {
+            None => (&self.texels[..]).into(),
+            Some(sm) if compensated => (&sm.compensated[..]).into(),
+            Some(sm) => (&sm.plain[..]).into(),
+        }
+    }
+
+    /// The plain or the compensated density.
+    #[inline]
+    pub(super) fn sampler(&self, compensated: bool) -> &TexelSampler {
+        if compensated {
+            &self.compensated
+        } else {
+            &self.plain
+        }
     }
 
     /// The scaled radiance at world direction `d` (unit), of texel `k`
@@ -306,15 +302,35 @@ impl EnvMap {
     /// nearest texels, interpolated for a smooth one.
     #[inline]
     pub(super) fn radiance_in(&self, k: usize, d: DVec3) -> Rgb {
-        if self.sampling.is_none() {
+        if self.smooth.is_none() {
             return self.radiance_at(k);
         }
-        let uv = self.direction_to_uv(d);
+        self.smooth_at(k, d).0
+    }
+
+    /// Of a smooth map ([`EnvMap::smooth`]), world direction `d` (unit) in
+    /// texel `k` (`d`'s, by [`EnvMap::texel_index`]): the scaled radiance,
+    /// and `(s, t)`, where `d` is in the texel (fractions in `φ` and in
+    /// `cos θ`).
+    #[inline]
+    pub(super) fn smooth_at(&self, k: usize, d: DVec3) -> (Rgb, f64, f64) {
         let (w, h) = (self.width, self.height);
-        let x = uv.x * w as f64 - 0.5;
-        let y = (uv.y * h as f64 - 0.5).clamp(0.0, (h - 1) as f64);
-        let (xf, yf) = (x.floor(), y.floor());
-        let (fx, fy) = (x - xf, y - yf);
+        let (i, j) = (k % w, k / w);
+        let dm = self.unrotate(d);
+        let mut u = dm.x.atan2(-dm.z) / (2.0 * PI);
+        if u < 0.0 {
+            u += 1.0;
+        }
+        if u >= 1.0 {
+            u = 0.0;
+        }
+        let y = dm.y.clamp(-1.0, 1.0);
+        let v = crate::math::safe_acos(y) / PI;
+        let x = u * w as f64;
+        // The radiance: bilinear between the texels' centres.
+        let (xc, yc) = (x - 0.5, (v * h as f64 - 0.5).clamp(0.0, (h - 1) as f64));
+        let (xf, yf) = (xc.floor(), yc.floor());
+        let (fx, fy) = (xc - xf, yc - yf);
         let i0 = (xf as i64).rem_euclid(w as i64) as usize;
         let i1 = (i0 + 1) % w;
         let j0 = (yf as usize).min(h - 1);
@@ -322,7 +338,91 @@ impl EnvMap {
         let at = |i: usize, j: usize| self.texels[j * w + i].rgb();
         let top = at(i0, j0) * (1.0 - fx) + at(i1, j0) * fx;
         let bottom = at(i0, j1) * (1.0 - fx) + at(i1, j1) * fx;
-        (top * (1.0 - fy) + bottom * fy) * self.scale
+        let radiance = (top * (1.0 - fy) + bottom * fy) * self.scale;
+        // Where in texel (i, j) (which the rounding of `x` near an edge
+        // can put on its other side, or across the seam).
+        let mut s = x - i as f64;
+        if s > 1.5 {
+            s -= w as f64;
+        } else if s < -0.5 {
+            s += w as f64;
+        }
+        let (c0, c1) = (self.row_cos[j], self.row_cos[j + 1]);
+        let t = (c0 - y) / (c0 - c1);
+        (radiance, s.clamp(0.0, 1.0), t.clamp(0.0, 1.0))
+    }
+
+    /// A smooth map's density (plain or compensated) at `(s, t)` in texel
+    /// `k`: the pdf in solid angle.
+    #[inline]
+    pub(super) fn smooth_pdf(&self, compensated: bool, k: usize, s: f64, t: f64) -> f64 {
+        let sampler = self.sampler(compensated);
+        match &self.smooth {
+            Some(sm) if sampler.norm > 0.0 => {
+                let w = self.width;
+                sm.density(w, compensated, (k % w, k / w), s, t) / sampler.norm
+            }
+            _ => 0.0,
+        }
+    }
+
+    /// Where a draw at `(ru, rv)` in texel `(i, j)` is in it, as fractions
+    /// `(s, t)` in `φ` and `cos θ`: `(rv, ru)`, uniform in solid angle, for
+    /// a map of nearest texels; a smooth map's from its density.
+    #[inline]
+    pub(super) fn place_in_texel(
+        &self,
+        compensated: bool,
+        (i, j): (usize, usize),
+        ru: f64,
+        rv: f64,
+    ) -> (f64, f64) {
+        match &self.smooth {
+            None => (rv, ru),
+            Some(sm) => sm.draw(self.width, compensated, (i, j), ru, rv),
+        }
+    }
+
+    /// For a smooth map ([`EnvMap::smooth`]), the cells of band `j` over
+    /// which its radiance is bilinear in `(φ, θ)`, `width` of them (twice
+    /// that for the last band): between the centres of rows `j − 1` and
+    /// `j` (the pole's cap for `j = 0`, and the other pole's beside it for
+    /// the last), each between the centres of two columns. Over all bands
+    /// they tile the sphere once. Empty for a map of nearest texels.
+    #[must_use]
+    pub fn bilinear_cells(&self, j: usize) -> Vec<BilinearCell> {
+        if !self.is_smooth() {
+            return Vec::new();
+        }
+        let (w, h) = (self.width, self.height);
+        let centre = |j: usize| PI * (j as f64 + 0.5) / h as f64;
+        let mut bands = vec![if j == 0 {
+            (0.0, centre(0), 0, 0)
+        } else {
+            (centre(j - 1), centre(j), j - 1, j)
+        }];
+        if j + 1 == h {
+            bands.push((centre(j), PI, j, j));
+        }
+        let mut cells = Vec::with_capacity(bands.len() * w);
+        for (t0, t1, j0, j1) in bands {
+            for i in 0..w {
+                let i0 = (i + w - 1) % w;
+                let p0 = 2.0 * PI * (i as f64 - 0.5) / w as f64;
+                let p1 = 2.0 * PI * (i as f64 + 0.5) / w as f64;
+                cells.push(BilinearCell::new(
+                    (t0, t1),
+                    (p0, p1),
+                    [
+                        self.texel(i0, j0),
+                        self.texel(i, j0),
+                        self.texel(i0, j1),
+                        self.texel(i, j1),
+                    ],
+                ));
+            }
+        }
+        cells
     }
 
     /// A map of one constant radiance (one texel).
@@ -459,21 +559,21 @@ impl EnvMap {
     /// from it): on rayon's threads, where a first draw on one of them
     /// builds them on that thread alone. The same draws either way.
     pub fn prepare_sampling(&self) {
-        let _ = self.plain.columns(self.sampling_texels());
-        let _ = self.compensated.columns(self.sampling_texels());
+        let _ = self.plain.columns(self.weights(false));
+        let _ = self.compensated.columns(self.weights(true));
     }
 
     /// Draw a world direction with density ∝ luminance; `None` for a black map.
     #[must_use]
     pub fn sample(&self, u: DVec2) -> Option<(DVec3, f64)> {
-        self.sample_with(&self.plain, u)
+        self.sample_with(false, u)
     }
 
     /// Density in solid angle of [`EnvMap::sample`] at world direction `d`.
     #[inline]
     #[must_use]
     pub fn pdf(&self, d: DVec3) -> f64 {
-        self.pdf_with(&self.plain, d)
+        self.pdf_with(false, d)
     }
 
     /// Draw with density ∝ `max(0, lum − mean lum)` (MIS compensation,
@@ -482,20 +582,23 @@ impl EnvMap {
     /// those directions. Falls back to [`EnvMap::sample`] for a uniform map.
     #[must_use]
     pub fn sample_compensated(&self, u: DVec2) -> Option<(DVec3, f64)> {
-        self.sample_with(&self.compensated, u)
+        self.sample_with(true, u)
     }
 
     /// Density of [`EnvMap::sample_compensated`].
     #[inline]
     #[must_use]
     pub fn pdf_compensated(&self, d: DVec3) -> f64 {
-        self.pdf_with(&self.compensated, d)
+        self.pdf_with(true, d)
     }
 
-    fn sample_with(&self, t: &TexelSampler, u: DVec2) -> Option<(DVec3, f64)> {
+    fn sample_with(&self, compensated: bool, u: DVec2) -> Option<(DVec3, f64)> {
+        let t = self.sampler(compensated);
         let (j, ru) = t.rows.sample(u.x)?;
-        let (i, rv) = t.columns(self.sampling_texels()).row(j).sample(u.y)?;
-        // Uniform in solid angle inside the texel: uniform in cos θ and φ.
+        let (i, rv) = t.columns(self.weights(compensated)).row(j).sample(u.y)?;
+        // Uniform in solid angle inside the texel (uniform in cos θ and φ),
+        // or a smooth map's density.
+        let (rv, ru) = self.place_in_texel(compensated, (i, j), ru, rv);
         let t0 = PI * j as f64 / self.height as f64;
         let t1 = PI * (j + 1) as f64 / self.height as f64;
         let (c0, c1) = (t0.cos(), t1.cos());
@@ -503,17 +606,23 @@ impl EnvMap {
         let v = crate::math::safe_acos(ct) / PI;
         let uu = (i as f64 + rv) / self.width as f64;
         let d = self.uv_to_direction(DVec2::new(uu, v.clamp(t0 / PI, t1 / PI)));
-        let pdf = self.pdf_with(t, d);
+        let pdf = self.pdf_with(compensated, d);
         (pdf > 0.0).then_some((d, pdf))
     }
 
     #[inline]
-    fn pdf_with(&self, t: &TexelSampler, d: DVec3) -> f64 {
+    fn pdf_with(&self, compensated: bool, d: DVec3) -> f64 {
+        let t = self.sampler(compensated);
         if t.norm <= 0.0 {
             return 0.0;
         }
         let (i, j) = self.texel_index(d);
-        t.weight(self.sampling_texels()[j * self.width + i].lum()) / t.norm
+        let k = j * self.width + i;
+        if self.smooth.is_some() {
+            let (_, s, tt) = self.smooth_at(k, d);
+            return self.smooth_pdf(compensated, k, s, tt);
+        }
+        t.weight(self.texels[k].lum()) / t.norm
     }
 
     /// The solid-angle region of texel `(i, j)`: `(θ₀, θ₁)`, `(φ₀, φ₁)` in the

@@ -32,7 +32,8 @@
 // | `distribution.rs` | `Distribution1D` and its borrowed `Tables` | |
 // | `texels.rs` | the texels' storage: `Texel`, `TexelBuffer`, `TexelBand` | |
 // | `sampler.rs` | the lazy density over the texels: `TexelSampler`, `Columns` | distribution, texels |
-// | `map.rs` | `EnvMap`: building, geometry, the texel search, `eval`, `sample`, `pdf` | error, texels, sampler |
+// | `smooth.rs` | a smooth map's densities (`Smooth`) and bilinear cells | sampler, texels |
+// | `map.rs` | `EnvMap`: building, geometry, the texel search, `eval`, `sample`, `pdf` | error, texels, sampler, smooth |
 // | `lookup.rs` | `EnvLookup` and the prefetching lookups, one and many | map, sampler |
 // | `tests.rs` | tests of the map as a whole (its sampler's tables, its clamping) | distribution, sampler, map |
 
@@ -41,6 +42,7 @@ mod error;
 mod lookup;
 mod map;
 mod sampler;
+mod smooth;
 #[cfg(test)]
 mod tests;
 mod texels;
@@ -49,4 +51,5 @@ pub use distribution::Distribution1D;
 pub use error::EnvMapError;
 pub use lookup::EnvLookup;
 pub use map::EnvMap;
+pub use smooth::BilinearCell;
 pub use texels::{TexelBand, TexelBuffer};

@@ -137,7 +137,7 @@ pub fn reference_method(m: &Material, light: &Light) -> String {
     let rel = REFERENCE_TOLERANCE;
     match (light, m.measured().is_some()) {
         (Light::Env(map), _) if map.is_smooth() => format!(
-            "a sum over the map's texels of ∫ radiance × f cos dω (its radiance interpolated; 4×4 Gauss-Legendre per quarter texel, refined to {rel:e} relative, f64)"
+            "a sum over the map's cells between texel centres of ∫ radiance × f cos dω (its radiance interpolated, bilinear in each; 4×4 Gauss-Legendre per cell, refined to {rel:e} relative, f64)"
         ),
         (Light::Env(_), _) => format!(
             "a sum over the map's texels of radiance × ∫ f cos dω (4×4 Gauss-Legendre per texel, refined to {rel:e} relative, f64)"
