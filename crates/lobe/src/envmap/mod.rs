@@ -13,8 +13,10 @@
 //! radiance is constant over it (nearest texel), so that light sampling can be
 //! exactly proportional to it. A smooth map ([`EnvMap::smooth`]; the
 //! built-in sky, [`EnvMap::sky`]) interpolates its texels bilinearly
-//! instead, and its densities are those below with each texel's luminance
-//! replaced by its average of the interpolated radiance.
+//! instead, and its densities follow the interpolation inside each texel
+//! too: a texel is picked as below with its luminance replaced by the
+//! density's mean over it, then a direction from the density, piecewise
+//! bilinear over the texel's quarters (`smooth.rs`).
 //!
 //! Light sampling picks a texel with probability proportional to its
 //! luminance times its solid angle `(2π/width)(cos θ₀ − cos θ₁)` (the sin θ

@@ -56,7 +56,12 @@ fn sample_linear(r: f64, a: f64, b: f64) -> f64 {
     if a == b {
         return r;
     }
-    let x = r * (a + b) / (a + ((1.0 - r) * a * a + r * b * b).sqrt());
+    let den = a + ((1.0 - r) * a * a + r * b * b).sqrt();
+    if den <= 0.0 {
+        // (r = 0 where a = 0.)
+        return 0.0;
+    }
+    let x = r * (a + b) / den;
     x.clamp(0.0, 1.0)
 }
 
