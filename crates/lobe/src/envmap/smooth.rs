@@ -213,7 +213,7 @@ impl Smooth {
 /// A region of a smooth map over which its radiance is bilinear in
 /// `(φ, θ)`: between four texels' centres (the rows' centres and a pole
 /// at the caps, where it is linear in `φ` alone). See
-/// [`EnvMap::bilinear_cells`].
+/// [`EnvMap::bilinear_cells`](super::EnvMap::bilinear_cells).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BilinearCell {
     /// `(θ₀, θ₁)` in the map's frame.
