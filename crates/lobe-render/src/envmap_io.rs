@@ -43,7 +43,8 @@ pub fn sun_azimuth_ok(degrees: f64) -> bool {
 /// The built-in sky ([`SKY`]'s resolution) with its sun at `elevation` and
 /// `azimuth` degrees, times `scale`, rotated by `rotation_y` degrees about
 /// +Y: the texels of [`EnvMap::sky`] through [`EnvMap::new`] (which
-/// counts the texels clamped, as [`load_envmap`] does).
+/// counts the texels clamped, as [`load_envmap`] does), smooth as
+/// [`EnvMap::sky`] is ([`EnvMap::smooth`]).
 pub fn sky(
     elevation: f64,
     azimuth: f64,
@@ -56,7 +57,7 @@ pub fn sky(
         .flat_map(|j| (0..w).map(move |i| (i, j)))
         .map(|(i, j)| sky.texel(i, j))
         .collect();
-    EnvMap::new(w, h, texels, scale, rotation_y)
+    EnvMap::new(w, h, texels, scale, rotation_y).map(|(map, clamped)| (map.smooth(), clamped))
 }
 
 /// Load `path` (`.hdr`, `.exr`, or the word `sky`) as an environment map

@@ -863,10 +863,33 @@ pub fn reference(m: &Material, sp: &ShadingPoint, light: &Light, rel: f64) -> Rg
 /// Row `j` of the environment-map reference: `Σ_i L(i, j) ∫_texel f cos dω`.
 /// Each texel integral is a 4 × 4 Gauss–Legendre rule in `(cos θ, φ)`,
 /// compared with the same rule on the texel's four quarters and refined
-/// where they differ by more than `rel` (up to 6 levels).
+/// where they differ by more than `rel` (up to 6 levels). A smooth map's
+/// ([`EnvMap::smooth`]) band `j` of cells instead, over which its radiance
+/// is bilinear ([`EnvMap::bilinear_cells`]): `Σ ∫_cell L f cos dω`, the same
+/// rule and refinement on the product, smooth inside each cell.
 #[must_use]
 pub fn reference_env_row(m: &Material, sp: &ShadingPoint, map: &EnvMap, j: usize, rel: f64) -> Rgb {
     let (wo, frame) = (sp.wo, &sp.frame);
+    if map.is_smooth() {
+        let mut sum = Rgb::ZERO;
+        for cell in map.bilinear_cells(j) {
+            if cell.is_black() {
+                continue;
+            }
+            let gc = |c: f64, phi: f64| {
+                let theta = crate::math::safe_acos(c);
+                let wi = frame.to_local(map.spherical_to_direction(theta, phi));
+                if wi.z <= 0.0 {
+                    Rgb::ZERO
+                } else {
+                    m.eval(wo, wi) * cell.radiance(theta, phi) * wi.z
+                }
+            };
+            let ((t0, t1), (p0, p1)) = (cell.theta, cell.phi);
+            sum += refined_4x4(gc, (t0.cos(), t1.cos(), p0, p1), rel);
+        }
+        return sum;
+    }
     let (w, _) = map.size();
     let mut sum = Rgb::ZERO;
     for i in 0..w {
@@ -921,6 +944,51 @@ pub fn reference_env_row(m: &Material, sp: &ShadingPoint, map: &EnvMap, j: usize
                 ] {
                     sum += l * gauss_legendre_4x4(gc, x0, x1, y0, y1);
                 }
+            }
+        }
+    }
+    sum
+}
+
+/// `∫ gc` over `(cos θ, φ) ∈ [c0, c1] × [p0, p1]` by the 4 × 4
+/// Gauss–Legendre rule, compared with the same rule on the cell's four
+/// quarters and refined where their luminances differ by more than `rel`
+/// (relative) and `1e-15` (up to 6 levels); RGB summed on the accepted
+/// cells' quarters.
+fn refined_4x4(
+    gc: impl Fn(f64, f64) -> Rgb,
+    (c0, c1, p0, p1): (f64, f64, f64, f64),
+    rel: f64,
+) -> Rgb {
+    let g = |c: f64, phi: f64| luminance(gc(c, phi));
+    let mut sum = Rgb::ZERO;
+    // Refine on luminance, integrate RGB on the accepted cells.
+    let mut stack = vec![(c0, c1, p0, p1, 0u32)];
+    while let Some((c0, c1, a, b, depth)) = stack.pop() {
+        let whole = gauss_legendre_4x4(g, c0, c1, a, b);
+        let (cm, pm) = (0.5 * (c0 + c1), 0.5 * (a + b));
+        let parts = gauss_legendre_4x4(g, c0, cm, a, pm)
+            + gauss_legendre_4x4(g, cm, c1, a, pm)
+            + gauss_legendre_4x4(g, c0, cm, pm, b)
+            + gauss_legendre_4x4(g, cm, c1, pm, b);
+        if depth < 6
+            && (whole - parts).abs() > rel * parts.abs().max(1e-300)
+            && (whole - parts).abs() > 1e-15
+        {
+            stack.extend([
+                (c0, cm, a, pm, depth + 1),
+                (cm, c1, a, pm, depth + 1),
+                (c0, cm, pm, b, depth + 1),
+                (cm, c1, pm, b, depth + 1),
+            ]);
+        } else {
+            for (x0, x1, y0, y1) in [
+                (c0, cm, a, pm),
+                (cm, c1, a, pm),
+                (c0, cm, pm, b),
+                (cm, c1, pm, b),
+            ] {
+                sum += gauss_legendre_4x4(&gc, x0, x1, y0, y1);
             }
         }
     }

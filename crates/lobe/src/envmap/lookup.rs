@@ -73,7 +73,12 @@ impl Step for SampleLookups<'_> {
                     continue;
                 }
                 let j = rj[k] as usize;
-                if let Some((i, r)) = map.sampler(comp).columns(&map.texels).row(j).sample(u.y) {
+                if let Some((i, r)) = map
+                    .sampler(comp)
+                    .columns(map.weights(comp))
+                    .row(j)
+                    .sample(u.y)
+                {
                     (ci[k], rv[k]) = (i as u32, r);
                     prefetch(&map.texels[j * map.width + i]);
                 }
@@ -169,13 +174,21 @@ impl EnvMap {
     #[must_use]
     pub fn lookup(&self, d: DVec3) -> EnvLookup {
         let (i, j) = self.texel_index(d);
-        self.texel_lookup(j * self.width + i)
+        self.texel_lookup(j * self.width + i, d)
     }
 
+    /// The lookup of direction `d` in its texel `k`.
     #[inline(always)]
-    fn texel_lookup(&self, k: usize) -> EnvLookup {
-        let texel = self.texels[k];
-        let lum = texel.lum();
+    fn texel_lookup(&self, k: usize, d: DVec3) -> EnvLookup {
+        if self.smooth.is_some() {
+            let (radiance, s, t) = self.smooth_at(k, d);
+            return EnvLookup {
+                radiance,
+                pdf: self.smooth_pdf(false, k, s, t),
+                pdf_compensated: self.smooth_pdf(true, k, s, t),
+            };
+        }
+        let lum = self.texels[k].lum();
         let pdf = |t: &TexelSampler| {
             if t.norm > 0.0 {
                 t.weight(lum) / t.norm
@@ -184,7 +197,7 @@ impl EnvMap {
             }
         };
         EnvLookup {
-            radiance: self.radiance_at(k),
+            radiance: self.radiance_in(k, d),
             pdf: pdf(&self.plain),
             pdf_compensated: pdf(&self.compensated),
         }
@@ -202,16 +215,8 @@ impl EnvMap {
     pub fn sample_lookup(&self, compensated: bool, u: DVec2) -> Option<(DVec3, EnvLookup)> {
         let t = self.sampler(compensated);
         let (j, ru) = t.rows.sample(u.x)?;
-        let (i, rv) = t.columns(&self.texels).row(j).sample(u.y)?;
+        let (i, rv) = t.columns(self.weights(compensated)).row(j).sample(u.y)?;
         self.finish_sample(compensated, (j, ru), (i, rv))
-    }
-
-    fn sampler(&self, compensated: bool) -> &TexelSampler {
-        if compensated {
-            &self.compensated
-        } else {
-            &self.plain
-        }
     }
 
     /// [`EnvMap::sample_lookup`] of many draws `(compensated, u)`:
@@ -251,7 +256,7 @@ impl EnvMap {
     /// (the same bits at every level).
     fn lookup_many_at(&self, level: SimdLevel, dirs: &[DVec3], out: &mut [EnvLookup]) {
         assert_eq!(dirs.len(), out.len(), "lookup_many: lengths differ");
-        self.texels_many(level, dirs, out, |k| self.texel_lookup(k));
+        self.texels_many(level, dirs, out, |k, d| self.texel_lookup(k, d));
     }
 
     /// [`EnvMap::eval`] of many directions, the radiance alone (no
@@ -266,7 +271,7 @@ impl EnvMap {
 
     fn eval_many_at(&self, level: SimdLevel, dirs: &[DVec3], out: &mut [Rgb]) {
         assert_eq!(dirs.len(), out.len(), "eval_many: lengths differ");
-        self.texels_many(level, dirs, out, |k| self.radiance_at(k));
+        self.texels_many(level, dirs, out, |k, d| self.radiance_in(k, d));
     }
 
     /// `out[k] = at(texel index of dirs[k])`, the indices of a chunk found
@@ -277,7 +282,7 @@ impl EnvMap {
         level: SimdLevel,
         dirs: &[DVec3],
         out: &mut [T],
-        at: impl Fn(usize) -> T,
+        at: impl Fn(usize, DVec3) -> T,
     ) {
         for (dc, oc) in dirs.chunks(LOOKUP_CHUNK).zip(out.chunks_mut(LOOKUP_CHUNK)) {
             let mut idx = [0usize; LOOKUP_CHUNK];
@@ -289,8 +294,8 @@ impl EnvMap {
             for &k in &idx[..dc.len()] {
                 prefetch(&self.texels[k]);
             }
-            for (o, &k) in oc.iter_mut().zip(&idx) {
-                *o = at(k);
+            for ((o, &k), &d) in oc.iter_mut().zip(&idx).zip(dc) {
+                *o = at(k, d);
             }
         }
     }
@@ -325,12 +330,13 @@ impl EnvMap {
         (j, ru): (usize, f64),
         (i, rv): (usize, f64),
     ) -> Option<(DVec3, EnvLookup)> {
+        let (rv, ru) = self.place_in_texel(compensated, (i, j), ru, rv);
         let (c0, c1) = (self.row_cos[j], self.row_cos[j + 1]);
         let ct = (c0 + (c1 - c0) * ru).clamp(c1.min(c0), c0.max(c1));
         let st = (1.0 - ct * ct).max(0.0).sqrt();
         let (sp, cp) = self.column_sin_cos(i, rv);
         let d = self.rotate(DVec3::new(st * sp, ct, -st * cp));
-        let l = self.texel_lookup(j * self.width + i);
+        let l = self.texel_lookup(j * self.width + i, d);
         let p = if compensated {
             l.pdf_compensated
         } else {
@@ -421,7 +427,8 @@ mod tests {
         )
         .unwrap()
         .0;
-        for map in [&m, &one, &few, &EnvMap::constant(Rgb::ONE)] {
+        let smooth = scaled_sky().smooth();
+        for map in [&m, &smooth, &one, &few, &EnvMap::constant(Rgb::ONE)] {
             for level in SimdLevel::ALL.into_iter().filter(|l| l.is_available()) {
                 let mut looked = vec![EnvLookup::default(); dirs.len()];
                 map.lookup_many_at(level, &dirs, &mut looked);
@@ -440,8 +447,12 @@ mod tests {
     /// distribution (the same texel for the same numbers).
     #[test]
     fn sample_lookup_agrees_with_sample_and_lookup() {
-        let m = scaled_sky();
-        for comp in [false, true] {
+        for (m, comp) in [
+            (scaled_sky(), false),
+            (scaled_sky(), true),
+            (scaled_sky().smooth(), false),
+            (scaled_sky().smooth(), true),
+        ] {
             for k in 0..2000 {
                 let u = DVec2::new(
                     (k as f64 * 0.618_033_988_7 + 0.01) % 1.0,

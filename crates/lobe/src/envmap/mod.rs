@@ -11,7 +11,12 @@
 //! `u = atan2(d.x, −d.z) / (2π)` wrapped into [0, 1) and `v = acos(d.y) / π`;
 //! texel `(i, j)` covers `u ∈ [i, i+1)/width`, `v ∈ [j, j+1)/height`, and the
 //! radiance is constant over it (nearest texel), so that light sampling can be
-//! exactly proportional to it.
+//! exactly proportional to it. A smooth map ([`EnvMap::smooth`]; the
+//! built-in sky, [`EnvMap::sky`]) interpolates its texels bilinearly
+//! instead, and its densities follow the interpolation inside each texel
+//! too: a texel is picked as below with its luminance replaced by the
+//! density's mean over it, then a direction from the density, piecewise
+//! bilinear over the texel's quarters (`smooth.rs`).
 //!
 //! Light sampling picks a texel with probability proportional to its
 //! luminance times its solid angle `(2π/width)(cos θ₀ − cos θ₁)` (the sin θ
@@ -29,7 +34,8 @@
 // | `distribution.rs` | `Distribution1D` and its borrowed `Tables` | |
 // | `texels.rs` | the texels' storage: `Texel`, `TexelBuffer`, `TexelBand` | |
 // | `sampler.rs` | the lazy density over the texels: `TexelSampler`, `Columns` | distribution, texels |
-// | `map.rs` | `EnvMap`: building, geometry, the texel search, `eval`, `sample`, `pdf` | error, texels, sampler |
+// | `smooth.rs` | a smooth map's densities (`Smooth`) and bilinear cells | sampler, texels |
+// | `map.rs` | `EnvMap`: building, geometry, the texel search, `eval`, `sample`, `pdf` | error, texels, sampler, smooth |
 // | `lookup.rs` | `EnvLookup` and the prefetching lookups, one and many | map, sampler |
 // | `tests.rs` | tests of the map as a whole (its sampler's tables, its clamping) | distribution, sampler, map |
 
@@ -38,6 +44,7 @@ mod error;
 mod lookup;
 mod map;
 mod sampler;
+mod smooth;
 #[cfg(test)]
 mod tests;
 mod texels;
@@ -46,4 +53,5 @@ pub use distribution::Distribution1D;
 pub use error::EnvMapError;
 pub use lookup::EnvLookup;
 pub use map::EnvMap;
+pub use smooth::BilinearCell;
 pub use texels::{TexelBand, TexelBuffer};

@@ -6,6 +6,38 @@ use super::distribution::{Distribution1D, Tables};
 use super::texels::Texel;
 use std::f64::consts::PI;
 
+/// What a [`TexelSampler`]'s texel weights are functions of: a map's
+/// texels (their luminance, under the sampler's shift), or given values
+/// (a smooth map's, [`EnvMap::smooth`](super::EnvMap::smooth)).
+#[derive(Debug, Clone, Copy)]
+pub(super) enum Weights<'a> {
+    Texels(&'a [Texel]),
+    Values(&'a [f64]),
+}
+
+impl<'a> From<&'a [Texel]> for Weights<'a> {
+    fn from(t: &'a [Texel]) -> Self {
+        Weights::Texels(t)
+    }
+}
+
+impl<'a> From<&'a [f64]> for Weights<'a> {
+    fn from(v: &'a [f64]) -> Self {
+        Weights::Values(v)
+    }
+}
+
+impl Weights<'_> {
+    /// Texel `k`'s luminance (or value).
+    #[inline(always)]
+    fn lum(self, k: usize) -> f64 {
+        match self {
+            Weights::Texels(t) => t[k].lum(),
+            Weights::Values(v) => v[k],
+        }
+    }
+}
+
 /// A piecewise-constant density over the texels: texel weights times their
 /// solid angles, a marginal over rows and a conditional within each row.
 #[derive(Debug, Clone, PartialEq)]
@@ -83,7 +115,7 @@ impl TexelSampler {
         width: usize,
         height: usize,
         shift: Option<f64>,
-        texels: &[Texel],
+        texels: Weights<'_>,
         tables: bool,
     ) -> Self {
         let (totals, built) = if tables {
@@ -132,13 +164,11 @@ impl TexelSampler {
         width: usize,
         height: usize,
         shift: Option<f64>,
-        texels: &[Texel],
+        texels: Weights<'_>,
         j: usize,
     ) -> impl ExactSizeIterator<Item = f64> + Clone + '_ {
         let omega = 2.0 * PI / width as f64 * Self::band(height, j);
-        texels[j * width..(j + 1) * width]
-            .iter()
-            .map(move |t| Self::weight_of(shift, t.lum()) * omega)
+        (j * width..(j + 1) * width).map(move |k| Self::weight_of(shift, texels.lum(k)) * omega)
     }
 
     /// The rows' tables and totals, each row's its own computation (the
@@ -148,7 +178,7 @@ impl TexelSampler {
         width: usize,
         height: usize,
         shift: Option<f64>,
-        texels: &[Texel],
+        texels: Weights<'_>,
         parallel: bool,
     ) -> (Vec<f64>, ColumnTables) {
         let steps = Distribution1D::steps(width);
@@ -194,7 +224,7 @@ impl TexelSampler {
     /// for the rows' jobs could take another job of its own that asks for
     /// the same tables, inside their construction.
     #[inline]
-    pub(super) fn columns(&self, texels: &[Texel]) -> BuiltColumns<'_> {
+    pub(super) fn columns(&self, texels: Weights<'_>) -> BuiltColumns<'_> {
         let tables = self.cols.tables.get_or_init(|| {
             #[cfg(feature = "parallel")]
             let parallel = rayon::current_thread_index().is_none();

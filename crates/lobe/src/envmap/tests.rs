@@ -61,17 +61,17 @@ fn plain_tables_are_built_on_first_draw() {
         assert_eq!(*l, eager.sample_lookup(false, u), "u {u}");
     }
     let (a, b) = (
-        lazy.plain.columns(&lazy.texels),
-        eager.plain.columns(&eager.texels),
+        lazy.plain.columns((&lazy.texels[..]).into()),
+        eager.plain.columns((&eager.texels[..]).into()),
     );
     assert_eq!(a.tables.cdf, b.tables.cdf);
     assert_eq!(a.tables.guide, b.tables.guide);
-    let (_, built) = TexelSampler::build_tables(w, h, None, &lazy.texels, false);
+    let (_, built) = TexelSampler::build_tables(w, h, None, (&lazy.texels[..]).into(), false);
     assert_eq!(a.tables.cdf, built.cdf);
     for j in 0..h {
         assert_eq!(a.row(j).total.to_bits(), a.totals[j].to_bits());
     }
-    let (totals, _) = TexelSampler::build_tables(w, h, None, &lazy.texels, true);
+    let (totals, _) = TexelSampler::build_tables(w, h, None, (&lazy.texels[..]).into(), true);
     let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
     assert_eq!(bits(&totals), bits(&lazy.plain.cols.totals));
 }
@@ -95,7 +95,7 @@ fn columns_are_the_rows_distributions() {
                     .iter()
                     .map(|x| TexelSampler::weight_of(t.shift, x.lum()) * omega),
             );
-            let row = t.columns(&m.texels).row(j);
+            let row = t.columns((&m.texels[..]).into()).row(j);
             assert_eq!(row.cdf, &alone.cdf[..], "row {j}");
             assert_eq!(row.guide, &alone.guide[..], "row {j}");
             assert_eq!(row.total.to_bits(), alone.total().to_bits(), "row {j}");

@@ -138,6 +138,9 @@ pub fn reference_method(m: &Material, light: &Light) -> String {
     use crate::estimator::{TABLE_REFERENCE_MAX_EVALS, TABLE_REFERENCE_TOLERANCE};
     let rel = REFERENCE_TOLERANCE;
     match (light, m.measured().is_some()) {
+        (Light::Env(map), _) if map.is_smooth() => format!(
+            "a sum over the map's cells between texel centres of ∫ radiance × f cos dω (its radiance interpolated, bilinear in each; 4×4 Gauss-Legendre per cell, refined to {rel:e} relative, f64)"
+        ),
         (Light::Env(_), _) => format!(
             "a sum over the map's texels of radiance × ∫ f cos dω (4×4 Gauss-Legendre per texel, refined to {rel:e} relative, f64)"
         ),

@@ -58,7 +58,8 @@ pub struct UniformVariance {
 /// Under an environment map: a sum over its texels, with the radiance
 /// constant per texel (the map's nearest-texel lookup), of
 /// `∫_texel lum(f L cos)² dω`, each by a refined 4 × 4 Gauss–Legendre rule as
-/// in [`crate::estimator::reference_env_row`]; its rows run in parallel
+/// in [`crate::estimator::reference_env_row`] (a smooth map's: over the cells
+/// where its radiance is bilinear, [`EnvMap::bilinear_cells`]); its rows run in parallel
 /// (feature `parallel`) and are summed in row order.
 #[must_use]
 pub fn uniform_variance(
@@ -74,7 +75,11 @@ pub fn uniform_variance(
             (
                 sum,
                 sum.is_finite(),
-                "exact, by quadrature: 2π Σ_texels ∫ lum(f L cos)² dω − μ² (refined 4×4 Gauss-Legendre per texel)",
+                if map.is_smooth() {
+                    "exact, by quadrature: 2π Σ_cells ∫ lum(f L cos)² dω − μ² (its radiance interpolated; refined 4×4 Gauss-Legendre per cell between texel centres)"
+                } else {
+                    "exact, by quadrature: 2π Σ_texels ∫ lum(f L cos)² dω − μ² (refined 4×4 Gauss-Legendre per texel)"
+                },
             )
         }
         _ => {
@@ -111,9 +116,33 @@ pub fn uniform_variance(
     }
 }
 
-/// Row `j` of the environment map's `∫ lum(f L cos)² dω` (without the 2π).
+/// Row `j` of the environment map's `∫ lum(f L cos)² dω` (without the 2π);
+/// a smooth map's ([`EnvMap::smooth`]) band `j` of cells over which its
+/// radiance is bilinear ([`EnvMap::bilinear_cells`]), the interpolated `L`
+/// in the integrand.
 fn env_row_second_moment(m: &Material, sp: &ShadingPoint, map: &EnvMap, j: usize) -> f64 {
     let (wo, frame) = (sp.wo, &sp.frame);
+    if map.is_smooth() {
+        let mut sum = 0.0;
+        for cell in map.bilinear_cells(j) {
+            if cell.is_black() {
+                continue;
+            }
+            let g = |c: f64, phi: f64| {
+                let theta = safe_acos(c);
+                let wi: DVec3 = frame.to_local(map.spherical_to_direction(theta, phi));
+                if wi.z <= 0.0 {
+                    0.0
+                } else {
+                    let y = luminance(m.eval(wo, wi) * cell.radiance(theta, phi)) * wi.z;
+                    y * y
+                }
+            };
+            let ((t0, t1), (p0, p1)) = (cell.theta, cell.phi);
+            sum += refined_second_moment(g, (t0.cos(), t1.cos(), p0, p1));
+        }
+        return sum;
+    }
     let (w, _) = map.size();
     let mut sum = 0.0;
     for i in 0..w {
@@ -154,6 +183,39 @@ fn env_row_second_moment(m: &Material, sp: &ShadingPoint, map: &EnvMap, j: usize
             } else {
                 sum += parts;
             }
+        }
+    }
+    sum
+}
+
+/// `∫ g` over `(cos θ, φ) ∈ [c0, c1] × [p0, p1]` refined as
+/// [`env_row_second_moment`] refines a texel's.
+fn refined_second_moment(
+    g: impl Fn(f64, f64) -> f64 + Copy,
+    (c0, c1, p0, p1): (f64, f64, f64, f64),
+) -> f64 {
+    let mut sum = 0.0;
+    let mut stack = vec![(c0, c1, p0, p1, 0u32)];
+    while let Some((c0, c1, a, b, depth)) = stack.pop() {
+        let whole = gauss_legendre_4x4(g, c0, c1, a, b);
+        let (cm, pm) = (0.5 * (c0 + c1), 0.5 * (a + b));
+        let quarters = [
+            (c0, cm, a, pm),
+            (cm, c1, a, pm),
+            (c0, cm, pm, b),
+            (cm, c1, pm, b),
+        ];
+        let parts: f64 = quarters
+            .iter()
+            .map(|&(x0, x1, y0, y1)| gauss_legendre_4x4(g, x0, x1, y0, y1))
+            .sum();
+        if depth < 6
+            && (whole - parts).abs() > SECOND_MOMENT_TOLERANCE * parts.abs().max(1e-300)
+            && (whole - parts).abs() > 1e-15
+        {
+            stack.extend(quarters.map(|(x0, x1, y0, y1)| (x0, x1, y0, y1, depth + 1)));
+        } else {
+            sum += parts;
         }
     }
     sum
