@@ -108,14 +108,12 @@ fn json_has_every_field_and_estimates_agree_with_the_reference() {
 
 /// Issue 41: under the sky's sun, cosine sampling's weights are heavy
 /// tailed: its standard error is marked `!` with a one-line legend, light
-/// sampling's is not; a smooth case prints no mark and no legend. (The
-/// rows' fields, which the JSON prints, are tested in
-/// `lobe::experiment::table`; one run under the sky, whose reference
-/// takes seconds.)
+/// sampling's is not, and the JSON says which; a smooth case prints no mark
+/// and no legend.
 #[test]
 fn heavy_tails_mark_the_standard_error_and_only_then_a_legend() {
-    let run = |light: &str| {
-        let args = [
+    let run = |light: &str, json: bool| {
+        let mut args = vec![
             "estimate",
             "-m",
             r#"{"type":"lambert"}"#,
@@ -127,11 +125,14 @@ fn heavy_tails_mark_the_standard_error_and_only_then_a_legend() {
             "cosine,light",
             "--quiet",
         ];
+        if json {
+            args.push("--json");
+        }
         let o = lobe(&args, None);
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
         String::from_utf8(o.stdout).unwrap()
     };
-    let out = run("sky");
+    let out = run("sky", false);
     let row = |name: &str| out.lines().find(|l| l.starts_with(name)).unwrap();
     assert!(row("cosine ").contains('!'), "{out}");
     assert!(!row("light ").contains('!'), "{out}");
@@ -141,7 +142,12 @@ fn heavy_tails_mark_the_standard_error_and_only_then_a_legend() {
         legend[0].contains("heavy-tailed") && legend[0].contains("0.15"),
         "{out}"
     );
-    let out = run("beam:4:0,0,1");
+    let v: serde_json::Value = serde_json::from_str(&run("sky", true)).unwrap();
+    let rows = v["strategies"].as_array().unwrap();
+    assert_eq!(rows[0]["stderr_reliable"], false);
+    assert!(rows[0]["variance_rel_stderr"].as_f64().unwrap() > 0.15);
+    assert_eq!(rows[1]["stderr_reliable"], true);
+    let out = run("beam:4:0,0,1", false);
     assert!(!out.contains('!'), "{out}");
 }
 
