@@ -917,60 +917,48 @@ pub fn reference_env_row(m: &Material, sp: &ShadingPoint, map: &EnvMap, j: usize
             }
         };
         // Refine on luminance, integrate RGB on the accepted cells.
-        let mut stack = vec![(t0.cos(), t1.cos(), p0, p1, 0u32)];
-        while let Some((c0, c1, a, b, depth)) = stack.pop() {
-            let whole = gauss_legendre_4x4(g, c0, c1, a, b);
-            let (cm, pm) = (0.5 * (c0 + c1), 0.5 * (a + b));
-            let parts = gauss_legendre_4x4(g, c0, cm, a, pm)
-                + gauss_legendre_4x4(g, cm, c1, a, pm)
-                + gauss_legendre_4x4(g, c0, cm, pm, b)
-                + gauss_legendre_4x4(g, cm, c1, pm, b);
-            if depth < 6
-                && (whole - parts).abs() > rel * parts.abs().max(1e-300)
-                && (whole - parts).abs() > 1e-15
-            {
-                stack.extend([
-                    (c0, cm, a, pm, depth + 1),
-                    (cm, c1, a, pm, depth + 1),
-                    (c0, cm, pm, b, depth + 1),
-                    (cm, c1, pm, b, depth + 1),
-                ]);
-            } else {
-                for (x0, x1, y0, y1) in [
-                    (c0, cm, a, pm),
-                    (cm, c1, a, pm),
-                    (c0, cm, pm, b),
-                    (cm, c1, pm, b),
-                ] {
-                    sum += l * gauss_legendre_4x4(gc, x0, x1, y0, y1);
-                }
-            }
-        }
+        refine_4x4(g, (t0.cos(), t1.cos(), p0, p1), rel, |x0, x1, y0, y1| {
+            sum += l * gauss_legendre_4x4(gc, x0, x1, y0, y1);
+        });
     }
     sum
 }
 
 /// `∫ gc` over `(cos θ, φ) ∈ [c0, c1] × [p0, p1]` by the 4 × 4
-/// Gauss–Legendre rule, compared with the same rule on the cell's four
-/// quarters and refined where their luminances differ by more than `rel`
-/// (relative) and `1e-15` (up to 6 levels); RGB summed on the accepted
-/// cells' quarters.
-fn refined_4x4(
-    gc: impl Fn(f64, f64) -> Rgb,
+/// Gauss–Legendre rule on [`refine_4x4`]'s accepted cells, refined on the
+/// luminance of `gc`.
+fn refined_4x4(gc: impl Fn(f64, f64) -> Rgb, cell: (f64, f64, f64, f64), rel: f64) -> Rgb {
+    let mut sum = Rgb::ZERO;
+    refine_4x4(
+        |c, phi| luminance(gc(c, phi)),
+        cell,
+        rel,
+        |x0, x1, y0, y1| {
+            sum += gauss_legendre_4x4(&gc, x0, x1, y0, y1);
+        },
+    );
+    sum
+}
+
+/// The cells of `(cos θ, φ) ∈ [c0, c1] × [p0, p1]` on which the 4 × 4
+/// Gauss–Legendre rule of `g` agrees with the same rule on the cell's four
+/// quarters within `rel` (relative) or `1e-15` (up to 6 levels of
+/// refinement): `accept(c0, c1, φ0, φ1)` is called with each accepted cell's
+/// quarters, in a fixed order.
+fn refine_4x4(
+    g: impl Fn(f64, f64) -> f64,
     (c0, c1, p0, p1): (f64, f64, f64, f64),
     rel: f64,
-) -> Rgb {
-    let g = |c: f64, phi: f64| luminance(gc(c, phi));
-    let mut sum = Rgb::ZERO;
-    // Refine on luminance, integrate RGB on the accepted cells.
+    mut accept: impl FnMut(f64, f64, f64, f64),
+) {
     let mut stack = vec![(c0, c1, p0, p1, 0u32)];
     while let Some((c0, c1, a, b, depth)) = stack.pop() {
-        let whole = gauss_legendre_4x4(g, c0, c1, a, b);
+        let whole = gauss_legendre_4x4(&g, c0, c1, a, b);
         let (cm, pm) = (0.5 * (c0 + c1), 0.5 * (a + b));
-        let parts = gauss_legendre_4x4(g, c0, cm, a, pm)
-            + gauss_legendre_4x4(g, cm, c1, a, pm)
-            + gauss_legendre_4x4(g, c0, cm, pm, b)
-            + gauss_legendre_4x4(g, cm, c1, pm, b);
+        let parts = gauss_legendre_4x4(&g, c0, cm, a, pm)
+            + gauss_legendre_4x4(&g, cm, c1, a, pm)
+            + gauss_legendre_4x4(&g, c0, cm, pm, b)
+            + gauss_legendre_4x4(&g, cm, c1, pm, b);
         if depth < 6
             && (whole - parts).abs() > rel * parts.abs().max(1e-300)
             && (whole - parts).abs() > 1e-15
@@ -988,9 +976,8 @@ fn refined_4x4(
                 (c0, cm, pm, b),
                 (cm, c1, pm, b),
             ] {
-                sum += gauss_legendre_4x4(&gc, x0, x1, y0, y1);
+                accept(x0, x1, y0, y1);
             }
         }
     }
-    sum
 }

@@ -139,7 +139,9 @@ fn env_row_second_moment(m: &Material, sp: &ShadingPoint, map: &EnvMap, j: usize
                 }
             };
             let ((t0, t1), (p0, p1)) = (cell.theta, cell.phi);
-            sum += refined_second_moment(g, (t0.cos(), t1.cos(), p0, p1));
+            let mut cell_sum = 0.0;
+            add_refined_second_moment(g, (t0.cos(), t1.cos(), p0, p1), &mut cell_sum);
+            sum += cell_sum;
         }
         return sum;
     }
@@ -161,40 +163,20 @@ fn env_row_second_moment(m: &Material, sp: &ShadingPoint, map: &EnvMap, j: usize
                 y * y
             }
         };
-        let mut stack = vec![(t0.cos(), t1.cos(), p0, p1, 0u32)];
-        while let Some((c0, c1, a, b, depth)) = stack.pop() {
-            let whole = gauss_legendre_4x4(g, c0, c1, a, b);
-            let (cm, pm) = (0.5 * (c0 + c1), 0.5 * (a + b));
-            let quarters = [
-                (c0, cm, a, pm),
-                (cm, c1, a, pm),
-                (c0, cm, pm, b),
-                (cm, c1, pm, b),
-            ];
-            let parts: f64 = quarters
-                .iter()
-                .map(|&(x0, x1, y0, y1)| gauss_legendre_4x4(g, x0, x1, y0, y1))
-                .sum();
-            if depth < 6
-                && (whole - parts).abs() > SECOND_MOMENT_TOLERANCE * parts.abs().max(1e-300)
-                && (whole - parts).abs() > 1e-15
-            {
-                stack.extend(quarters.map(|(x0, x1, y0, y1)| (x0, x1, y0, y1, depth + 1)));
-            } else {
-                sum += parts;
-            }
-        }
+        add_refined_second_moment(g, (t0.cos(), t1.cos(), p0, p1), &mut sum);
     }
     sum
 }
 
-/// `∫ g` over `(cos θ, φ) ∈ [c0, c1] × [p0, p1]` refined as
-/// [`env_row_second_moment`] refines a texel's.
-fn refined_second_moment(
+/// Add `∫ g` over `(cos θ, φ) ∈ [c0, c1] × [p0, p1]` to `sum`, cell by
+/// accepted cell: the 4 × 4 Gauss–Legendre rule, compared with the same
+/// rule on the cell's four quarters and refined where they differ by more
+/// than [`SECOND_MOMENT_TOLERANCE`] (relative) and `1e-15` (up to 6 levels).
+fn add_refined_second_moment(
     g: impl Fn(f64, f64) -> f64 + Copy,
     (c0, c1, p0, p1): (f64, f64, f64, f64),
-) -> f64 {
-    let mut sum = 0.0;
+    sum: &mut f64,
+) {
     let mut stack = vec![(c0, c1, p0, p1, 0u32)];
     while let Some((c0, c1, a, b, depth)) = stack.pop() {
         let whole = gauss_legendre_4x4(g, c0, c1, a, b);
@@ -215,10 +197,9 @@ fn refined_second_moment(
         {
             stack.extend(quarters.map(|(x0, x1, y0, y1)| (x0, x1, y0, y1, depth + 1)));
         } else {
-            sum += parts;
+            *sum += parts;
         }
     }
-    sum
 }
 
 /// View angles (degrees from the normal) at which [`max_albedo`] measures
