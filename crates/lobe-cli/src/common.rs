@@ -202,6 +202,18 @@ pub fn warn_scene_energy_gain(scene: &lobe_render::Scene, path: &std::path::Path
 /// Warn once on stderr when `m` reflects more than it receives: its largest
 /// directional albedo ([`lobe::experiment::variance::max_albedo`]) is above 1.
 pub fn warn_energy_gain(m: &lobe::Material, what: &str) {
+    // A Lambertian term and a Cook-Torrance lobe reflect at most kd + ks
+    // (a microfacet lobe's single scattering and every Fresnel term are at
+    // most 1): where that bound is at most 1 the quadrature (about a second
+    // for a Beckmann lobe, paid at every start-up) cannot find a gain.
+    let ks = match &m.glossy {
+        lobe::Glossy::None => Some(lobe::Rgb::ZERO),
+        lobe::Glossy::CookTorrance(ct) => Some(ct.ks),
+        _ => None,
+    };
+    if ks.is_some_and(|ks| (m.diffuse.albedo + ks).max_element() <= 1.0) {
+        return;
+    }
     let a = lobe::experiment::variance::max_albedo(m);
     if a.gains_energy() {
         // Cook-Torrance without a Fresnel term (Mitsuba's default) reflects
