@@ -107,25 +107,18 @@ def _check_finite(v: Any, path: str) -> None:
 def load_dict(desc: Mapping[str, Any]) -> Material:
     """A material from a dict with the keys of ``lobe --material``.
 
-    ``{"type": "lambert" | "phong" | "blinn-phong" | "cook-torrance", ...}``
-    (``lobe eval --help`` lists every key, range and default), or one of
-    Mitsuba 3's plugins translated to lobe's models:
-
-    * ``diffuse``: ``reflectance`` → ``lambert``;
-    * ``roughconductor``: ``distribution`` (default ``beckmann``), ``alpha``
-      (0.1) or ``alpha_u``/``alpha_v``, ``material`` (``none`` or one of
-      Mitsuba's conductor names, ``Au``, ``Ag``, ``Cu``, ``Al``, ``Cr``,
-      ``W``, ... with the RGB (eta, k) of Mitsuba's RGB variants) or
-      ``eta``/``k``,
-      ``specular_reflectance`` → ``cook-torrance`` with Smith separable
-      shadowing (Mitsuba's) and a conductor Fresnel term;
-    * ``roughplastic``: ``distribution``, ``alpha``, ``int_ior`` (1.49),
-      ``ext_ior`` (1.000277), each a number or one of Mitsuba's names
-      (``bk7``, ``water``, ``air``, ``diamond``, ... 23 of them),
-      ``specular_reflectance``,
-      ``diffuse_reflectance`` (0.5) → ``cook-torrance`` with a dielectric
-      Fresnel term plus ``kd/π``. The specular lobe is Mitsuba's; the
-      diffuse term is not Fresnel-weighted as in Mitsuba, so it differs.
+    lobe's models (``lambert``, ``phong``, ``blinn-phong``,
+    ``cook-torrance``, ``measured``) and the dicts a Mitsuba 3 user writes
+    for ``mi.load_dict``, with Mitsuba's parameter names and defaults:
+    ``diffuse``, ``conductor``, ``roughconductor``, ``dielectric``,
+    ``thindielectric``, ``roughdielectric``, ``plastic``, ``roughplastic``
+    and ``twosided`` (one nested material under ``bsdf`` or ``material``).
+    Colours are a number, ``[r, g, b]`` or ``{"type": "rgb", "value": ...}``;
+    ``int_ior``/``ext_ior`` a number or one of Mitsuba's names (``bk7``,
+    ``water``, ``air``, ``diamond``, ...); a conductor's ``material`` one of
+    Mitsuba's names (``Au``, ``Ag``, ``Cu``, ``Al``, ``Cr``, ...) with the
+    RGB (eta, k) of its RGB variants. ``lobe eval --help`` lists every key,
+    range and default.
 
     A bad key or value raises ``ValueError`` naming the field, with the CLI's
     message. The material's conventions: local frame, +z the normal, wo

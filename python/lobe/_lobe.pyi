@@ -91,7 +91,7 @@ class Material:
         material's two lobes with ``uc``, which ``sample`` then requires."""
     @property
     def model(self) -> str:
-        """The model's short name (lambert, phong, blinn-phong, cook-torrance, measured)."""
+        """The model's short name (lambert, phong, blinn-phong, cook-torrance, measured, conductor, dielectric, thindielectric, roughdielectric, plastic, roughplastic). Mitsuba's names (diffuse, roughconductor, twosided) give lambert, cook-torrance and the wrapped material's model."""
     @property
     def description(self) -> str:
         """lobe's description of the material: JSON text with the keys of ``--material``."""

@@ -13,7 +13,9 @@ use std::path::{Path, PathBuf};
 /// `--theta DEG` or `--wo x,y,z`: the view direction in the local frame.
 #[derive(Args, Debug, Clone)]
 pub struct ViewArgs {
-    /// View angle from the normal in degrees, in [0, 90): wo = (sin θ, 0, cos θ)
+    /// View angle from the normal in degrees, in [0, 90): wo = (sin θ, 0,
+    /// cos θ); up to 180 (below the surface, seen from inside) for a
+    /// material that transmits or is two-sided
     #[arg(long, conflicts_with = "wo", allow_hyphen_values = true)]
     pub theta: Option<f64>,
     /// View direction x,y,z in the local frame (+z is the normal); normalized
@@ -22,19 +24,35 @@ pub struct ViewArgs {
 }
 
 impl ViewArgs {
-    /// The unit view direction; 30° when neither flag is given.
-    pub fn wo(&self) -> Result<DVec3> {
+    /// The unit view direction; 30° when neither flag is given. Below the
+    /// horizon only where `m` scatters from there (it transmits, or is
+    /// two-sided); never on it.
+    pub fn wo(&self, m: &lobe::Material) -> Result<DVec3> {
+        let below_ok = m.reach().transmits || m.two_sided;
         if let Some(w) = &self.wo {
             let v = parse_vec3("--wo", w)?;
-            if v.z <= 0.0 {
+            if v.z == 0.0 {
+                bail!("--wo {w}: the view direction is on the horizon (z must not be 0)");
+            }
+            if v.z < 0.0 && !below_ok {
                 bail!(
-                    "--wo {w}: the view direction is below the horizon (z must be > 0 in the local frame)"
+                    "--wo {w}: the view direction is below the horizon (z must be > 0 in the local frame; below it only for a material that transmits or is two-sided)"
                 );
             }
             return Ok(v.normalize());
         }
         let t = self.theta.unwrap_or(30.0);
-        theta_to_wo(t)
+        if below_ok && t.is_finite() && t > 90.0 && t <= 180.0 {
+            let r = t.to_radians();
+            return Ok(DVec3::new(r.sin(), 0.0, r.cos()));
+        }
+        theta_to_wo(t).map_err(|e| {
+            if below_ok {
+                anyhow!("{e}, or in (90, 180] from inside")
+            } else {
+                e
+            }
+        })
     }
 }
 

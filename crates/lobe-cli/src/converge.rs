@@ -208,7 +208,7 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
         &["csv", "svg", "png"].map(|e| with_ext(&args.out, e)),
     )?;
     let m = crate::common::load_material(&args.material)?;
-    let wo = args.view.wo()?;
+    let wo = args.view.wo(&m)?;
     let light = args.light.light()?;
     let strategies =
         crate::estimate::parse_strategies(&args.strategy, &m, m.best_bsdf_strategy(), 1, 1)?;

@@ -124,7 +124,7 @@ pub fn parse_sequence(spec: &str) -> Result<Sequence> {
 
 pub fn run(args: &EstimateArgs) -> Result<()> {
     let m = crate::common::load_material(&args.material)?;
-    let wo = args.view.wo()?;
+    let wo = args.view.wo(&m)?;
     let light = args.light.light()?;
     let mis_samples = parse_mis_samples(&args.mis_samples)?;
     let settings = EstimateTableSettings {
@@ -194,6 +194,8 @@ fn print_table(t: &Table, model: &str, wo: DVec3) {
             "vs uniform: against uniform's exact variance {:.4e} ({})\n",
             u.variance, u.method
         );
+    } else if u.variance.is_infinite() {
+        println!("vs uniform: {}\n", u.method);
     } else {
         println!(
             "vs uniform: unreliable (the quadrature of uniform's variance did not converge)\n"

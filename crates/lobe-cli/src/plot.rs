@@ -113,7 +113,9 @@ pub fn run(args: &PlotArgs) -> Result<()> {
         .parse()
         .map_err(|e| anyhow!("--scale {}: {e}", args.scale))?;
     let material = load_material(&args.material)?;
-    let wo = args.view.wo()?;
+    // The figures are drawn over the hemisphere of the normal (transmitted
+    // lobes and views from inside: issue 42's next step).
+    let wo = args.view.wo(&lobe::Material::lambert(lobe::Rgb::ONE)?)?;
     if (args.fit.is_some() || args.against.is_some()) && !kinds.contains(&Kind::Polar) {
         bail!("--fit and --against draw polar figures: use --kind polar or all");
     }

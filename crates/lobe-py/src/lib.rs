@@ -3,7 +3,7 @@
 //!
 //! The pure-Rust parts are modules of their own, tested by `cargo test`
 //! without Python: the array [`engine`] (batch SIMD kernels with a scalar
-//! fallback, rayon blocks), the [`mitsuba`] plugin translation, the
+//! fallback, rayon blocks), the
 //! [`estimate`] call and the [`chi2`] glue. The PyO3 glue (`py`) is built
 //! only with the `python` feature, which maturin turns on
 //! (`pyproject.toml`), so a plain `cargo build` or `cargo test` neither
@@ -12,7 +12,6 @@
 pub mod chi2;
 pub mod engine;
 pub mod estimate;
-pub mod mitsuba;
 pub mod pool;
 #[cfg(feature = "python")]
 mod py;

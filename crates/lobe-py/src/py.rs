@@ -628,7 +628,8 @@ impl PyMaterial {
     }
 
     /// The model's short name (`lambert`, `phong`, `blinn-phong`,
-    /// `cook-torrance`, `measured`).
+    /// `cook-torrance`, `measured`, `conductor`, `dielectric`,
+    /// `thindielectric`, `roughdielectric`, `plastic`, `roughplastic`).
     /// Conventions: local frame (+z the normal), wo toward the viewer, wi
     /// toward the light, f without the cosine, weight = f·cos θi / pdf.
     #[getter]
@@ -637,7 +638,7 @@ impl PyMaterial {
     }
 
     /// lobe's description of the material (JSON text, the keys of
-    /// `--material`; a Mitsuba dict as translated).
+    /// `--material`, Mitsuba's plugin names among them).
     /// Conventions: local frame (+z the normal), wo toward the viewer, wi
     /// toward the light, f without the cosine, weight = f·cos θi / pdf.
     #[getter]
@@ -650,8 +651,8 @@ impl PyMaterial {
     }
 }
 
-/// Build a material from JSON text in lobe's `--material` form (or a
-/// Mitsuba dict as JSON); errors name the field.
+/// Build a material from JSON text in lobe's `--material` form (Mitsuba's
+/// plugin dicts among them); errors name the field.
 #[pyfunction]
 fn _load_json(text: &str) -> PyResult<PyMaterial> {
     let v: serde_json::Value = serde_json::from_str(text)
@@ -659,20 +660,8 @@ fn _load_json(text: &str) -> PyResult<PyMaterial> {
     if !v.is_object() {
         return Err(PyTypeError::new_err("material: expected a dict"));
     }
-    let v = crate::mitsuba::translate(v).map_err(value_error)?;
     let desc = v.to_string();
-    let m = Material::load(&desc).map_err(|e| {
-        let m = e.to_string();
-        let m = without_position(&m);
-        if m.starts_with("material: field `type`: unknown value") {
-            value_error(format!(
-                "{m}; or one of Mitsuba 3's plugins: {}",
-                crate::mitsuba::PLUGINS.join(", ")
-            ))
-        } else {
-            value_error(m)
-        }
-    })?;
+    let m = Material::load(&desc).map_err(|e| value_error(without_position(&e.to_string())))?;
     Ok(PyMaterial { m, desc })
 }
 

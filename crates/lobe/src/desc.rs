@@ -37,7 +37,7 @@ impl<'de> Deserialize<'de> for Color {
         impl<'de> Visitor<'de> for V {
             type Value = Color;
             fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
-                f.write_str("a number or an [r, g, b] array of three numbers")
+                f.write_str("a number, an [r, g, b] array of three numbers or {\"type\": \"rgb\", \"value\": [r, g, b]}")
             }
             fn visit_f64<E: de::Error>(self, v: f64) -> Result<Color, E> {
                 Ok(Color::Grey(v))
@@ -47,6 +47,33 @@ impl<'de> Deserialize<'de> for Color {
             }
             fn visit_u64<E: de::Error>(self, v: u64) -> Result<Color, E> {
                 Ok(Color::Grey(v as f64))
+            }
+            /// Mitsuba's form: `{"type": "rgb", "value": [r, g, b]}` (or
+            /// `"spectrum"` with one number), nothing else in it.
+            fn visit_map<A: de::MapAccess<'de>>(self, mut map: A) -> Result<Color, A::Error> {
+                let (mut kind, mut value): (Option<String>, Option<Color>) = (None, None);
+                while let Some(key) = map.next_key::<String>()? {
+                    match key.as_str() {
+                        "type" => kind = Some(map.next_value()?),
+                        "value" => value = Some(map.next_value()?),
+                        other => {
+                            return Err(de::Error::custom(format!(
+                                "unknown key `{other}` in a colour: expected {{\"type\": \"rgb\", \"value\": [r, g, b]}}"
+                            )));
+                        }
+                    }
+                }
+                match (kind.as_deref(), value) {
+                    (Some("rgb" | "spectrum"), Some(v)) => Ok(v),
+                    (Some(k), _) if k != "rgb" && k != "spectrum" => {
+                        Err(de::Error::custom(format!(
+                            "a colour of type `{k}` is not supported: give a number, [r, g, b] or {{\"type\": \"rgb\", \"value\": [r, g, b]}}"
+                        )))
+                    }
+                    _ => Err(de::Error::custom(
+                        "a colour object needs \"type\": \"rgb\" and \"value\": [r, g, b]",
+                    )),
+                }
             }
             fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<Color, A::Error> {
                 let mut c = [0.0; 3];
@@ -59,6 +86,90 @@ impl<'de> Deserialize<'de> for Color {
                     return Err(de::Error::invalid_length(4, &self));
                 }
                 Ok(Color::Rgb(c))
+            }
+        }
+        d.deserialize_any(V)
+    }
+}
+
+/// An index of refraction as written: a number, or a name of
+/// [`crate::ior::IORS`] (`bk7`, `water`, `air`, ...).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(untagged)]
+pub enum Ior {
+    Number(f64),
+    Name(String),
+}
+
+impl<'de> Deserialize<'de> for Ior {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct V;
+        impl Visitor<'_> for V {
+            type Value = Ior;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("an index of refraction: a number or a name (bk7, water, air, ...)")
+            }
+            fn visit_f64<E: de::Error>(self, v: f64) -> Result<Ior, E> {
+                Ok(Ior::Number(v))
+            }
+            fn visit_i64<E: de::Error>(self, v: i64) -> Result<Ior, E> {
+                Ok(Ior::Number(v as f64))
+            }
+            fn visit_u64<E: de::Error>(self, v: u64) -> Result<Ior, E> {
+                Ok(Ior::Number(v as f64))
+            }
+            fn visit_str<E: de::Error>(self, v: &str) -> Result<Ior, E> {
+                Ok(Ior::Name(v.to_string()))
+            }
+        }
+        d.deserialize_any(V)
+    }
+}
+
+impl Ior {
+    /// The index: the number, or the named one's; `field` names the key in
+    /// the error (an unknown name, or a number not finite or not > 0).
+    pub fn value(&self, field: &str) -> Result<f64, Error> {
+        let v = match self {
+            Ior::Number(v) => *v,
+            Ior::Name(n) => crate::ior::dielectric(field, n)?,
+        };
+        if v.is_finite() && v > 0.0 {
+            Ok(v)
+        } else {
+            Err(Error::param(
+                field,
+                format!("{v} is out of range: an index of refraction must be a number > 0"),
+            ))
+        }
+    }
+}
+
+/// Mitsuba's `material`: a conductor's name (`conductor`,
+/// `roughconductor`), or the nested material of `twosided`.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(untagged)]
+pub enum Nested {
+    Name(String),
+    Material(Box<MaterialDesc>),
+}
+
+impl<'de> Deserialize<'de> for Nested {
+    /// A string, or an object read as a [`MaterialDesc`] (its errors name
+    /// the nested field).
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct V;
+        impl<'de> Visitor<'de> for V {
+            type Value = Nested;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("a conductor's name or a nested material object")
+            }
+            fn visit_str<E: de::Error>(self, v: &str) -> Result<Nested, E> {
+                Ok(Nested::Name(v.to_string()))
+            }
+            fn visit_map<A: de::MapAccess<'de>>(self, map: A) -> Result<Nested, A::Error> {
+                MaterialDesc::deserialize(de::value::MapAccessDeserializer::new(map))
+                    .map(|m| Nested::Material(Box::new(m)))
             }
         }
         d.deserialize_any(V)
@@ -114,6 +225,33 @@ pub struct MaterialDesc {
     pub path: Option<String>,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub interpolation: Option<String>,
+    // Mitsuba 3's keys, for the models named after its plugins.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub reflectance: Option<Color>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub diffuse_reflectance: Option<Color>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub specular_reflectance: Option<Color>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub specular_transmittance: Option<Color>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub int_ior: Option<Ior>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub ext_ior: Option<Ior>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub eta: Option<Color>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub k: Option<Color>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub material: Option<Nested>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub bsdf: Option<Box<MaterialDesc>>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub nonlinear: Option<bool>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sample_visible: Option<bool>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub mode: Option<String>,
     /// The directory relative paths (`path`) are taken from: the directory
     /// of the file the description was read from; `None` for the working
     /// directory. Not a key.
@@ -152,7 +290,7 @@ impl MaterialDesc {
         self
     }
 
-    pub(crate) fn present_fields(&self) -> [(&'static str, bool); 14] {
+    pub(crate) fn present_fields(&self) -> [(&'static str, bool); 27] {
         [
             ("albedo", self.albedo.is_some()),
             ("ks", self.ks.is_some()),
@@ -168,6 +306,22 @@ impl MaterialDesc {
             ("fresnel", self.fresnel.is_some()),
             ("path", self.path.is_some()),
             ("interpolation", self.interpolation.is_some()),
+            ("reflectance", self.reflectance.is_some()),
+            ("diffuse_reflectance", self.diffuse_reflectance.is_some()),
+            ("specular_reflectance", self.specular_reflectance.is_some()),
+            (
+                "specular_transmittance",
+                self.specular_transmittance.is_some(),
+            ),
+            ("int_ior", self.int_ior.is_some()),
+            ("ext_ior", self.ext_ior.is_some()),
+            ("eta", self.eta.is_some()),
+            ("k", self.k.is_some()),
+            ("material", self.material.is_some()),
+            ("bsdf", self.bsdf.is_some()),
+            ("nonlinear", self.nonlinear.is_some()),
+            ("sample_visible", self.sample_visible.is_some()),
+            ("mode", self.mode.is_some()),
         ]
     }
 }

@@ -20,10 +20,12 @@ use crate::material::BsdfSampler;
 use crate::math::{Rgb, luminance};
 pub use crate::sequence::CHUNK;
 use crate::sequence::{self, Sequence};
-use crate::stats::quadrature::{Tolerance, gauss_legendre_4x4, integrate_hemisphere};
+use crate::stats::quadrature::{
+    Tolerance, gauss_legendre_4x4, integrate_hemisphere, integrate_sphere,
+};
 use crate::stats::ttest::Moments;
 pub use crate::strategy::{Heuristic, Mis, MisForm, NON_BSDF_NAMES, Strategy};
-use crate::{BsdfSample, Error, Frame, Material};
+use crate::{BsdfSample, BsdfStrategy, Error, Frame, Material};
 use glam::{DVec2, DVec3};
 
 /// Running sums of the sample values `f L cos / p` (zero for a failed sample).
@@ -78,6 +80,21 @@ impl<'m> ShadingEstimator<'m> {
     /// Validate `strategy` for `m` once, into an estimator of one shading
     /// point; the error says why a BSDF strategy does not apply.
     pub fn new(strategy: Strategy, m: &'m Material) -> Result<Self, Error> {
+        if strategy == Strategy::Light && m.reach().delta {
+            return Err(Error::Unsupported {
+                strategy: "light".into(),
+                reason: format!(
+                    "{} has a delta part (a mirror or a smooth interface) that light sampling never hits",
+                    m.model_name()
+                ),
+                available: m
+                    .strategies()
+                    .into_iter()
+                    .map(BsdfStrategy::name)
+                    .chain(["mis"])
+                    .collect(),
+            });
+        }
         let sampler = match strategy.bsdf_strategy(m) {
             Some(s) => Some(m.sampler(s)?),
             None => None,
@@ -373,6 +390,12 @@ impl<'m> ShadingEstimator<'m> {
     /// effect on any other strategy).
     #[must_use]
     pub fn with_allocation(self, a: Allocation) -> Self {
+        // Light sampling alone never draws a delta part.
+        let a = if a == Allocation::Light && self.material.reach().delta {
+            Allocation::Balance
+        } else {
+            a
+        };
         ShadingEstimator {
             allocation: if self.is_adaptive() {
                 a
@@ -532,6 +555,9 @@ impl<'m> ShadingEstimator<'m> {
                         if p[0] < cb {
                             // Reuse the choice number for the lobe choice, rescaled.
                             match draw_bsdf(&s, sp, p, cb, vis, &mut first) {
+                                Some((x, dir)) if x.scattering.is_specular() => {
+                                    x.weight * light.radiance(dir) / cb
+                                }
                                 Some((x, dir)) => {
                                     let w = h.weight(cb * x.pdf, cl * light.pdf(dist, dir));
                                     x.weight * light.radiance(dir) * (w / cb)
@@ -573,6 +599,11 @@ fn multi_sample(
     let mut sum = Rgb::ZERO;
     for p in &points[..n_b as usize] {
         if let Some((x, dir)) = draw_bsdf(s, sp, *p, 1.0, vis, first) {
+            if x.scattering.is_specular() {
+                // A delta part: light sampling never draws it (weight 1).
+                sum += x.weight * light.radiance(dir) / nb;
+                continue;
+            }
             let pc = light.pdf(dist, dir);
             let w = h.weight(nb * x.pdf, nl * pc);
             let v = x.weight * light.radiance(dir);
@@ -627,7 +658,9 @@ fn light_draw(
 ) -> Option<LightDraw> {
     let ls = light.sample(dist, DVec2::new(p[1], p[2]))?;
     let wi = sp.frame.to_local(ls.dir);
-    if wi.z <= 0.0 {
+    // Below the horizon `f` is zero but where the material transmits (or
+    // is two-sided and seen from below).
+    if wi.z == 0.0 {
         return None;
     }
     let (f, pb) = match bsdf {
@@ -638,7 +671,7 @@ fn light_draw(
         return None;
     }
     Some(LightDraw {
-        f_l_cos: f * light.radiance(ls.dir) * wi.z,
+        f_l_cos: f * light.radiance(ls.dir) * wi.z.abs(),
         pdf: ls.pdf,
         pdf_bsdf: pb,
         dir: ls.dir,
@@ -848,16 +881,30 @@ pub fn reference(m: &Material, sp: &ShadingPoint, light: &Light, rel: f64) -> Rg
         for j in 0..map.size().1 {
             sum += reference_env_row(m, sp, map, j, rel);
         }
-        return sum;
+        return sum + delta_reference(m, sp, light);
     }
+    let sphere = m.reach().transmits || (m.two_sided && wo.z < 0.0);
     let channel = |c: usize| {
-        integrate_hemisphere(
-            |wi| (m.eval(wo, wi) * light.radiance(sp.frame.to_world(wi)))[c] * wi.z,
-            reference_tolerance(m, rel),
-        )
-        .value
+        let f =
+            |wi: DVec3| (m.eval(wo, wi) * light.radiance(sp.frame.to_world(wi)))[c] * wi.z.abs();
+        let tol = reference_tolerance(m, rel);
+        if sphere {
+            integrate_sphere(f, tol).value
+        } else {
+            integrate_hemisphere(f, tol).value
+        }
     };
-    Rgb::new(channel(0), channel(1), channel(2))
+    Rgb::new(channel(0), channel(1), channel(2)) + delta_reference(m, sp, light)
+}
+
+/// What the delta parts of `m` add to the reflected radiance, exactly:
+/// `Σ value · L(wi)` over [`Material::deltas`].
+fn delta_reference(m: &Material, sp: &ShadingPoint, light: &Light) -> Rgb {
+    let mut sum = Rgb::ZERO;
+    for d in m.deltas(sp.wo).iter() {
+        sum += d.value * light.radiance(sp.frame.to_world(d.wi));
+    }
+    sum
 }
 
 /// Row `j` of the environment-map reference: `Σ_i L(i, j) ∫_texel f cos dω`.
@@ -879,11 +926,8 @@ pub fn reference_env_row(m: &Material, sp: &ShadingPoint, map: &EnvMap, j: usize
             let gc = |c: f64, phi: f64| {
                 let theta = crate::math::safe_acos(c);
                 let wi = frame.to_local(map.spherical_to_direction(theta, phi));
-                if wi.z <= 0.0 {
-                    Rgb::ZERO
-                } else {
-                    m.eval(wo, wi) * cell.radiance(theta, phi) * wi.z
-                }
+                // `f` is zero where the material does not scatter.
+                m.eval(wo, wi) * cell.radiance(theta, phi) * wi.z.abs()
             };
             let ((t0, t1), (p0, p1)) = (cell.theta, cell.phi);
             sum += refined_4x4(gc, (t0.cos(), t1.cos(), p0, p1), rel);
@@ -901,20 +945,12 @@ pub fn reference_env_row(m: &Material, sp: &ShadingPoint, map: &EnvMap, j: usize
         let g = |c: f64, phi: f64| {
             let d = map.spherical_to_direction(crate::math::safe_acos(c), phi);
             let wi = frame.to_local(d);
-            if wi.z <= 0.0 {
-                0.0
-            } else {
-                luminance(m.eval(wo, wi)) * wi.z
-            }
+            luminance(m.eval(wo, wi)) * wi.z.abs()
         };
         let gc = |c: f64, phi: f64| {
             let d = map.spherical_to_direction(crate::math::safe_acos(c), phi);
             let wi = frame.to_local(d);
-            if wi.z <= 0.0 {
-                Rgb::ZERO
-            } else {
-                m.eval(wo, wi) * wi.z
-            }
+            m.eval(wo, wi) * wi.z.abs()
         };
         // Refine on luminance, integrate RGB on the accepted cells.
         refine_4x4(g, (t0.cos(), t1.cos(), p0, p1), rel, |x0, x1, y0, y1| {

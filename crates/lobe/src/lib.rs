@@ -11,7 +11,8 @@
 //! * Local shading frame, `+z` is the surface normal ([`Frame`] goes to and
 //!   from the world).
 //! * `wo` points toward the viewer, `wi` toward the light; both are unit
-//!   vectors pointing away from the surface.
+//!   vectors pointing away from the surface (for a transmission, `wi` is on
+//!   the other side of it; `wo` below the surface sees glass from inside).
 //! * [`Material::eval`] is `f_r` **without** the cosine.
 //! * Pdfs are densities in **solid angle** over `wi`.
 //! * A sample whose direction falls below the horizon is a *failed* sample:
@@ -77,6 +78,7 @@ pub mod experiment;
 pub mod fit;
 pub mod frame;
 pub mod fresnel;
+pub mod ior;
 pub mod light;
 pub mod material;
 pub mod math;
@@ -88,6 +90,7 @@ pub mod sequence;
 pub mod stats;
 pub mod strategy;
 pub mod tabulate;
+pub mod transport;
 pub mod warp;
 
 pub use bsdf_strategy::BsdfStrategy;
@@ -101,5 +104,6 @@ pub use light::Light;
 pub use material::{BsdfSampler, Glossy, Material};
 pub use math::Rgb;
 pub use microfacet::{Microfacet, Ndf, Shadowing};
-pub use sample::{BsdfSample, Component, LobeSample, Scattering};
+pub use sample::{BsdfSample, Component, Delta, Deltas, LobeSample, Reach, Scattering};
 pub use strategy::Strategy;
+pub use transport::TransportMode;

@@ -1,7 +1,14 @@
-//! A material: a Lambertian term plus at most one glossy lobe, with
-//! evaluation, and a sampler for each strategy that applies to it
-//! ([`Material::sampler`], resolved once) that draws directions and gives
-//! the matching pdf.
+//! A material: a Lambertian term plus at most one other lobe (its
+//! *glossy* lobe: any model but Lambert's, glass and plastic included),
+//! seen from the front or from both sides, with evaluation, and a sampler
+//! for each strategy that applies to it ([`Material::sampler`], resolved
+//! once) that draws directions and gives the matching pdf.
+//!
+//! An opaque material scatters into the hemisphere of `wo`: from below the
+//! surface it is black, unless it is two-sided (Mitsuba's `twosided`: `wo`
+//! and `wi` mirrored through the surface before the lobes see them). A
+//! material whose lobe transmits ([`Reach::transmits`]: glass) scatters
+//! over the whole sphere and is seen from either side.
 //!
 //! With two lobes, `sample` chooses the glossy lobe with probability
 //! `P = a_g / (a_g + a_d)` from the lobes' albedo estimates
@@ -13,7 +20,7 @@ use crate::math::Rgb;
 pub use crate::models::Glossy;
 use crate::models::lambert::CosineSampler;
 use crate::models::{Bxdf, GlossySampler, Lambert, Lobes};
-use crate::sample::{BsdfSample, Component, Scattering};
+use crate::sample::{BsdfSample, Component, Deltas, Reach, Scattering};
 use crate::{BsdfStrategy, Error, warp};
 use glam::{DVec2, DVec3};
 
@@ -23,6 +30,15 @@ use glam::{DVec2, DVec3};
 pub struct Material {
     pub diffuse: Lambert,
     pub glossy: Glossy,
+    /// Seen from below the surface as from above (`wo` and `wi` mirrored
+    /// through it); only for an opaque material.
+    pub two_sided: bool,
+}
+
+/// `w` mirrored through the surface (its `z` negated).
+#[inline]
+fn mirrored(w: DVec3) -> DVec3 {
+    DVec3::new(w.x, w.y, -w.z)
 }
 
 impl Material {
@@ -31,6 +47,7 @@ impl Material {
         Ok(Material {
             diffuse: Lambert::new(albedo)?,
             glossy: Glossy::None,
+            two_sided: false,
         })
     }
 
@@ -67,6 +84,47 @@ impl Material {
 
     pub(crate) fn has_diffuse(&self) -> bool {
         self.diffuse.albedo != Rgb::ZERO
+    }
+
+    /// Whether it transmits, has a delta part, chooses between parts: its
+    /// glossy lobe's ([`crate::models::Bxdf::reach`]).
+    #[inline]
+    #[must_use]
+    pub fn reach(&self) -> Reach {
+        self.glossy.reach()
+    }
+
+    /// This material seen from both sides (Mitsuba's `twosided`); an error
+    /// for one that transmits (it has two sides already).
+    pub fn two_sided(mut self) -> crate::error::Result<Self> {
+        if self.reach().transmits {
+            return Err(Error::param(
+                "bsdf",
+                format!(
+                    "twosided needs an opaque material; {} transmits and is seen from both sides already",
+                    self.model_name()
+                ),
+            ));
+        }
+        self.two_sided = true;
+        Ok(self)
+    }
+
+    /// `(wo, wi)` as the lobes see them, or `None` where the material does
+    /// not scatter: for an opaque material both above the surface (mirrored
+    /// first if it is two-sided and `wo` is below); for one that transmits,
+    /// `wo` off the horizon.
+    #[inline]
+    fn local(&self, wo: DVec3, wi: DVec3) -> Option<(DVec3, DVec3)> {
+        if self.reach().transmits {
+            return (wo.z != 0.0).then_some((wo, wi));
+        }
+        let (wo, wi) = if self.two_sided && wo.z < 0.0 {
+            (mirrored(wo), mirrored(wi))
+        } else {
+            (wo, wi)
+        };
+        (wo.z > 0.0 && wi.z > 0.0).then_some((wo, wi))
     }
 
     /// `Ok` when `strategy` applies to this material, otherwise an error
@@ -119,8 +177,9 @@ impl Material {
         if g + d > 0.0 { g / (g + d) } else { 0.5 }
     }
 
-    /// `f_r(wo, wi)` without the cosine; zero unless both directions are
-    /// above the horizon.
+    /// `f(wo, wi)` without the cosine (delta parts left out); zero where
+    /// the material does not scatter (an opaque one: unless both directions
+    /// are above the horizon, or both below for a two-sided one).
     #[inline]
     #[must_use]
     pub fn eval(&self, wo: DVec3, wi: DVec3) -> Rgb {
@@ -128,25 +187,68 @@ impl Material {
             crate::math::is_unit(wo) && crate::math::is_unit(wi),
             "wo {wo} or wi {wi} not unit"
         );
-        if wo.z <= 0.0 || wi.z <= 0.0 {
+        let Some((wo, wi)) = self.local(wo, wi) else {
             return Rgb::ZERO;
-        }
-        let g = self.glossy.eval(wo, wi);
-        g + self.diffuse.eval(wo, wi)
+        };
+        self.eval_local(wo, wi)
     }
 
-    /// What the material's samples do when a strategy ignores its lobes.
-    fn hemisphere_scattering(&self) -> Scattering {
-        self.glossy
+    /// The delta parts at `wo` (a mirror's, glass's reflection and
+    /// refraction, a coating's): each direction and `∫ f |cos θi| dωi` over
+    /// it, what [`Material::eval`] leaves out. None where the material does
+    /// not scatter.
+    #[must_use]
+    pub fn deltas(&self, wo: DVec3) -> Deltas {
+        let transmits = self.reach().transmits;
+        if wo.z == 0.0 || (wo.z < 0.0 && !transmits && !self.two_sided) {
+            return Deltas::NONE;
+        }
+        if wo.z < 0.0 && !transmits {
+            return self.glossy.deltas(mirrored(wo)).map_wi(mirrored);
+        }
+        self.glossy.deltas(wo)
+    }
+
+    /// [`Material::eval`] of directions already as the lobes see them.
+    #[inline]
+    fn eval_local(&self, wo: DVec3, wi: DVec3) -> Rgb {
+        let g = self.glossy.eval(wo, wi);
+        if wo.z > 0.0 && wi.z > 0.0 {
+            g + self.diffuse.eval(wo, wi)
+        } else {
+            g
+        }
+    }
+
+    /// What the material's samples do when a strategy ignores its lobes:
+    /// the glossy lobe's kind (diffuse for none), reflected or transmitted
+    /// as `wi` is on the side of `wo` or not.
+    fn hemisphere_scattering(&self, wo: DVec3, wi: DVec3) -> Scattering {
+        let kind = self
+            .glossy
             .scattering()
-            .unwrap_or(Scattering::DiffuseReflection)
+            .unwrap_or(Scattering::DiffuseReflection);
+        if wo.z * wi.z >= 0.0 {
+            return kind;
+        }
+        match kind {
+            Scattering::DiffuseReflection => Scattering::DiffuseTransmission,
+            Scattering::SpecularReflection => Scattering::SpecularTransmission,
+            Scattering::GlossyReflection => Scattering::GlossyTransmission,
+            other => other,
+        }
     }
 
     /// How `strategy` draws for this material: the one place a strategy is
     /// turned into samplers (`uniform` and `cosine` here, the others by the
     /// lobes' own tables, [`Bxdf::sampler`]).
     fn draw(&self, strategy: BsdfStrategy) -> Result<Draw<'_>, String> {
+        let reach = self.reach();
         match strategy {
+            BsdfStrategy::Uniform | BsdfStrategy::Cosine if reach.delta => Err(format!(
+                "{} has a delta part (a mirror or a smooth interface) that {strategy} sampling never hits: only the model's own sampler (brdf) reaches it",
+                self.model_name()
+            )),
             BsdfStrategy::Uniform => Ok(Draw::Uniform),
             BsdfStrategy::Cosine => Ok(Draw::Cosine),
             _ => match self.glossy {
@@ -190,6 +292,7 @@ impl From<Lobes> for Material {
         Material {
             diffuse: l.diffuse,
             glossy: l.glossy,
+            two_sided: l.two_sided,
         }
     }
 }
@@ -228,9 +331,11 @@ impl crate::desc::MaterialDesc {
 /// How a [`BsdfSampler`] draws: resolved once from its strategy.
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum Draw<'m> {
-    /// Uniform over the hemisphere, whatever the lobes.
+    /// Uniform over the hemisphere of `wo` (over the sphere for a material
+    /// that transmits), whatever the lobes.
     Uniform,
-    /// Cosine-weighted, whatever the lobes.
+    /// Cosine-weighted over the hemisphere of `wo` (`|cos θ|/(2π)` over the
+    /// sphere for a material that transmits), whatever the lobes.
     Cosine,
     /// The glossy lobe by its sampler, the diffuse term by cosine sampling,
     /// one of them chosen by `uc` with the lobes' albedo hints.
@@ -261,39 +366,41 @@ impl<'m> BsdfSampler<'m> {
         self.material
     }
 
-    /// Whether `sample` uses `uc` to choose between two lobes: the material
-    /// has a diffuse term and a glossy lobe, and the strategy samples them
-    /// (not `uniform` or `cosine`).
+    /// Whether `sample` uses `uc` to choose a lobe or a part of one: the
+    /// material has a diffuse term and a glossy lobe, or a lobe with parts
+    /// (glass: reflection or refraction; plastic: coating or base), and the
+    /// strategy samples them (not `uniform` or `cosine`).
     #[inline]
     #[must_use]
     pub fn chooses_lobe(&self) -> bool {
         let m = self.material;
-        matches!(self.draw, Draw::Lobes(..)) && !matches!(m.glossy, Glossy::None) && m.has_diffuse()
+        matches!(self.draw, Draw::Lobes(..))
+            && !matches!(m.glossy, Glossy::None)
+            && (m.has_diffuse() || m.reach().chooses)
     }
 
-    /// Density in solid angle with which `sample(wo, ..)` returns `wi`;
-    /// zero below the horizon.
+    /// Density of `uniform` or `cosine` at `wi` (directions as the lobes
+    /// see them, where the material scatters).
+    #[inline]
+    fn hemisphere_pdf(&self, wi: DVec3) -> f64 {
+        let sphere = self.material.reach().transmits;
+        match (self.draw, sphere) {
+            (Draw::Cosine, false) => warp::square_to_cosine_hemisphere_pdf(wi),
+            (Draw::Cosine, true) => 0.5 * warp::square_to_cosine_hemisphere_pdf(abs_z(wi)),
+            (_, false) => warp::square_to_uniform_hemisphere_pdf(wi),
+            (_, true) => warp::square_to_uniform_sphere_pdf(wi),
+        }
+    }
+
+    /// Density in solid angle with which `sample(wo, ..)` returns `wi`
+    /// (delta parts left out); zero where the material does not scatter.
     #[inline]
     #[must_use]
     pub fn pdf(&self, wo: DVec3, wi: DVec3) -> f64 {
-        if wo.z <= 0.0 || wi.z <= 0.0 {
+        let Some((wo, wi)) = self.material.local(wo, wi) else {
             return 0.0;
-        }
-        match self.draw {
-            Draw::Uniform => warp::square_to_uniform_hemisphere_pdf(wi),
-            Draw::Cosine => warp::square_to_cosine_hemisphere_pdf(wi),
-            Draw::Lobes(glossy, diffuse) => {
-                let m = self.material;
-                let p = m.glossy_probability(wo);
-                let pg = if p > 0.0 { glossy.pdf(wo, wi) } else { 0.0 };
-                let pd = if p < 1.0 {
-                    m.diffuse.pdf(diffuse, wo, wi)
-                } else {
-                    0.0
-                };
-                p * pg + (1.0 - p) * pd
-            }
-        }
+        };
+        self.pdf_local(wo, wi)
     }
 
     /// `(f, pdf)` at `wi` in one call: the lobe-choice probability (which
@@ -303,20 +410,12 @@ impl<'m> BsdfSampler<'m> {
     #[inline]
     #[must_use]
     pub fn eval_pdf(&self, wo: DVec3, wi: DVec3) -> (Rgb, f64) {
-        if wo.z <= 0.0 || wi.z <= 0.0 {
-            return (Rgb::ZERO, 0.0);
-        }
         let m = self.material;
-        let fd = m.diffuse.eval(wo, wi);
+        let Some((wo, wi)) = m.local(wo, wi) else {
+            return (Rgb::ZERO, 0.0);
+        };
         match self.draw {
-            Draw::Uniform => (
-                m.glossy.eval(wo, wi) + fd,
-                warp::square_to_uniform_hemisphere_pdf(wi),
-            ),
-            Draw::Cosine => (
-                m.glossy.eval(wo, wi) + fd,
-                warp::square_to_cosine_hemisphere_pdf(wi),
-            ),
+            Draw::Uniform | Draw::Cosine => (m.eval_local(wo, wi), self.hemisphere_pdf(wi)),
             Draw::Lobes(glossy, diffuse) => {
                 let p = m.glossy_probability(wo);
                 let (fg, pg) = if p > 0.0 {
@@ -324,6 +423,10 @@ impl<'m> BsdfSampler<'m> {
                 } else {
                     (m.glossy.eval(wo, wi), 0.0)
                 };
+                if !(wo.z > 0.0 && wi.z > 0.0) {
+                    return (fg, p * pg);
+                }
+                let fd = m.diffuse.eval(wo, wi);
                 let pd = if p < 1.0 {
                     m.diffuse.pdf(diffuse, wo, wi)
                 } else {
@@ -334,69 +437,135 @@ impl<'m> BsdfSampler<'m> {
         }
     }
 
-    /// Draw `wi` for `wo`: `uc` chooses the lobe, `u` the direction. `None`
-    /// is a failed sample (below the horizon, or `wo` below it), which an
-    /// estimator counts with weight zero. The weight includes the cosine.
+    /// Draw `wi` for `wo`: `uc` chooses the lobe (or a part of it), `u` the
+    /// direction. `None` is a failed sample (below the horizon, or `wo`
+    /// where the material does not scatter), which an estimator counts with
+    /// weight zero. The weight includes the cosine.
     #[inline]
     #[must_use]
     pub fn sample(&self, wo: DVec3, uc: f64, u: DVec2) -> Option<BsdfSample> {
-        if wo.z <= 0.0 {
+        let m = self.material;
+        let reach = m.reach();
+        let flip = m.two_sided && wo.z < 0.0 && !reach.transmits;
+        let wo = if flip { mirrored(wo) } else { wo };
+        if wo.z == 0.0 || (wo.z < 0.0 && !reach.transmits) {
             return None;
         }
+        let s = self.sample_local(wo, uc, u)?;
+        Some(if flip {
+            BsdfSample {
+                wi: mirrored(s.wi),
+                ..s
+            }
+        } else {
+            s
+        })
+    }
+
+    /// [`BsdfSampler::sample`] for `wo` as the lobes see it.
+    #[inline]
+    fn sample_local(&self, wo: DVec3, uc: f64, u: DVec2) -> Option<BsdfSample> {
         let m = self.material;
-        let (wi, component, scattering) = match self.draw {
-            Draw::Uniform => (
-                warp::square_to_uniform_hemisphere(u),
-                Component::Hemisphere,
-                m.hemisphere_scattering(),
-            ),
-            Draw::Cosine => (
-                warp::square_to_cosine_hemisphere(u),
-                Component::Hemisphere,
-                m.hemisphere_scattering(),
-            ),
+        let (wi, component) = match self.draw {
+            Draw::Uniform | Draw::Cosine => {
+                let sphere = m.reach().transmits;
+                // Over the sphere, `u.x` chooses the side first (half each).
+                let (u, below) = if sphere && u.x >= 0.5 {
+                    (DVec2::new(2.0 * u.x - 1.0, u.y), true)
+                } else if sphere {
+                    (DVec2::new(2.0 * u.x, u.y), false)
+                } else {
+                    (u, false)
+                };
+                let w = if matches!(self.draw, Draw::Cosine) {
+                    warp::square_to_cosine_hemisphere(u)
+                } else {
+                    warp::square_to_uniform_hemisphere(u)
+                };
+                (if below { mirrored(w) } else { w }, Component::Hemisphere)
+            }
             Draw::Lobes(glossy, diffuse) => {
                 let p = m.glossy_probability(wo);
-                let glossy_scattering = m.glossy.scattering();
                 if p >= 1.0 {
-                    // One lobe: its own f and pdf, computed with the sample.
-                    let s = glossy.sample_eval(wo, u)?;
-                    return finish(s.wi, s.f, s.pdf, Component::Glossy, glossy_scattering?);
+                    // One lobe: its own f and pdf (and its delta parts),
+                    // computed with the sample.
+                    let s = glossy.sample_eval(wo, uc, u)?;
+                    return finish(wo, s.wi, s.f, s.pdf, Component::Glossy, s.scattering);
                 }
+                // Two lobes (a diffuse term beside an opaque lobe with a
+                // density: `Lobes::with_diffuse`); `uc` rescaled so that the
+                // lobe sees a uniform number of its own.
                 if uc < p {
-                    (glossy.sample(wo, u)?, Component::Glossy, glossy_scattering?)
+                    (glossy.sample(wo, uc / p, u)?, Component::Glossy)
                 } else {
-                    (
-                        m.diffuse.sample(diffuse, wo, u)?,
-                        Component::Diffuse,
-                        m.diffuse.scattering(),
-                    )
+                    (m.diffuse.sample(diffuse, wo, 0.0, u)?, Component::Diffuse)
                 }
             }
         };
-        if wi.z <= 0.0 {
+        if wi.z == 0.0 || (wi.z < 0.0 && !m.reach().transmits) {
             return None;
         }
-        finish(wi, m.eval(wo, wi), self.pdf(wo, wi), component, scattering)
+        let scattering = match component {
+            Component::Diffuse => m.diffuse.scattering(),
+            _ => m.hemisphere_scattering(wo, wi),
+        };
+        finish(
+            wo,
+            wi,
+            m.eval_local(wo, wi),
+            self.pdf_local(wo, wi),
+            component,
+            scattering,
+        )
+    }
+
+    /// [`BsdfSampler::pdf`] for directions as the lobes see them.
+    #[inline]
+    fn pdf_local(&self, wo: DVec3, wi: DVec3) -> f64 {
+        let m = self.material;
+        match self.draw {
+            Draw::Uniform | Draw::Cosine => self.hemisphere_pdf(wi),
+            Draw::Lobes(glossy, diffuse) => {
+                let p = m.glossy_probability(wo);
+                let pg = if p > 0.0 { glossy.pdf(wo, wi) } else { 0.0 };
+                let pd = if p < 1.0 && wo.z > 0.0 && wi.z > 0.0 {
+                    m.diffuse.pdf(diffuse, wo, wi)
+                } else {
+                    0.0
+                };
+                p * pg + (1.0 - p) * pd
+            }
+        }
     }
 }
 
+/// `w` with `|z|`.
+#[inline]
+fn abs_z(w: DVec3) -> DVec3 {
+    DVec3::new(w.x, w.y, w.z.abs())
+}
+
+/// The sample record, or `None` for a sample with no weight to give (a
+/// zero or non-finite pdf, `wi` on the horizon or on the side its
+/// scattering does not go to).
 #[inline]
 fn finish(
+    wo: DVec3,
     wi: DVec3,
     f: Rgb,
     pdf: f64,
     component: Component,
     scattering: Scattering,
 ) -> Option<BsdfSample> {
-    if !(pdf > 0.0 && pdf.is_finite() && wi.z > 0.0) {
+    let same_side = wo.z * wi.z > 0.0;
+    if !(pdf > 0.0 && pdf.is_finite() && wi.z != 0.0 && same_side == scattering.is_reflection()) {
         return None;
     }
     Some(BsdfSample {
         wi,
         f,
         pdf,
-        weight: f * (wi.z / pdf),
+        weight: f * (wi.z.abs() / pdf),
         component,
         scattering,
     })

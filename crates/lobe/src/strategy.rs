@@ -249,8 +249,11 @@ impl Strategy {
                     for s in m.strategies() {
                         push(Strategy::Bsdf(s), &mut v);
                     }
+                    // Light sampling alone never reaches a delta part.
+                    if !m.reach().delta {
+                        push(Strategy::Light, &mut v);
+                    }
                     for t in [
-                        Strategy::Light,
                         mis(Heuristic::Balance, MisForm::Adaptive),
                         mis(Heuristic::Balance, MisForm::MultiSample),
                         mis(Heuristic::Power, MisForm::MultiSample),
@@ -258,6 +261,16 @@ impl Strategy {
                         push(t, &mut v);
                     }
                     continue;
+                }
+                "light" if m.reach().delta => {
+                    return Err(Error::Unsupported {
+                        strategy: "light".into(),
+                        reason: format!(
+                            "{} has a delta part (a mirror or a smooth interface) that light sampling never hits",
+                            m.model_name()
+                        ),
+                        available: m.strategies().into_iter().map(BsdfStrategy::name).collect(),
+                    });
                 }
                 "light" => Strategy::Light,
                 "mis" => mis(Heuristic::Balance, MisForm::Adaptive),

@@ -47,7 +47,7 @@ pub(super) enum Source {
     /// The material description for a parameter value.
     Lecture(fn(f64) -> String),
     /// A material of `--material` (loaded once).
-    Given(Material),
+    Given(Box<Material>),
 }
 
 pub(super) fn models() -> Vec<Model> {
@@ -184,7 +184,7 @@ pub(super) fn given_models(specs: &[String]) -> Result<Vec<Model>> {
                 warp_theta: 45.0,
                 warp_extra: vndf.clone(),
                 heat_extra: vndf,
-                source: Source::Given(m),
+                source: Source::Given(Box::new(m)),
                 intro,
                 family,
             })
@@ -200,7 +200,7 @@ pub(super) fn build(model: &Model, value: f64) -> Result<Material> {
                 .and_then(|d| d.build())
                 .map_err(|e| anyhow!("report material {json}: {e}"))
         }
-        Source::Given(m) => Ok(m.clone()),
+        Source::Given(m) => Ok(m.as_ref().clone()),
     }
 }
 

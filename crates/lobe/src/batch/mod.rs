@@ -52,11 +52,15 @@
 //!   once, the same at every level; with a diffuse term `uc` chooses the
 //!   lobe as in the scalar mixture.
 //!
-//! Every model and strategy the scalar path has is batched. The test
-//! `grid_every_supported_combination_builds` walks every combination of the
-//! analytic models the scalar path has and checks that none is refused. (A
-//! lecture-form `ks` whose `ks · K` is beyond f32's range is refused with
-//! that reason.)
+//! Every model and strategy of the lecture, Cook-Torrance and the measured
+//! tables is batched. The test `grid_every_supported_combination_builds`
+//! walks every combination of those analytic models and checks that none
+//! is refused. (A lecture-form `ks` whose `ks · K` is beyond f32's range is
+//! refused with that reason.)
+//!
+//! Refused with [`BatchError::Unsupported`], the scalar path serving them:
+//! not yet batched: glass, mirrors, plastic and two-sided materials (issue
+//! 42's models; their kernels are issues 42 and 44's work).
 //!
 //! Beckmann's visible slopes are drawn as the scalar path draws them (Heitz
 //! and d'Eon 2014: the slope CDF inverted by Newton's method inside a
@@ -795,6 +799,12 @@ fn kernel_for(m: &Material, strategy: BsdfStrategy) -> Result<Kernel, BatchError
             reason: e.to_string(),
         });
     }
+    if m.two_sided {
+        return unsupported(
+            "not yet batched: glass, mirrors, plastic and two-sided materials (this one is two-sided)"
+                .into(),
+        );
+    }
     let c3 = |c: Rgb| [c.x as f32, c.y as f32, c.z as f32];
     let kd = m.diffuse.albedo;
     let kd_pi = c3(kd * crate::math::INV_PI);
@@ -857,7 +867,7 @@ fn kernel_for(m: &Material, strategy: BsdfStrategy) -> Result<Kernel, BatchError
         #[allow(unreachable_patterns)]
         _ => {
             return unsupported(format!(
-                "model `{}` (batched so far: cook-torrance, lambert, measured)",
+                "model `{}`: not yet batched: glass, mirrors, plastic and two-sided materials",
                 m.model_name()
             ));
         }

@@ -900,6 +900,7 @@ fn batch_errors_name_the_slice_and_the_unsupported() {
     let phong = Material {
         diffuse: crate::models::Lambert::new(Rgb::ZERO).unwrap(),
         glossy: Glossy::Phong(crate::models::Phong::new(Rgb::splat(0.5), 10.0, true).unwrap()),
+        two_sided: false,
     };
     assert!(unsupported(&phong, BsdfStrategy::Vndf).contains("Phong"));
 

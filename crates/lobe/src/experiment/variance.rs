@@ -12,7 +12,9 @@ use super::map_indices;
 use crate::envmap::EnvMap;
 use crate::estimator::ShadingPoint;
 use crate::math::{Rgb, luminance, safe_acos};
-use crate::stats::quadrature::{Tolerance, gauss_legendre_4x4, integrate_hemisphere};
+use crate::stats::quadrature::{
+    Tolerance, gauss_legendre_4x4, integrate_hemisphere, integrate_sphere,
+};
 use crate::{Light, Material};
 use glam::DVec3;
 use std::f64::consts::TAU;
@@ -36,8 +38,10 @@ pub const TABLE_SECOND_MOMENT_MAX_EVALS: usize = 4_000_000;
 /// See [`TABLE_SECOND_MOMENT_TOLERANCE`].
 pub const TABLE_SECOND_MOMENT_ACCEPT: f64 = 1e-3;
 
-/// The exact per-sample variance of uniform hemisphere sampling of the
-/// luminance of `f L cos / p` at one shading point.
+/// The exact per-sample variance of uniform sampling (over the hemisphere
+/// of `wo`, or the sphere for a material that transmits) of the luminance
+/// of `f L |cos| / p` at one shading point; none (unreliable, infinite) for
+/// a material with a delta part, which uniform sampling never draws.
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "desc", derive(serde::Serialize))]
 pub struct UniformVariance {
@@ -68,6 +72,14 @@ pub fn uniform_variance(
     light: &Light,
     mean: f64,
 ) -> UniformVariance {
+    if m.reach().delta {
+        return UniformVariance {
+            variance: f64::INFINITY,
+            second_moment: f64::INFINITY,
+            reliable: false,
+            method: "none: uniform sampling never draws a delta part (a mirror or a smooth interface)",
+        };
+    }
     let (integral, reliable, method) = match light {
         Light::Env(map) => {
             let rows = map_indices(map.size().1, |j| env_row_second_moment(m, sp, map, j));
@@ -75,7 +87,9 @@ pub fn uniform_variance(
             (
                 sum,
                 sum.is_finite(),
-                if map.is_smooth() {
+                if m.reach().transmits {
+                    "exact, by quadrature: 4π Σ ∫ lum(f L |cos|)² dω − μ² over the sphere (refined 4×4 Gauss-Legendre per texel or cell)"
+                } else if map.is_smooth() {
                     "exact, by quadrature: 2π Σ_cells ∫ lum(f L cos)² dω − μ² (its radiance interpolated; refined 4×4 Gauss-Legendre per cell between texel centres)"
                 } else {
                     "exact, by quadrature: 2π Σ_texels ∫ lum(f L cos)² dω − μ² (refined 4×4 Gauss-Legendre per texel)"
@@ -91,23 +105,32 @@ pub fn uniform_variance(
             } else {
                 Tolerance::relative(SECOND_MOMENT_TOLERANCE).with_max_evals(SECOND_MOMENT_MAX_EVALS)
             };
-            let e = integrate_hemisphere(
-                |wi| {
-                    let y =
-                        luminance(m.eval(wo, wi) * light.radiance(sp.frame.to_world(wi))) * wi.z;
-                    y * y
-                },
-                tol,
-            );
+            let g = |wi: DVec3| {
+                let y =
+                    luminance(m.eval(wo, wi) * light.radiance(sp.frame.to_world(wi))) * wi.z.abs();
+                y * y
+            };
+            let e = if m.reach().transmits || (m.two_sided && wo.z < 0.0) {
+                integrate_sphere(g, tol)
+            } else {
+                integrate_hemisphere(g, tol)
+            };
             let close_enough = table && e.error <= TABLE_SECOND_MOMENT_ACCEPT * e.value.abs();
             (
                 e.value,
                 (e.converged || close_enough) && e.value.is_finite(),
-                "exact, by quadrature: 2π ∫ lum(f L cos)² dω − μ² (adaptive Gauss-Kronrod)",
+                if m.reach().transmits {
+                    "exact, by quadrature: 4π ∫ lum(f L |cos|)² dω − μ² over the sphere (adaptive Gauss-Kronrod)"
+                } else {
+                    "exact, by quadrature: 2π ∫ lum(f L cos)² dω − μ² (adaptive Gauss-Kronrod)"
+                },
             )
         }
     };
-    let second_moment = TAU * integral;
+    // Uniform sampling's density: over the hemisphere of `wo`, or over the
+    // sphere for a material that transmits.
+    let area = if m.reach().transmits { 2.0 * TAU } else { TAU };
+    let second_moment = area * integral;
     UniformVariance {
         variance: (second_moment - mean * mean).max(0.0),
         second_moment,
@@ -131,12 +154,9 @@ fn env_row_second_moment(m: &Material, sp: &ShadingPoint, map: &EnvMap, j: usize
             let g = |c: f64, phi: f64| {
                 let theta = safe_acos(c);
                 let wi: DVec3 = frame.to_local(map.spherical_to_direction(theta, phi));
-                if wi.z <= 0.0 {
-                    0.0
-                } else {
-                    let y = luminance(m.eval(wo, wi) * cell.radiance(theta, phi)) * wi.z;
-                    y * y
-                }
+                // `f` is zero where the material does not scatter.
+                let y = luminance(m.eval(wo, wi) * cell.radiance(theta, phi)) * wi.z.abs();
+                y * y
             };
             let ((t0, t1), (p0, p1)) = (cell.theta, cell.phi);
             let mut cell_sum = 0.0;
@@ -156,12 +176,8 @@ fn env_row_second_moment(m: &Material, sp: &ShadingPoint, map: &EnvMap, j: usize
         let g = |c: f64, phi: f64| {
             let d = map.spherical_to_direction(safe_acos(c), phi);
             let wi: DVec3 = frame.to_local(d);
-            if wi.z <= 0.0 {
-                0.0
-            } else {
-                let y = luminance(m.eval(wo, wi) * l) * wi.z;
-                y * y
-            }
+            let y = luminance(m.eval(wo, wi) * l) * wi.z.abs();
+            y * y
         };
         add_refined_second_moment(g, (t0.cos(), t1.cos(), p0, p1), &mut sum);
     }
@@ -239,11 +255,14 @@ pub fn max_albedo(m: &Material) -> MaxAlbedo {
     for theta in ALBEDO_THETAS {
         let t = theta.to_radians();
         let wo = DVec3::new(t.sin(), 0.0, t.cos());
-        let a = integrate_hemisphere(
-            |wi| luminance(m.eval(wo, wi)) * wi.z,
-            Tolerance::relative(1e-5).with_max_evals(2_000_000),
-        )
-        .value;
+        let tol = Tolerance::relative(1e-5).with_max_evals(2_000_000);
+        let g = |wi: DVec3| luminance(m.eval(wo, wi)) * wi.z.abs();
+        let density = if m.reach().transmits {
+            integrate_sphere(g, tol).value
+        } else {
+            integrate_hemisphere(g, tol).value
+        };
+        let a = density + m.deltas(wo).iter().map(|d| luminance(d.value)).sum::<f64>();
         if a > best.albedo {
             best = MaxAlbedo {
                 albedo: a,

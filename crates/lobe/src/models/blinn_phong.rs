@@ -124,7 +124,7 @@ impl Bxdf for BlinnPhong {
     }
 
     #[inline]
-    fn sample(&self, _: HalfVectorSampler, wo: DVec3, u: DVec2) -> Option<DVec3> {
+    fn sample(&self, _: HalfVectorSampler, wo: DVec3, _uc: f64, u: DVec2) -> Option<DVec3> {
         let h = warp::square_to_cos_power(u, self.exponent);
         let wi = reflect(wo, h);
         (wi.z > 0.0 && wo.dot(h) > 0.0).then(|| wi.normalize())

@@ -320,14 +320,20 @@ impl Bxdf for CookTorrance {
     }
 
     #[inline]
-    fn sample(&self, sampler: MicrofacetSampler, wo: DVec3, u: DVec2) -> Option<DVec3> {
+    fn sample(&self, sampler: MicrofacetSampler, wo: DVec3, _uc: f64, u: DVec2) -> Option<DVec3> {
         self.sample_wm(sampler, wo, u).map(|(wi, _)| wi)
     }
 
     /// The sampled `wm` is the half vector of `wo` and the reflected `wi`,
     /// so `D(wm)` and `Λ(wo)` serve `f` and the pdf at once.
     #[inline]
-    fn sample_eval(&self, sampler: MicrofacetSampler, wo: DVec3, u: DVec2) -> Option<LobeSample> {
+    fn sample_eval(
+        &self,
+        sampler: MicrofacetSampler,
+        wo: DVec3,
+        _uc: f64,
+        u: DVec2,
+    ) -> Option<LobeSample> {
         let (wi, wm) = self.sample_wm(sampler, wo, u)?;
         let mf = &self.microfacet;
         let cos_oh = wo.dot(wm);
@@ -350,6 +356,7 @@ impl Bxdf for CookTorrance {
             wi,
             f: self.ks * self.fresnel.eval(cos_oh) * dg,
             pdf,
+            scattering: Scattering::GlossyReflection,
         })
     }
 

@@ -44,6 +44,7 @@ fn from_desc(d: &crate::desc::MaterialDesc) -> crate::error::Result<super::Lobes
                 .map_or(Rgb::splat(DEFAULT_ALBEDO), crate::desc::Color::rgb),
         )?,
         glossy: super::Glossy::None,
+        two_sided: false,
     })
 }
 
@@ -87,7 +88,7 @@ impl Bxdf for Lambert {
     }
 
     #[inline]
-    fn sample(&self, _: CosineSampler, _wo: DVec3, u: DVec2) -> Option<DVec3> {
+    fn sample(&self, _: CosineSampler, _wo: DVec3, _uc: f64, u: DVec2) -> Option<DVec3> {
         let wi = warp::square_to_cosine_hemisphere(u);
         (wi.z > 0.0).then_some(wi)
     }

@@ -345,7 +345,7 @@ impl Bxdf for Measured {
     }
 
     #[inline]
-    fn sample(&self, sampler: MeasuredSampler, wo: DVec3, u: DVec2) -> Option<DVec3> {
+    fn sample(&self, sampler: MeasuredSampler, wo: DVec3, _uc: f64, u: DVec2) -> Option<DVec3> {
         match (sampler, &self.data.table) {
             (MeasuredSampler::Warps, Table::Rgl(r)) => r.sample_warps(wo, u),
             // `Warps` is given for RGL files only (`sampler`).

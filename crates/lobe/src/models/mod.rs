@@ -16,7 +16,7 @@
 
 use crate::BsdfStrategy;
 use crate::math::Rgb;
-use crate::sample::{LobeSample, Scattering};
+use crate::sample::{Deltas, LobeSample, Reach, Scattering};
 use glam::{DVec2, DVec3};
 use std::fmt::{self, Write as _};
 
@@ -30,8 +30,14 @@ pub use lambert::Lambert;
 ///
 /// A strategy is resolved once, by [`Bxdf::sampler`], into a small `Copy`
 /// value of the model's own type; `sample` and `pdf` take that value and
-/// never see a strategy it does not have. The caller guarantees `wo.z > 0`
-/// (and `wi.z > 0` for `eval` and `pdf`).
+/// never see a strategy it does not have.
+///
+/// Directions: a lobe that does not transmit ([`Reach::transmits`] false)
+/// is called with `wo.z > 0` (and `wi.z > 0` for `eval` and `pdf`); one that
+/// transmits is called with any `wo` off the horizon and any `wi`, and
+/// `wo.z < 0` means seen from inside. A delta part ([`Reach::delta`]) is in
+/// neither `eval` nor `pdf`: only `sample` reaches it ([`LobeSample`] says
+/// how its `f` and `pdf` are given).
 pub trait Bxdf {
     /// The model's samplers: one value per strategy it has (an enum, or a
     /// unit struct where it has one).
@@ -39,24 +45,39 @@ pub trait Bxdf {
     /// The model's table of strategies: the sampler for `strategy`, or why
     /// the model has none (the caller lists the strategies it has).
     fn sampler(&self, strategy: BsdfStrategy) -> Result<Self::Sampler, String>;
-    /// What its samples are: reflection or transmission; diffuse, glossy or
-    /// specular.
+    /// What its samples are when it reflects with a density: diffuse or
+    /// glossy reflection (a lobe with several parts says in each
+    /// [`LobeSample`] which it drew).
     fn scattering(&self) -> Scattering;
-    /// `f_r(wo, wi)` of this lobe, without the cosine.
+    /// Whether it transmits, has a delta part, chooses between parts with
+    /// `uc`; the lecture's models reflect only, with a density.
+    fn reach(&self) -> Reach {
+        Reach::REFLECTION
+    }
+    /// `f(wo, wi)` of this lobe, without the cosine (delta parts left out).
     fn eval(&self, wo: DVec3, wi: DVec3) -> Rgb;
-    /// Draw `wi` by `sampler`; `None` for a failed sample (below the horizon).
-    fn sample(&self, sampler: Self::Sampler, wo: DVec3, u: DVec2) -> Option<DVec3>;
-    /// Density in solid angle of what `sample` returns.
+    /// Draw `wi` by `sampler` (`uc` chooses a part where the lobe has
+    /// several); `None` for a failed sample (below the horizon).
+    fn sample(&self, sampler: Self::Sampler, wo: DVec3, uc: f64, u: DVec2) -> Option<DVec3>;
+    /// Density in solid angle of what `sample` returns (delta parts left out).
     fn pdf(&self, sampler: Self::Sampler, wo: DVec3, wi: DVec3) -> f64;
     /// `sample`, and `eval` and `pdf` at the sampled direction, sharing what
-    /// they have in common (a model may override it for speed).
+    /// they have in common (a model may override it for speed; a model with
+    /// a delta part must, to return it).
     #[inline]
-    fn sample_eval(&self, sampler: Self::Sampler, wo: DVec3, u: DVec2) -> Option<LobeSample> {
-        let wi = self.sample(sampler, wo, u)?;
+    fn sample_eval(
+        &self,
+        sampler: Self::Sampler,
+        wo: DVec3,
+        uc: f64,
+        u: DVec2,
+    ) -> Option<LobeSample> {
+        let wi = self.sample(sampler, wo, uc, u)?;
         Some(LobeSample {
             wi,
             f: self.eval(wo, wi),
             pdf: self.pdf(sampler, wo, wi),
+            scattering: self.scattering(),
         })
     }
     /// `(eval, pdf)` at one `wi`, sharing what they have in common (a model
@@ -65,6 +86,11 @@ pub trait Bxdf {
     #[inline]
     fn eval_pdf(&self, sampler: Self::Sampler, wo: DVec3, wi: DVec3) -> (Rgb, f64) {
         (self.eval(wo, wi), self.pdf(sampler, wo, wi))
+    }
+    /// The delta parts at `wo` ([`Reach::delta`]): what a quadrature of
+    /// `eval` leaves out. None for a lobe with a density only.
+    fn deltas(&self, _wo: DVec3) -> Deltas {
+        Deltas::NONE
     }
     /// An estimate of the lobe's directional albedo (luminance), used to
     /// choose between lobes.
@@ -85,6 +111,13 @@ pub enum Range {
     Names(&'static str),
     /// The path of a data file (a measured table).
     File,
+    /// An index of refraction: a number `> 0` or a name of
+    /// [`crate::ior::IORS`].
+    Ior,
+    /// `none` or the name of a conductor of [`crate::ior::CONDUCTORS`].
+    Conductor,
+    /// A nested material description.
+    Material,
 }
 
 /// The default of a key of a material description.
@@ -163,6 +196,13 @@ impl fmt::Display for Range {
             Range::Number { min, max } => write!(f, "[{}, {}]", Num(min), Num(max)),
             Range::Bool => f.write_str("bool"),
             Range::File => f.write_str("a file (MERL .binary or RGL .bsdf, by content)"),
+            Range::Ior => {
+                f.write_str("> 0, or a name (`bk7`, `water`, `air`, ...: `lobe eval --help`)")
+            }
+            Range::Conductor => {
+                f.write_str("`none` or a conductor's name (`Au`, `Ag`, `Cu`, `Al`, `Cr`, ...)")
+            }
+            Range::Material => f.write_str("a material description"),
             Range::Names(names) => {
                 let mut first = true;
                 for n in names.split(',') {
@@ -278,15 +318,19 @@ pub fn names(sep: &str) -> String {
 }
 
 /// A material's lobes, as a model builds them from a description: a
-/// Lambertian term and at most one glossy lobe. `Material` is made of them.
+/// Lambertian term and at most one glossy lobe, and whether it is seen from
+/// both sides. `Material` is made of them.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Lobes {
     pub diffuse: Lambert,
     pub glossy: Glossy,
+    pub two_sided: bool,
 }
 
 impl Lobes {
-    /// A glossy lobe plus a diffuse term `kd/π`; the error names `kd`.
+    /// A glossy lobe plus a diffuse term `kd/π`; the error names `kd`. A
+    /// diffuse term goes only beside an opaque lobe with a density and one
+    /// part (not glass, a mirror or plastic, which has a base of its own).
     pub fn with_diffuse(kd: Rgb, glossy: Glossy) -> crate::error::Result<Self> {
         let diffuse = Lambert::new(kd).map_err(|_| {
             crate::Error::param(
@@ -294,7 +338,38 @@ impl Lobes {
                 format!("{kd} is out of range: each channel must be in [0, 1]"),
             )
         })?;
-        Ok(Lobes { diffuse, glossy })
+        let reach = glossy.reach();
+        if kd != Rgb::ZERO && (reach.transmits || reach.delta || reach.chooses) {
+            return Err(crate::Error::param(
+                "kd",
+                format!(
+                    "a diffuse term goes only beside an opaque lobe with a density; {} {}",
+                    glossy.model_name(),
+                    if reach.transmits {
+                        "transmits"
+                    } else if reach.delta {
+                        "has a delta part"
+                    } else {
+                        "has parts of its own"
+                    }
+                ),
+            ));
+        }
+        Ok(Lobes {
+            diffuse,
+            glossy,
+            two_sided: false,
+        })
+    }
+
+    /// One lobe and no diffuse term.
+    #[must_use]
+    pub fn only(glossy: Glossy) -> Self {
+        Lobes {
+            diffuse: Lambert { albedo: Rgb::ZERO },
+            glossy,
+            two_sided: false,
+        }
     }
 }
 
@@ -340,11 +415,17 @@ pub const MAX_EXPONENT: f64 = 1e7;
 /// module's `INFO` in [`MODELS`]. Both enums dispatch statically over the
 /// variants.
 macro_rules! glossy_models {
-    ($($module:ident :: $ty:ident),* $(,)?) => {
+    (
+        lobes: $($module:ident :: $ty:ident),* $(,)?;
+        names: $($alias:ident),* $(,)?
+    ) => {
         $(pub mod $module; pub use $module::$ty;)*
+        $(pub mod $alias;)*
 
-        /// Every model, Lambert first.
-        pub const MODELS: &[&ModelInfo] = &[&lambert::INFO, $(&$module::INFO),*];
+        /// Every model, Lambert first, then the lobes, then the models
+        /// whose lobe is another's (Mitsuba's names for lobe's models, and
+        /// `twosided`).
+        pub const MODELS: &[&ModelInfo] = &[&lambert::INFO, $(&$module::INFO,)* $(&$alias::INFO),*];
 
         /// The glossy lobe of a material (static dispatch). `None` reflects
         /// nothing.
@@ -401,6 +482,26 @@ macro_rules! glossy_models {
                 }
             }
 
+            /// [`Bxdf::reach`]; for no lobe, an opaque one's.
+            #[inline]
+            #[must_use]
+            pub fn reach(&self) -> Reach {
+                match self {
+                    Glossy::None => Reach::REFLECTION,
+                    $(Glossy::$ty(l) => l.reach()),*
+                }
+            }
+
+            /// [`Bxdf::deltas`]; none for no lobe.
+            #[inline]
+            #[must_use]
+            pub fn deltas(&self, wo: DVec3) -> Deltas {
+                match self {
+                    Glossy::None => Deltas::NONE,
+                    $(Glossy::$ty(l) => l.deltas(wo)),*
+                }
+            }
+
             /// [`Bxdf::albedo_hint`]; zero for no lobe.
             #[inline]
             #[must_use]
@@ -416,10 +517,10 @@ macro_rules! glossy_models {
             /// [`Bxdf::sample`].
             #[inline]
             #[must_use]
-            pub fn sample(&self, wo: DVec3, u: DVec2) -> Option<DVec3> {
+            pub fn sample(&self, wo: DVec3, uc: f64, u: DVec2) -> Option<DVec3> {
                 match self {
                     GlossySampler::None => None,
-                    $(GlossySampler::$ty(l, s) => l.sample(*s, wo, u)),*
+                    $(GlossySampler::$ty(l, s) => l.sample(*s, wo, uc, u)),*
                 }
             }
             /// [`Bxdf::pdf`].
@@ -434,10 +535,10 @@ macro_rules! glossy_models {
             /// [`Bxdf::sample_eval`].
             #[inline]
             #[must_use]
-            pub fn sample_eval(&self, wo: DVec3, u: DVec2) -> Option<LobeSample> {
+            pub fn sample_eval(&self, wo: DVec3, uc: f64, u: DVec2) -> Option<LobeSample> {
                 match self {
                     GlossySampler::None => None,
-                    $(GlossySampler::$ty(l, s) => l.sample_eval(*s, wo, u)),*
+                    $(GlossySampler::$ty(l, s) => l.sample_eval(*s, wo, uc, u)),*
                 }
             }
             /// [`Bxdf::eval_pdf`].
@@ -454,11 +555,24 @@ macro_rules! glossy_models {
 }
 
 glossy_models! {
-    phong::Phong,
-    blinn_phong::BlinnPhong,
-    cook_torrance::CookTorrance,
-    measured::Measured,
+    lobes:
+        phong::Phong,
+        blinn_phong::BlinnPhong,
+        cook_torrance::CookTorrance,
+        measured::Measured,
+        conductor::Conductor,
+        dielectric::Dielectric,
+        thindielectric::ThinDielectric,
+        roughdielectric::RoughDielectric,
+        plastic::Plastic,
+        roughplastic::RoughPlastic;
+    names:
+        diffuse,
+        roughconductor,
+        twosided,
 }
+
+pub mod keys;
 
 #[cfg(feature = "desc")]
 /// The material keys, their values and defaults, printed by `lobe eval --help`:

@@ -136,7 +136,7 @@ impl Bxdf for Phong {
     }
 
     #[inline]
-    fn sample(&self, _: MirrorLobeSampler, wo: DVec3, u: DVec2) -> Option<DVec3> {
+    fn sample(&self, _: MirrorLobeSampler, wo: DVec3, _uc: f64, u: DVec2) -> Option<DVec3> {
         let local = warp::square_to_cos_power(u, self.exponent);
         let wi = Frame::from_normal(mirror_z(wo)).to_world(local);
         (wi.z > 0.0).then_some(wi)

@@ -11,6 +11,7 @@ mod adaptive_mis;
 mod checklist;
 mod chi2;
 mod estimator;
+mod glass;
 mod lights;
 mod measured;
 mod measured_fuzz;
