@@ -17,7 +17,9 @@
 //! has no density); only the `brdf` sampler reaches it, and `uniform` and
 //! `cosine` are refused.
 
-use super::keys::{self, ETA, K, MATERIAL, SPECULAR_REFLECTANCE};
+#[cfg(feature = "desc")]
+use super::keys;
+use super::keys::{ETA, K, MATERIAL, SPECULAR_REFLECTANCE};
 use super::{Bxdf, ModelInfo, Param, Range, Value};
 use crate::math::{Rgb, luminance};
 use crate::sample::{Delta, Deltas, LobeSample, Reach, Scattering};

@@ -3,6 +3,7 @@
 //! plugins and read the dicts a Mitsuba user writes).
 
 use super::{Param, Range, Value};
+#[cfg(feature = "desc")]
 use crate::math::Rgb;
 
 pub const INT_IOR: Param = Param {

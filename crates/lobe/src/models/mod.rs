@@ -196,9 +196,9 @@ impl fmt::Display for Range {
             Range::Number { min, max } => write!(f, "[{}, {}]", Num(min), Num(max)),
             Range::Bool => f.write_str("bool"),
             Range::File => f.write_str("a file (MERL .binary or RGL .bsdf, by content)"),
-            Range::Ior => {
-                f.write_str("> 0, or a name (`bk7`, `water`, `air`, ...: `lobe eval --help`)")
-            }
+            Range::Ior => f.write_str(
+                "> 0, or a name (`bk7`, `water`, `air`, ...: the list ends `lobe eval --help`)",
+            ),
             Range::Conductor => {
                 f.write_str("`none` or a conductor's name (`Au`, `Ag`, `Cu`, `Al`, `Cr`, ...)")
             }
@@ -629,6 +629,13 @@ fn defaults_text() -> String {
     ] {
         let _ = write!(s, "\n  {object:<35} {says}");
     }
+    let names = |v: Vec<&str>| v.join(", ");
+    let _ = write!(
+        s,
+        "\nNamed indices of refraction (int_ior, ext_ior; any case):\n  {}\nNamed conductors (material; Mitsuba's RGB data):\n  none, {}",
+        names(crate::ior::IORS.iter().map(|(n, _)| *n).collect()),
+        names(crate::ior::CONDUCTORS.iter().map(|(n, _, _)| *n).collect())
+    );
     s
 }
 

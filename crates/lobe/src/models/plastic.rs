@@ -5,8 +5,8 @@
 //! |---|---|---|---|
 //! | `diffuse_reflectance` | RGB in [0, 1] | 0.5 | albedo of the base under the coating |
 //! | `specular_reflectance` | RGB in [0, 1] | 1 | multiplies the reflected part (not physical; Mitsuba's) |
-//! | `int_ior` | > 0, or a name (`bk7`, `water`, `air`, ...: `lobe eval --help`) | `polypropylene` | index of refraction of the coating; `polypropylene` is 1.49 |
-//! | `ext_ior` | > 0, or a name (`bk7`, `water`, `air`, ...: `lobe eval --help`) | `air` | index of refraction outside (above the surface); `air` is 1.000277 |
+//! | `int_ior` | > 0, or a name (`bk7`, `water`, `air`, ...: the list ends `lobe eval --help`) | `polypropylene` | index of refraction of the coating; `polypropylene` is 1.49 |
+//! | `ext_ior` | > 0, or a name (`bk7`, `water`, `air`, ...: the list ends `lobe eval --help`) | `air` | index of refraction outside (above the surface); `air` is 1.000277 |
 //! | `nonlinear` | bool | false | account for the base's colour in the light it sends back through the coating (its albedo in the internal-reflection series) |
 //!
 //! (This table is [`PARAMS`]; a test checks that they agree.)
@@ -27,7 +27,9 @@
 //! part's (the coating is a delta): only `brdf` samples it all.
 
 use super::conductor::{DeltaSampler, mirror};
-use super::keys::{self, EXT_IOR, INT_IOR, SPECULAR_REFLECTANCE};
+#[cfg(feature = "desc")]
+use super::keys;
+use super::keys::{EXT_IOR, INT_IOR, SPECULAR_REFLECTANCE};
 use super::{Bxdf, ModelInfo, Param, Range, Value};
 use crate::fresnel::{diffuse_reflectance_fit, fresnel_dielectric};
 use crate::math::{INV_PI, Rgb};

@@ -19,7 +19,9 @@
 //! (Mitsuba's `G1(wo) G1(wi)`), `ks = specular_reflectance` and a
 //! conductor's Fresnel term (`none` for `material = none`).
 
-use super::keys::{self, ETA, K, MATERIAL, SPECULAR_REFLECTANCE};
+#[cfg(feature = "desc")]
+use super::keys;
+use super::keys::{ETA, K, MATERIAL, SPECULAR_REFLECTANCE};
 use super::roughdielectric::{
     DISTRIBUTION, MITSUBA_ALPHA, MITSUBA_ALPHA_U, MITSUBA_ALPHA_V, SAMPLE_VISIBLE,
 };

@@ -7,8 +7,8 @@
 //! | `alpha` | [1e-4, 2] | 0.1 | width of `D` |
 //! | `alpha_u` | [1e-4, 2] | `alpha` | width along the tangent; with `alpha_v`, instead of `alpha` (anisotropic) |
 //! | `alpha_v` | [1e-4, 2] | `alpha` | width along the bitangent |
-//! | `int_ior` | > 0, or a name (`bk7`, `water`, `air`, ...: `lobe eval --help`) | `bk7` | index of refraction inside (below the surface); `bk7` is 1.5046 |
-//! | `ext_ior` | > 0, or a name (`bk7`, `water`, `air`, ...: `lobe eval --help`) | `air` | index of refraction outside (above the surface); `air` is 1.000277 |
+//! | `int_ior` | > 0, or a name (`bk7`, `water`, `air`, ...: the list ends `lobe eval --help`) | `bk7` | index of refraction inside (below the surface); `bk7` is 1.5046 |
+//! | `ext_ior` | > 0, or a name (`bk7`, `water`, `air`, ...: the list ends `lobe eval --help`) | `air` | index of refraction outside (above the surface); `air` is 1.000277 |
 //! | `specular_reflectance` | RGB in [0, 1] | 1 | multiplies the reflected part (not physical; Mitsuba's) |
 //! | `specular_transmittance` | RGB in [0, 1] | 1 | multiplies the transmitted part (not physical; Mitsuba's) |
 //! | `sample_visible` | bool | true | Mitsuba's switch; lobe takes the strategy from each call instead, so only `true` is accepted |
@@ -40,7 +40,9 @@
 
 use super::cook_torrance::{ALPHA, ALPHA_U, ALPHA_V};
 use super::dielectric::{check_eta, refraction_scale};
-use super::keys::{self, EXT_IOR, INT_IOR, MODE, SPECULAR_REFLECTANCE, SPECULAR_TRANSMITTANCE};
+#[cfg(feature = "desc")]
+use super::keys;
+use super::keys::{EXT_IOR, INT_IOR, MODE, SPECULAR_REFLECTANCE, SPECULAR_TRANSMITTANCE};
 use super::{Bxdf, ModelInfo, Param, Range, Value};
 use crate::fresnel::{fresnel_dielectric, refract_about};
 use crate::math::Rgb;

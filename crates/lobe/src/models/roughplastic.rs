@@ -7,8 +7,8 @@
 //! | `specular_reflectance` | RGB in [0, 1] | 1 | multiplies the reflected part (not physical; Mitsuba's) |
 //! | `distribution` | `ggx`, `beckmann` | `beckmann` | the NDF `D` (Mitsuba's default) |
 //! | `alpha` | [1e-4, 2] | 0.1 | width of `D` |
-//! | `int_ior` | > 0, or a name (`bk7`, `water`, `air`, ...: `lobe eval --help`) | `polypropylene` | index of refraction of the coating; `polypropylene` is 1.49 |
-//! | `ext_ior` | > 0, or a name (`bk7`, `water`, `air`, ...: `lobe eval --help`) | `air` | index of refraction outside (above the surface); `air` is 1.000277 |
+//! | `int_ior` | > 0, or a name (`bk7`, `water`, `air`, ...: the list ends `lobe eval --help`) | `polypropylene` | index of refraction of the coating; `polypropylene` is 1.49 |
+//! | `ext_ior` | > 0, or a name (`bk7`, `water`, `air`, ...: the list ends `lobe eval --help`) | `air` | index of refraction outside (above the surface); `air` is 1.000277 |
 //! | `nonlinear` | bool | false | account for the base's colour in the light it sends back through the coating (its albedo in the internal-reflection series) |
 //! | `sample_visible` | bool | true | Mitsuba's switch; lobe takes the strategy from each call instead, so only `true` is accepted |
 //!
@@ -32,7 +32,9 @@
 //! base's `cos θi / π`.
 
 use super::cook_torrance::CookTorrance;
-use super::keys::{self, EXT_IOR, SPECULAR_REFLECTANCE};
+#[cfg(feature = "desc")]
+use super::keys;
+use super::keys::{EXT_IOR, SPECULAR_REFLECTANCE};
 use super::plastic::{Base, DIFFUSE_REFLECTANCE, NONLINEAR, PLASTIC_INT_IOR};
 use super::roughdielectric::{DISTRIBUTION, MITSUBA_ALPHA, SAMPLE_VISIBLE};
 use super::{Bxdf, ModelInfo, Param};

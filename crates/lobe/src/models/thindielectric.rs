@@ -3,8 +3,8 @@
 //!
 //! | parameter | range | default | meaning |
 //! |---|---|---|---|
-//! | `int_ior` | > 0, or a name (`bk7`, `water`, `air`, ...: `lobe eval --help`) | `bk7` | index of refraction inside (below the surface); `bk7` is 1.5046 |
-//! | `ext_ior` | > 0, or a name (`bk7`, `water`, `air`, ...: `lobe eval --help`) | `air` | index of refraction outside (above the surface); `air` is 1.000277 |
+//! | `int_ior` | > 0, or a name (`bk7`, `water`, `air`, ...: the list ends `lobe eval --help`) | `bk7` | index of refraction inside (below the surface); `bk7` is 1.5046 |
+//! | `ext_ior` | > 0, or a name (`bk7`, `water`, `air`, ...: the list ends `lobe eval --help`) | `air` | index of refraction outside (above the surface); `air` is 1.000277 |
 //! | `specular_reflectance` | RGB in [0, 1] | 1 | multiplies the reflected part (not physical; Mitsuba's) |
 //! | `specular_transmittance` | RGB in [0, 1] | 1 | multiplies the transmitted part (not physical; Mitsuba's) |
 //!
@@ -21,7 +21,9 @@
 
 use super::conductor::{DeltaSampler, delta_sampler, mirror};
 use super::dielectric::check_eta;
-use super::keys::{self, EXT_IOR, INT_IOR, SPECULAR_REFLECTANCE, SPECULAR_TRANSMITTANCE};
+#[cfg(feature = "desc")]
+use super::keys;
+use super::keys::{EXT_IOR, INT_IOR, SPECULAR_REFLECTANCE, SPECULAR_TRANSMITTANCE};
 use super::{Bxdf, ModelInfo, Param};
 use crate::fresnel::fresnel_dielectric;
 use crate::math::Rgb;
