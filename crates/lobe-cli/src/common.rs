@@ -206,6 +206,26 @@ pub fn load_material(spec: &str) -> Result<lobe::Material> {
     Ok(m)
 }
 
+/// Refuse a material that `command` cannot show yet: one that transmits
+/// or has a delta part (its figures and tables are of the hemisphere of
+/// reflection, which would leave part of it out without a word).
+pub fn refuse_transmission(m: &lobe::Material, command: &str) -> Result<()> {
+    let reach = m.reach();
+    if reach.transmits || reach.delta {
+        bail!(
+            "--material: {command} does not yet take {} ({} {}; issue 42's next part): `lobe estimate` and `lobe converge` do",
+            m.model_name(),
+            m.model_name(),
+            if reach.transmits {
+                "transmits"
+            } else {
+                "has a delta part"
+            }
+        );
+    }
+    Ok(())
+}
+
 /// [`warn_energy_gain`] for every object of a scene loaded from `path`,
 /// named by its place among the file's `[[object]]` tables.
 pub fn warn_scene_energy_gain(scene: &lobe_render::Scene, path: &std::path::Path) {

@@ -113,6 +113,7 @@ pub fn run(args: &PlotArgs) -> Result<()> {
         .parse()
         .map_err(|e| anyhow!("--scale {}: {e}", args.scale))?;
     let material = load_material(&args.material)?;
+    crate::common::refuse_transmission(&material, "plot")?;
     // The figures are drawn over the hemisphere of the normal (transmitted
     // lobes and views from inside: issue 42's next step).
     let wo = args.view.wo(&lobe::Material::lambert(lobe::Rgb::ONE)?)?;
@@ -317,6 +318,7 @@ fn histogram(
 fn comparison(args: &PlotArgs, data: &Material) -> Result<Option<(Material, String)>> {
     if let Some(spec) = &args.against {
         let m = load_material(spec).context("--against")?;
+        crate::common::refuse_transmission(&m, "plot").context("--against")?;
         let label = material_label(spec, &m);
         return Ok(Some((m, label)));
     }

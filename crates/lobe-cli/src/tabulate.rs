@@ -42,6 +42,7 @@ pub struct TabulateArgs {
 pub fn run(args: &TabulateArgs) -> Result<()> {
     crate::common::prepare_output_files("--out", std::slice::from_ref(&args.out))?;
     let m = crate::common::load_material(&args.material)?;
+    crate::common::refuse_transmission(&m, "tabulate (a table of reflection)")?;
     let format = match args.format.as_str() {
         "merl" => Format::Merl,
         _ => Format::Rgl(RglResolution {

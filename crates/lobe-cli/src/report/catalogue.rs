@@ -124,6 +124,8 @@ pub(super) fn given_models(specs: &[String]) -> Result<Vec<Model>> {
         .map(|(i, spec)| {
             let m =
                 crate::common::load_material(spec).with_context(|| format!("--material {spec}"))?;
+            crate::common::refuse_transmission(&m, "report")
+                .with_context(|| format!("--material {spec}"))?;
             let vndf = if m.check(BsdfStrategy::Vndf).is_ok() {
                 vec![BsdfStrategy::Vndf]
             } else {

@@ -165,6 +165,15 @@ fn bad_input_fails_with_one_line() {
         (vec!["--strategy", "vndf", "--theta", "-1"], "--theta"),
         (vec!["--kind", "weights"], "--strategy"),
         (vec!["--strategy", "vndf", "--material", "{"], "material"),
+        // Glass is not drawn yet: refused by name, not half drawn.
+        (
+            vec![
+                "--material",
+                r#"{"type":"roughdielectric","distribution":"ggx"}"#,
+            ],
+            "transmits",
+        ),
+        (vec!["--material", r#"{"type":"plastic"}"#], "delta part"),
         (vec!["--strategy", "vndf", "--out", under_file], "--out"),
     ];
     for (extra, needle) in cases {
