@@ -137,7 +137,14 @@ impl Table {
 pub fn reference_method(m: &Material, light: &Light) -> String {
     use crate::estimator::{TABLE_REFERENCE_MAX_EVALS, TABLE_REFERENCE_TOLERANCE};
     let rel = REFERENCE_TOLERANCE;
-    match (light, m.measured().is_some()) {
+    let reach = m.reach();
+    let over = match (reach.transmits, reach.delta) {
+        (false, false) => "",
+        (true, false) => " over the whole sphere",
+        (false, true) => ", plus the delta parts exactly",
+        (true, true) => " over the whole sphere, plus the delta parts exactly",
+    };
+    let text = match (light, m.measured().is_some()) {
         (Light::Env(map), _) if map.is_smooth() => format!(
             "a sum over the map's cells between texel centres of ∫ radiance × f cos dω (its radiance interpolated, bilinear in each; 4×4 Gauss-Legendre per cell, refined to {rel:e} relative, f64)"
         ),
@@ -154,7 +161,8 @@ pub fn reference_method(m: &Material, light: &Light) -> String {
             rel.max(TABLE_REFERENCE_TOLERANCE),
             TABLE_REFERENCE_MAX_EVALS
         ),
-    }
+    };
+    text + over
 }
 
 /// Estimates `L_o(wo) = ∫ f_r(wo, wi) L(wi) cos θi dωi` with every strategy
