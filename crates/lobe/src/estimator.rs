@@ -898,8 +898,9 @@ pub fn reference(m: &Material, sp: &ShadingPoint, light: &Light, rel: f64) -> Rg
 }
 
 /// What the delta parts of `m` add to the reflected radiance, exactly:
-/// `Σ value · L(wi)` over [`Material::deltas`].
-fn delta_reference(m: &Material, sp: &ShadingPoint, light: &Light) -> Rgb {
+/// `Σ value · L(wi)` over [`Material::deltas`] (part of [`reference`]).
+#[must_use]
+pub fn delta_reference(m: &Material, sp: &ShadingPoint, light: &Light) -> Rgb {
     let mut sum = Rgb::ZERO;
     for d in m.deltas(sp.wo).iter() {
         sum += d.value * light.radiance(sp.frame.to_world(d.wi));

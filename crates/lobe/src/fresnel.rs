@@ -73,9 +73,10 @@ pub struct DielectricFresnel {
     /// interface from the incident one (sign opposite to `cos_theta_i`;
     /// 0 past the critical angle).
     pub cos_theta_t: f64,
-    /// `η_i / η_t`: the index on the incident side over the other.
+    /// `η_t / η_i`: the index on the other side over the incident one
+    /// (Mitsuba's `eta_it`; `eta` itself from outside).
     pub eta_it: f64,
-    /// `η_t / η_i`, its reciprocal: the ratio Snell's law scales the
+    /// `η_i / η_t`, its reciprocal: the ratio Snell's law scales the
     /// tangential component by (`sin θt = eta_ti sin θi`).
     pub eta_ti: f64,
 }

@@ -33,8 +33,8 @@ pub mod variance;
 pub mod warp_test;
 
 use crate::estimator::{
-    Accumulator, EstimateSettings, ShadingEstimator, ShadingPoint, estimate_chunk, reference,
-    reference_env_row,
+    Accumulator, EstimateSettings, ShadingEstimator, ShadingPoint, delta_reference, estimate_chunk,
+    reference, reference_env_row,
 };
 use crate::progress::Progress;
 use crate::{Error, Light, Material, Rgb};
@@ -87,7 +87,7 @@ pub fn reference_rows(m: &Material, sp: &ShadingPoint, light: &Light, rel: f64) 
     match light {
         Light::Env(map) => {
             let rows = map_indices(map.size().1, |j| reference_env_row(m, sp, map, j, rel));
-            rows.iter().fold(Rgb::ZERO, |a, &b| a + b)
+            rows.iter().fold(Rgb::ZERO, |a, &b| a + b) + delta_reference(m, sp, light)
         }
         _ => reference(m, sp, light, rel),
     }
@@ -139,15 +139,27 @@ mod tests {
 
     #[test]
     fn row_reference_equals_the_serial_one() {
-        let m = Material::lambert(Rgb::splat(0.5)).unwrap();
         let map = crate::envmap::EnvMap::sky(16, 8, 30.0, 40.0);
         let light = Light::Env(Arc::new(map));
         let sp = ShadingPoint {
             frame: Frame::from_normal_tangent(DVec3::Y, DVec3::X).unwrap(),
-            wo: DVec3::Z,
+            wo: DVec3::new(0.3, 0.0, 0.954).normalize(),
         };
-        let a = reference_rows(&m, &sp, &light, 1e-6);
-        assert_eq!(a, reference(&m, &sp, &light, 1e-6));
-        assert!(a.x > 0.0);
+        // A density, and delta parts (a mirror, glass, a coating), whose
+        // exact terms both references add.
+        let lambert = Material::lambert(Rgb::splat(0.5)).unwrap();
+        let lobes = |g| Material::from(crate::models::Lobes::only(g));
+        let mirror = lobes(crate::Glossy::Conductor(crate::models::Conductor::new(
+            crate::Fresnel::None,
+            Rgb::ONE,
+        )));
+        let plastic = lobes(crate::Glossy::Plastic(
+            crate::models::Plastic::new(Rgb::splat(0.5), Rgb::ONE, 1.49, false).unwrap(),
+        ));
+        for m in [lambert, mirror, plastic] {
+            let a = reference_rows(&m, &sp, &light, 1e-6);
+            assert_eq!(a, reference(&m, &sp, &light, 1e-6), "{}", m.model_name());
+            assert!(a.x > 0.0, "{}", m.model_name());
+        }
     }
 }
