@@ -94,6 +94,21 @@ impl Material {
         self.glossy.reach()
     }
 
+    /// The same material carrying importance ([`crate::TransportMode`]):
+    /// its refraction without radiance's `(η_i/η_t)²`, so that what it
+    /// scatters is a fraction of the flux it receives (an energy check's
+    /// view; radiance into a less dense medium legitimately grows).
+    #[must_use]
+    pub fn carrying_importance(&self) -> Material {
+        let mut m = self.clone();
+        match &mut m.glossy {
+            Glossy::Dielectric(d) => d.mode = crate::TransportMode::Importance,
+            Glossy::RoughDielectric(d) => d.mode = crate::TransportMode::Importance,
+            _ => {}
+        }
+        m
+    }
+
     /// This material seen from both sides (Mitsuba's `twosided`); an error
     /// for one that transmits (it has two sides already).
     pub fn two_sided(mut self) -> crate::error::Result<Self> {
