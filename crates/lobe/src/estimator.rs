@@ -25,7 +25,7 @@ use crate::stats::quadrature::{
 };
 use crate::stats::ttest::Moments;
 pub use crate::strategy::{Heuristic, Mis, MisForm, NON_BSDF_NAMES, Strategy};
-use crate::{BsdfSample, BsdfStrategy, Error, Frame, Material};
+use crate::{BsdfSample, Error, Frame, Material};
 use glam::{DVec2, DVec3};
 
 /// Running sums of the sample values `f L cos / p` (zero for a failed sample).
@@ -81,19 +81,7 @@ impl<'m> ShadingEstimator<'m> {
     /// point; the error says why a BSDF strategy does not apply.
     pub fn new(strategy: Strategy, m: &'m Material) -> Result<Self, Error> {
         if strategy == Strategy::Light && m.reach().delta {
-            return Err(Error::Unsupported {
-                strategy: "light".into(),
-                reason: format!(
-                    "{} has a delta part (a mirror or a smooth interface) that light sampling never hits",
-                    m.model_name()
-                ),
-                available: m
-                    .strategies()
-                    .into_iter()
-                    .map(BsdfStrategy::name)
-                    .chain(["mis"])
-                    .collect(),
-            });
+            return Err(crate::strategy::light_never_hits(m));
         }
         let sampler = match strategy.bsdf_strategy(m) {
             Some(s) => Some(m.sampler(s)?),

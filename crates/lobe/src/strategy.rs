@@ -262,16 +262,7 @@ impl Strategy {
                     }
                     continue;
                 }
-                "light" if m.reach().delta => {
-                    return Err(Error::Unsupported {
-                        strategy: "light".into(),
-                        reason: format!(
-                            "{} has a delta part (a mirror or a smooth interface) that light sampling never hits",
-                            m.model_name()
-                        ),
-                        available: m.strategies().into_iter().map(BsdfStrategy::name).collect(),
-                    });
-                }
+                "light" if m.reach().delta => return Err(light_never_hits(m)),
                 "light" => Strategy::Light,
                 "mis" => mis(Heuristic::Balance, MisForm::Adaptive),
                 "mis-balance" => mis(Heuristic::Balance, MisForm::MultiSample),
@@ -290,5 +281,23 @@ impl Strategy {
             push(t, &mut v);
         }
         Ok(v)
+    }
+}
+
+/// Why light sampling alone does not apply to `m`, which has a delta part:
+/// the error the strategy parser and the estimator give.
+pub(crate) fn light_never_hits(m: &Material) -> Error {
+    Error::Unsupported {
+        strategy: "light".into(),
+        reason: format!(
+            "{} has a delta part (a mirror or a smooth interface) that light sampling never hits",
+            m.model_name()
+        ),
+        available: m
+            .strategies()
+            .into_iter()
+            .map(BsdfStrategy::name)
+            .chain(["mis"])
+            .collect(),
     }
 }

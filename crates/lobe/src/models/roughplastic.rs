@@ -176,11 +176,13 @@ impl RoughPlastic {
 /// cuts the integrand).
 fn coating_tables(mf: &Microfacet, eta: f64) -> (Vec<f64>, f64) {
     let mu = |j: usize| (j as f64 / (TABLE_SIZE - 1) as f64).max(1e-6);
+    // The two rules, computed once for the 128 integrals.
+    let rules = [32, 128].map(crate::stats::quadrature::gauss_legendre);
     let quad = |n: usize, f: &dyn Fn(DVec2) -> f64| -> f64 {
-        let rule = crate::stats::quadrature::gauss_legendre(n);
+        let rule = &rules[usize::from(n == 128)];
         let mut s = 0.0;
-        for &(xa, wa) in &rule {
-            for &(xb, wb) in &rule {
+        for &(xa, wa) in rule {
+            for &(xb, wb) in rule {
                 s += 0.25 * wa * wb * f(DVec2::new(0.5 * xa + 0.5, 0.5 * xb + 0.5));
             }
         }
