@@ -244,10 +244,22 @@ pub fn warn_energy_gain(m: &lobe::Material, what: &str) {
     // (a microfacet lobe's single scattering and every Fresnel term are at
     // most 1): where that bound is at most 1 the quadrature (about a second
     // for a Beckmann lobe, paid at every start-up) cannot find a gain.
+    // Mitsuba's models scatter at most their largest tint: a mirror's
+    // Fresnel term is at most 1, glass splits the flux into R + T = 1 at
+    // most, and plastic's base sends out at most the (1 − F) its coating
+    // lets in (the internal reflections' series sums to at most 1 for
+    // ρ ≤ 1).
+    use lobe::Glossy;
     let ks = match &m.glossy {
-        lobe::Glossy::None => Some(lobe::Rgb::ZERO),
-        lobe::Glossy::CookTorrance(ct) => Some(ct.ks),
-        _ => None,
+        Glossy::None => Some(lobe::Rgb::ZERO),
+        Glossy::CookTorrance(ct) => Some(ct.ks),
+        Glossy::Conductor(c) => Some(c.specular_reflectance),
+        Glossy::Dielectric(d) => Some(d.specular_reflectance.max(d.specular_transmittance)),
+        Glossy::ThinDielectric(d) => Some(d.specular_reflectance.max(d.specular_transmittance)),
+        Glossy::RoughDielectric(d) => Some(d.specular_reflectance.max(d.specular_transmittance)),
+        Glossy::Plastic(p) => Some(p.specular_reflectance.max(p.diffuse_reflectance)),
+        Glossy::RoughPlastic(p) => Some(p.coating.ks.max(p.diffuse_reflectance)),
+        Glossy::Phong(_) | Glossy::BlinnPhong(_) | Glossy::Measured(_) => None,
     };
     if ks.is_some_and(|ks| (m.diffuse.albedo + ks).max_element() <= 1.0) {
         return;

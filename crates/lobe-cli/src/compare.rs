@@ -355,6 +355,9 @@ pub fn run(args: &CompareArgs) -> Result<()> {
     for w in &scene.warnings {
         eprintln!("lobe: warning: {w}");
     }
+    if let Some(n) = lobe_render::integrator::shallow_glass(&scene, settings.max_depth) {
+        eprintln!("lobe: note: {n}");
+    }
     if !args.quiet {
         for &m in &settings.strategies {
             for f in fallbacks(&scene, m) {

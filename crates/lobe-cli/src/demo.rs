@@ -37,11 +37,12 @@ use std::time::Instant;
                   theta_o = 30° under a white furnace, it estimates the reflected radiance with uniform \
                   hemisphere sampling and with each importance sampler at the same number of samples, \
                   and prints the relative error, the per-sample variance and the variance reduction.\n\n\
-                  Then it renders the showcase: eight spheres (Phong n=20 and 300, Blinn-Phong n=80 and \
-                  1200, GGX alpha=0.3 and 0.06, Beckmann gold alpha=0.3 and 0.06) on a grey ground under \
-                  the built-in sky, by path tracing (up to 3 bounces, so that the sharp spheres mirror \
-                  the ground) with brdf, light and mis at 16 samples per pixel next to a mis \
-                  reference at 768, and writes DIR/showcase.png (the renders with their error maps and \
+                  Then it renders the showcase: twelve spheres (Phong n=20 and 300, Blinn-Phong n=80 and \
+                  1200, GGX alpha=0.3 and 0.06, Beckmann gold alpha=0.3 and 0.06, smooth and rough glass, \
+                  a silver mirror, rough plastic) on a grey ground under the built-in sky, by path \
+                  tracing (up to 5 bounces, so that the sharp spheres mirror the ground and light \
+                  passes through the glass) with brdf, light and mis at 16 samples per pixel next to \
+                  a mis reference at 512, and writes DIR/showcase.png (the renders with their error maps and \
                   RMSE, as `lobe compare` draws them), DIR/showcase.json (the numbers) and each render \
                   as DIR/<strategy>.png.",
     after_help = "Examples:\n  lobe demo\n  lobe demo --out /tmp/demo --quiet"
@@ -59,12 +60,13 @@ pub struct DemoArgs {
 }
 
 /// Samples per pixel of the showcase's reference (MIS).
-const REFERENCE_SPP: u32 = 768;
+const REFERENCE_SPP: u32 = 512;
 
 /// Bounces of the showcase's paths: enough for the sharp spheres to mirror
-/// the ground and their neighbours (the integrator's next-event estimation
-/// at every vertex, Russian roulette after the third bounce).
-const MAX_DEPTH: u32 = 3;
+/// the ground and their neighbours, and for a ray to go into a glass
+/// sphere, out of it and on to the lit ground (the integrator's next-event
+/// estimation at every vertex, Russian roulette after the third bounce).
+const MAX_DEPTH: u32 = 5;
 
 /// Sizes of the run.
 struct DemoSettings {
@@ -80,7 +82,7 @@ impl DemoSettings {
         if quick {
             DemoSettings {
                 tour_samples: 1024,
-                width: 96,
+                width: 144,
                 height: 30,
                 spp: 2,
                 reference_spp: 16,
@@ -88,7 +90,7 @@ impl DemoSettings {
         } else {
             DemoSettings {
                 tour_samples: 65536,
-                width: 640,
+                width: 960,
                 height: 200,
                 spp: 16,
                 reference_spp: REFERENCE_SPP,
@@ -216,7 +218,7 @@ fn tour(demo: &DemoSettings, quiet: bool) -> Result<()> {
 
 /// The showcase's spheres, two per model: the model, the parameter, the
 /// material.
-const SPHERES: [(&str, &str, &str); 8] = [
+const SPHERES: [(&str, &str, &str); 12] = [
     (
         "Phong",
         "n = 20",
@@ -256,6 +258,18 @@ const SPHERES: [(&str, &str, &str); 8] = [
         "Beckmann (gold)",
         "α = 0.06",
         r#"{"type":"cook-torrance","distribution":"beckmann","alpha":0.06,"fresnel":{"type":"conductor"}}"#,
+    ),
+    ("Glass (BK7)", "smooth", r#"{"type":"dielectric"}"#),
+    ("Glass (BK7)", "α = 0.1", r#"{"type":"roughdielectric"}"#),
+    (
+        "Mirror (Ag), plastic",
+        "mirror",
+        r#"{"type":"conductor","material":"Ag"}"#,
+    ),
+    (
+        "Mirror (Ag), plastic",
+        "α = 0.1",
+        r#"{"type":"roughplastic","diffuse_reflectance":[0.45,0.07,0.05]}"#,
     ),
 ];
 
@@ -320,7 +334,8 @@ fn showcase_caption(s: &CompareSettings) -> Vec<String> {
             s.max_depth
         ),
         "brdf samples the BSDF only: it rarely finds the small sun, so the ground shows the blue sky with sun fireflies.".to_string(),
-        "light samples the sky and sun only: clean on the diffuse ground, noisy on glossy lobes, worst on sharp gold; mis gives each pixel's draws to BSDF sampling, the balance heuristic or the light, as its pilot finds best.".to_string(),
+        "light samples the sky and sun only: clean on the diffuse ground, noisy on glossy lobes, worst on sharp gold; it never hits a delta lobe, so smooth glass and the mirror fall back to brdf.".to_string(),
+        "mis gives each pixel's draws to BSDF sampling, the balance heuristic or the light, as its pilot finds best. The sparks under the glass are caustics: sunlight through glass, found only when a path from the ground happens to leave through the sphere toward the sun.".to_string(),
     ]
 }
 
@@ -341,18 +356,19 @@ fn showcase(demo: &DemoSettings, dir: &Path, quiet: bool) -> Result<()> {
         equal_time: false,
     };
     println!(
-        "lobe demo, part 2: the showcase, {}×{}: eight spheres (Phong, Blinn-Phong, GGX, Beckmann gold; a",
+        "lobe demo, part 2: the showcase, {}×{}: twelve spheres (Phong, Blinn-Phong, GGX, Beckmann gold; a",
         demo.width, demo.height
     );
     println!(
-        "broad and a sharp lobe each) on a grey ground under the built-in sky with its sun, rendered by"
+        "broad and a sharp lobe each; smooth and rough glass, a mirror, rough plastic) on a grey ground"
     );
     println!(
-        "BSDF sampling (brdf), light sampling and MIS at {} spp, paths of up to {} bounces; the reference",
-        settings.spp, settings.max_depth
+        "under the built-in sky with its sun, rendered by BSDF sampling (brdf), light sampling and MIS at"
     );
     println!(
-        "is {} (MIS with the balance heuristic) at {} spp.",
+        "{} spp, paths of up to {} bounces; the reference is {} (MIS with the balance heuristic) at {} spp.",
+        settings.spp,
+        settings.max_depth,
         lobe_render::compare::REFERENCE_STRATEGY.name(),
         settings.reference_spp
     );

@@ -214,6 +214,9 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     for w in &scene.warnings {
         eprintln!("lobe: warning: {w}");
     }
+    if let Some(n) = lobe_render::integrator::shallow_glass(&scene, opts.max_depth) {
+        eprintln!("lobe: note: {n}");
+    }
     if !args.quiet {
         for f in fallbacks(&scene, opts.strategy) {
             eprintln!(

@@ -131,7 +131,7 @@ use crate::scene::Scene;
 pub use crate::settings::{RenderLoop, RenderSettings, SppAllocation};
 use glam::{DVec2, DVec3};
 use lobe::estimator::{
-    Allocation, DrawnBsdf, Mis, MisForm, Pilot, ShadingEstimator, ShadingPoint, Strategy,
+    Allocation, BsdfDraw, DrawnBsdf, Mis, MisForm, Pilot, ShadingEstimator, ShadingPoint, Strategy,
     Visibility,
 };
 use lobe::light::Light;
@@ -275,14 +275,21 @@ struct ObjectShading<'m> {
     estimator: ShadingEstimator<'m>,
     /// The strategy's own BSDF sampler, or for `light` the material's best.
     continuation: BsdfSampler<'m>,
+    /// The material transmits: its frame keeps the surface's own normal,
+    /// and a view from below it is a view from inside.
+    transmits: bool,
 }
 
 /// The strategy `strategy` becomes on material `m`: a BSDF strategy that
-/// does not apply falls back to `brdf`, which applies to every material.
+/// does not apply falls back to `brdf`, which applies to every material;
+/// light sampling on a material with a delta part (a mirror, smooth glass,
+/// plastic's coating), which light samples never hit, falls back to the
+/// material's best BSDF strategy ([`Material::best_bsdf_strategy`]).
 #[must_use]
 pub fn strategy_for(strategy: Strategy, m: &Material) -> Strategy {
     match strategy {
         Strategy::Bsdf(s) if m.check(s).is_err() => Strategy::Bsdf(BsdfStrategy::Brdf),
+        Strategy::Light if m.reach().delta => Strategy::Bsdf(m.best_bsdf_strategy()),
         t => t,
     }
 }
@@ -298,6 +305,7 @@ fn object_shading(strategy: Strategy, m: &Material) -> ObjectShading<'_> {
     ObjectShading {
         estimator,
         continuation,
+        transmits: m.reach().transmits,
     }
 }
 
@@ -306,32 +314,51 @@ fn object_shading(strategy: Strategy, m: &Material) -> ObjectShading<'_> {
 pub struct Fallback {
     pub object: usize,
     pub model: &'static str,
-    pub requested: BsdfStrategy,
-    pub used: BsdfStrategy,
+    pub requested: Strategy,
+    pub used: Strategy,
 }
 
-/// The objects on which `strategy`'s BSDF strategy falls back to `brdf`.
+/// The objects on which `strategy` falls back to another
+/// ([`strategy_for`]).
 #[must_use]
 pub fn fallbacks(scene: &Scene, strategy: Strategy) -> Vec<Fallback> {
-    let Strategy::Bsdf(s) = strategy else {
-        return Vec::new();
-    };
     scene
         .objects
         .iter()
         .enumerate()
         .filter_map(|(i, o)| {
-            let Strategy::Bsdf(used) = strategy_for(strategy, &o.material) else {
-                return None;
-            };
-            (used != s).then(|| Fallback {
+            let used = strategy_for(strategy, &o.material);
+            (used != strategy).then(|| Fallback {
                 object: i,
                 model: o.material.model_name(),
-                requested: s,
+                requested: strategy,
                 used,
             })
         })
         .collect()
+}
+
+/// The depth below which a transmitting object shows little of what is
+/// behind it: a ray goes in, out, and on to the next surface.
+pub const SEE_THROUGH_DEPTH: u32 = 3;
+
+/// A note when an object of `scene` transmits (glass) and `max_depth` is
+/// below [`SEE_THROUGH_DEPTH`]: such a render is correct for its depth but
+/// shows glass dark, and the user likely wants more bounces.
+#[must_use]
+pub fn shallow_glass(scene: &Scene, max_depth: u32) -> Option<String> {
+    if max_depth >= SEE_THROUGH_DEPTH {
+        return None;
+    }
+    let (i, o) = scene
+        .objects
+        .iter()
+        .enumerate()
+        .find(|(_, o)| o.material.reach().transmits)?;
+    Some(format!(
+        "object {i} ({}) transmits, and max_depth {max_depth} ends paths before light passes through it (in, out, on: {SEE_THROUGH_DEPTH} bounces), so it shows dark; give max_depth 8 or more to see through glass",
+        o.material.model_name()
+    ))
 }
 
 /// The largest spp × passes a Sobol render takes (its sample index is 32
@@ -1128,22 +1155,38 @@ impl Context<'_> {
             // Normals turned toward the viewer; the shading normal on the
             // geometric normal's side, and the geometric one where the
             // interpolated normal would put the viewer below the horizon.
-            let ng = if hit.ng.dot(wo_world) < 0.0 {
-                -hit.ng
+            //
+            // A transmitting material keeps the shape's own orientation
+            // (outward on spheres and closed meshes): `wo` below its surface
+            // is a view from inside. Its shading normal gives way to the
+            // geometric one where the two put the viewer on different sides.
+            let (ng, ns) = if shading.transmits {
+                let side = hit.ng.dot(wo_world);
+                let ns = if hit.ns.dot(wo_world) * side > 0.0 {
+                    hit.ns
+                } else {
+                    hit.ng
+                };
+                (hit.ng, ns)
             } else {
-                hit.ng
+                let ng = if hit.ng.dot(wo_world) < 0.0 {
+                    -hit.ng
+                } else {
+                    hit.ng
+                };
+                let mut ns = if hit.ns.dot(ng) < 0.0 {
+                    -hit.ns
+                } else {
+                    hit.ns
+                };
+                if ns.dot(wo_world) <= 0.0 {
+                    ns = ng;
+                }
+                (ng, ns)
             };
-            let mut ns = if hit.ns.dot(ng) < 0.0 {
-                -hit.ns
-            } else {
-                hit.ns
-            };
-            if ns.dot(wo_world) <= 0.0 {
-                ns = ng;
-            }
             let frame = Frame::from_normal(ns);
             let wo = frame.to_local(wo_world);
-            if wo.z <= 0.0 {
+            if wo.z <= 0.0 && !(shading.transmits && wo.z < 0.0) {
                 break;
             }
             let sp = ShadingPoint { frame, wo };
@@ -1194,20 +1237,26 @@ impl Context<'_> {
                 stats.rays += vis.rays;
                 break;
             }
-            // Continue with the estimate's BSDF sample, or draw one (light
-            // sampling alone, or one-sample MIS that chose the light).
-            let drawn = e.bsdf.or_else(|| {
-                let uc = ps.one(dims::next_uc(b));
-                let u = ps.pair(dims::next_u(b));
-                let s = shading.continuation.sample(wo, uc, u)?;
-                let dir = frame.to_world(s.wi);
-                let escaped = vis.escapes(dir);
-                Some(DrawnBsdf {
-                    sample: s,
-                    dir,
-                    escaped,
-                })
-            });
+            // Continue with the estimate's BSDF sample, or draw one where
+            // it drew none (light sampling alone, one-sample MIS that chose
+            // the light); where its draw failed, the path ends.
+            let drawn = match e.bsdf {
+                BsdfDraw::Drawn(d) => Some(d),
+                BsdfDraw::Failed => None,
+                BsdfDraw::NotDrawn => {
+                    let uc = ps.one(dims::next_uc(b));
+                    let u = ps.pair(dims::next_u(b));
+                    shading.continuation.sample(wo, uc, u).map(|s| {
+                        let dir = frame.to_world(s.wi);
+                        let escaped = vis.escapes(dir);
+                        DrawnBsdf {
+                            sample: s,
+                            dir,
+                            escaped,
+                        }
+                    })
+                }
+            };
             stats.rays += vis.rays;
             let Some(d) = drawn else {
                 break;

@@ -790,21 +790,6 @@ fn build_object(
         .relative_to(base)
         .build()
         .map_err(|e| material_error(i, &o.material, e))?;
-    let reach = material.reach();
-    if reach.transmits || reach.delta {
-        return Err((
-            FieldPath::object(i).key("material"),
-            format!(
-                "type {}: the renderer does not yet trace {} (issue 42's next part); lobe estimate, converge and eval take it",
-                o.material.kind,
-                if reach.transmits {
-                    "refraction"
-                } else {
-                    "delta reflections"
-                }
-            ),
-        ));
-    }
     let shape_err = |e: ShapeError| (at(e.field), e.message);
     match o.kind.as_str() {
         "sphere" => Object::sphere(

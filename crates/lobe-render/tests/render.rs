@@ -13,6 +13,9 @@ use lobe_render::{
 use std::path::PathBuf;
 use std::sync::Arc;
 
+#[path = "render/glass.rs"]
+mod glass;
+
 fn lambert(a: f64) -> Material {
     Material::lambert(Rgb::splat(a)).unwrap()
 }
@@ -899,27 +902,6 @@ fn scene_files_load_and_their_errors_name_file_line_and_field() {
         e.contains(&dir.join("bunny.obj").display().to_string()),
         "{e}"
     );
-
-    // Glass and mirrors load as materials but are not traced yet: refused,
-    // named, never rendered wrong.
-    for (m, what) in [
-        ("{ type = \"dielectric\" }", "refraction"),
-        (
-            "{ type = \"conductor\", material = \"Au\" }",
-            "delta reflections",
-        ),
-    ] {
-        std::fs::write(
-            &bad,
-            SCENE.replace("{ type = \"phong\", exponent = 50 }", m),
-        )
-        .unwrap();
-        let e = load_scene(&bad).unwrap_err().to_string();
-        assert!(
-            e.contains("field object[0].material") && e.contains(what),
-            "{e}"
-        );
-    }
 
     std::fs::write(dir.join("broken.obj"), "v 0 0 0\nv 1 0 0\nf 1 2 7\n").unwrap();
     std::fs::write(&bad, SCENE.replace("tri.obj", "broken.obj")).unwrap();

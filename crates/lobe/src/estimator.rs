@@ -164,14 +164,30 @@ pub struct DrawnBsdf {
     pub escaped: bool,
 }
 
+/// What an estimate's first BSDF draw gives a renderer to continue its path
+/// with.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum BsdfDraw {
+    /// The estimate drew no BSDF direction (light sampling, one-sample MIS
+    /// that chose the light, adaptive MIS that gave its draws to the
+    /// light): the renderer draws one of its own.
+    NotDrawn,
+    /// The first draw failed (no direction, as a sample below the horizon):
+    /// the path ends there. Drawing again would give the path a second
+    /// chance the estimate's failed sample did not have, and bias it.
+    Failed,
+    /// The first BSDF sample drawn.
+    Drawn(DrawnBsdf),
+}
+
 /// One estimate at a shading point.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ShadingEstimate {
     /// `f L cos / p`, MIS-weighted where MIS is used (cosine included);
     /// zero for failed samples.
     pub value: Rgb,
-    /// The first BSDF sample drawn, if the strategy drew one.
-    pub bsdf: Option<DrawnBsdf>,
+    /// The first BSDF draw, for a renderer's path.
+    pub bsdf: BsdfDraw,
 }
 
 /// A [`Strategy`] validated for one material ([`ShadingEstimator::new`]).
@@ -433,7 +449,7 @@ impl<'m> ShadingEstimator<'m> {
     ) -> ShadingEstimate {
         match (self.strategy, self.sampler) {
             (Strategy::Mis(mis), Some(s)) if mis.form == MisForm::Adaptive => {
-                let mut first = None;
+                let mut first = BsdfDraw::NotDrawn;
                 pilot.samples += 1;
                 let value = multi_sample(
                     self.material,
@@ -467,7 +483,7 @@ impl<'m> ShadingEstimator<'m> {
     ) -> ShadingEstimate {
         let m = self.material;
         let dist = self.strategy.light_distribution();
-        let mut first: Option<DrawnBsdf> = None;
+        let mut first = BsdfDraw::NotDrawn;
         let value = match (self.strategy, self.sampler) {
             (Strategy::Bsdf(_), Some(s)) => {
                 let p = points[0];
@@ -579,7 +595,7 @@ fn multi_sample(
     (n_b, n_l): (u32, u32),
     points: &[[f64; 3]],
     vis: &mut impl Visibility,
-    first: &mut Option<DrawnBsdf>,
+    first: &mut BsdfDraw,
     mut pilot: Option<&mut Pilot>,
 ) -> Rgb {
     let dist = LightDistribution::Compensated;
@@ -675,18 +691,23 @@ fn draw_bsdf(
     p: [f64; 3],
     uc_scale: f64,
     vis: &mut impl Visibility,
-    first: &mut Option<DrawnBsdf>,
+    first: &mut BsdfDraw,
 ) -> Option<(BsdfSample, DVec3)> {
     let uc = if uc_scale == 1.0 {
         p[0]
     } else {
         p[0] / uc_scale
     };
-    let x = s.sample(sp.wo, uc, DVec2::new(p[1], p[2]))?;
+    let Some(x) = s.sample(sp.wo, uc, DVec2::new(p[1], p[2])) else {
+        if *first == BsdfDraw::NotDrawn {
+            *first = BsdfDraw::Failed;
+        }
+        return None;
+    };
     let dir = sp.frame.to_world(x.wi);
     let escaped = vis.escapes(dir);
-    if first.is_none() {
-        *first = Some(DrawnBsdf {
+    if *first == BsdfDraw::NotDrawn {
+        *first = BsdfDraw::Drawn(DrawnBsdf {
             sample: x,
             dir,
             escaped,
