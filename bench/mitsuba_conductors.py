@@ -1,6 +1,6 @@
 """Print the RGB (eta, k) that Mitsuba 3's RGB variants use for each named
 conductor of `roughconductor` (the table `CONDUCTORS` in
-crates/lobe-py/src/mitsuba.rs). Needs `pip install mitsuba`; not run by CI.
+crates/lobe/src/ior.rs). Needs `pip install mitsuba`; not run by CI.
 
     python3 bench/mitsuba_conductors.py
 """

@@ -226,6 +226,19 @@ pub fn refuse_transmission(m: &lobe::Material, command: &str) -> Result<()> {
     Ok(())
 }
 
+/// Refuse a material whose scattering is all delta (a smooth mirror,
+/// smooth or thin glass) for a figure of densities (`plot`, `report`): it
+/// has no curve, no histogram and no weight map to draw.
+pub fn refuse_all_delta(m: &lobe::Material, wo: glam::DVec3) -> Result<()> {
+    if m.reach().delta && lobe::experiment::polar::albedo(m, wo) == 0.0 {
+        bail!(
+            "--material: {} scatters only into single directions (delta lobes: a mirror reflection, smooth refraction), which have no density to draw or to test; `lobe estimate` and `lobe eval` take it",
+            m.model_name()
+        );
+    }
+    Ok(())
+}
+
 /// [`warn_energy_gain`] for every object of a scene loaded from `path`,
 /// named by its place among the file's `[[object]]` tables.
 pub fn warn_scene_energy_gain(scene: &lobe_render::Scene, path: &std::path::Path) {

@@ -10,6 +10,10 @@
 //!   of `lobe::stats::chi2`.
 //! * `weights`: the sample weight `f·cos/pdf` over the projected hemisphere.
 //!
+//! Where the material transmits (or is seen from below) the figures cover
+//! the whole sphere: the polar plot goes round the full circle, the maps
+//! are two disks, above and below the surface.
+//!
 //! The figures themselves are drawn by [`crate::figures`].
 
 use crate::common::load_material;
@@ -41,6 +45,9 @@ const MAX_RES: usize = 1024;
         weights    the sample weight f·cos θi/pdf over the projected hemisphere,\n             \
         directions never sampled in red                       -> weights-<STRATEGY>.png\n  \
         all        the three\n\
+        Glass and other materials that transmit (and two-sided ones seen from below, --theta\n\
+        above 90): the polar plot goes round the full circle, the maps cover both hemispheres.\n\
+        Delta lobes (smooth glass, mirrors, plastic's coating) have no density and are not drawn.\n\
         Prints the paths it wrote, one per line; the chi-square result goes to stderr.",
     after_help = "Examples:\n  \
         lobe plot --material '{\"type\":\"cook-torrance\",\"alpha\":0.3}' --theta 60 --strategy vndf --out figs\n  \
@@ -113,13 +120,17 @@ pub fn run(args: &PlotArgs) -> Result<()> {
         .parse()
         .map_err(|e| anyhow!("--scale {}: {e}", args.scale))?;
     let material = load_material(&args.material)?;
-    crate::common::refuse_transmission(&material, "plot")?;
-    // The figures are drawn over the hemisphere of the normal (transmitted
-    // lobes and views from inside: issue 42's next step).
-    let wo = args.view.wo(&lobe::Material::lambert(lobe::Rgb::ONE)?)?;
+    // Over the whole sphere where the material transmits or is seen from
+    // below (two-sided): the polar plot round the full circle, the maps
+    // as two disks, one per hemisphere.
+    let wo = args.view.wo(&material)?;
     if (args.fit.is_some() || args.against.is_some()) && !kinds.contains(&Kind::Polar) {
         bail!("--fit and --against draw polar figures: use --kind polar or all");
     }
+    if args.fit.is_some() || args.against.is_some() {
+        crate::common::refuse_transmission(&material, "plot --fit or --against")?;
+    }
+    crate::common::refuse_all_delta(&material, wo)?;
     let needs_strategy = kinds.iter().any(|&k| k != Kind::Polar);
     let strategy = match (&args.strategy, needs_strategy) {
         (Some(s), _) => {
@@ -202,7 +213,7 @@ pub fn run(args: &PlotArgs) -> Result<()> {
             Kind::Weights => {
                 let s = strategy.expect("checked above");
                 let path = args.out.join(format!("weights-{s}.png"));
-                let title = format!("{label}, {s}, {view}: sample weight f·cos θi / pdf");
+                let title = format!("{label}, {s}, {view}: sample weight f·|cos θi| / pdf");
                 figures::weight_heatmap(&path, &title, &material.sampler(s)?, wo, args.res)?;
                 println!("{}", path.display());
             }
@@ -304,14 +315,7 @@ fn histogram(
             .map(|m| format!(" ({m})"))
             .unwrap_or_default()
     );
-    figures::warp_histogram(
-        path,
-        title,
-        &h.observed,
-        &h.expected,
-        args.res,
-        result.p_value,
-    )
+    figures::warp_histogram(path, title, &h.observed, &h.expected, h.res, result.p_value)
 }
 
 /// The material `--fit` fits or `--against` names, and how to call it.

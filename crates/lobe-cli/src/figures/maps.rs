@@ -4,8 +4,8 @@
 
 use crate::draw::{
     DIM_TEXT, DResult, Figure, OUTLINE, Orientation, TEXT, colorbar_extent, draw_colorbar,
-    draw_title, fmt_num, fmt_p, linear_ticks, log_ticks, put_text, save_figure, text_width,
-    viridis,
+    draw_title, fit_size, fmt_num, fmt_p, linear_ticks, log_ticks, put_text, save_figure,
+    text_width, viridis,
 };
 use anyhow::{Result, bail};
 use glam::{DVec2, DVec3};
@@ -16,11 +16,23 @@ use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, VPos};
 use std::path::Path;
 
-/// Size in pixels of a warp-test histogram (two maps side by side).
+/// Size in pixels of a warp-test histogram (two maps side by side; two rows
+/// of them over the sphere).
 const HISTOGRAM_SIZE: (u32, u32) = (800, 400);
+const HISTOGRAM_SPHERE_SIZE: (u32, u32) = (800, 740);
 
-/// Size in pixels of a sample-weight heat map.
+/// Size in pixels of a sample-weight heat map (one disk; two side by side
+/// over the sphere).
 const WEIGHTS_SIZE: (u32, u32) = (640, 600);
+const WEIGHTS_SPHERE_SIZE: (u32, u32) = (1000, 560);
+
+/// The names of the disks of a map over the sphere.
+const HEMISPHERES: [&str; 2] = ["above the surface", "below the surface"];
+
+/// How many disks (1, or 2 over the sphere) `len` values of `res²` make.
+fn disks(len: usize, res: usize) -> Option<usize> {
+    [1, 2].into_iter().find(|d| len == d * res * res)
+}
 
 /// Significance level of the pass/fail word of [`warp_histogram`]: the test
 /// passes when `p_value > PASS_LEVEL` (Nori's warp test uses 1 %).
@@ -33,7 +45,8 @@ pub const PASS_LEVEL: f64 = 0.01;
 /// appended to `title`.
 ///
 /// `observed` and `expected` are `res × res` grids laid out as
-/// [`lobe::experiment::histogram::projected_histograms`] returns them.
+/// [`lobe::experiment::histogram::projected_histograms`] returns them, or
+/// two each over the sphere (drawn as a second row, below the surface).
 ///
 /// Writes an SVG if `path` ends in `.svg`, a PNG (800×400) if `.png`.
 ///
@@ -49,9 +62,9 @@ pub fn warp_histogram(
     res: usize,
     p_value: f64,
 ) -> Result<()> {
-    if res == 0 || observed.len() != res * res || expected.len() != res * res {
+    if res == 0 || disks(observed.len(), res).is_none() || observed.len() != expected.len() {
         bail!(
-            "warp_histogram: the grids must hold res² = {}² values (got {} and {})",
+            "warp_histogram: the grids must hold res² = {}² values, or twice that over the sphere (got {} and {})",
             res,
             observed.len(),
             expected.len()
@@ -103,6 +116,7 @@ pub fn weight_heatmap(
             pixels: &pixels,
             res,
             mirror: DVec2::new(-wo.x, -wo.y),
+            mirror_below: wo.z < 0.0,
         },
     )
 }
@@ -224,7 +238,11 @@ struct WarpHistogram<'a> {
 
 impl Figure for WarpHistogram<'_> {
     fn size(&self) -> (u32, u32) {
-        HISTOGRAM_SIZE
+        if self.observed.len() > self.res * self.res {
+            HISTOGRAM_SPHERE_SIZE
+        } else {
+            HISTOGRAM_SIZE
+        }
     }
 
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DResult<DB> {
@@ -251,6 +269,7 @@ impl Figure for WarpHistogram<'_> {
             .fold(0.0, f64::max);
         let vmax = if vmax > 0.0 { vmax } else { 1.0 };
         // Pixels whose centre is in the disk, or that hold any count.
+        let rows = self.observed.len() / (res * res);
         let colors = |grid: &[f64], other: &[f64]| -> Vec<Option<RGBColor>> {
             (0..res * res)
                 .map(|k| {
@@ -269,41 +288,52 @@ impl Figure for WarpHistogram<'_> {
         let ticks = linear_ticks(vmax);
         let bar_w = colorbar_extent(16, &ticks);
         // Room for the tick labels at the left, the gap, and the colour bar.
-        let size =
-            (h as i32 - title_h - label_h - 34).min((w as i32 - 44 - 50 - 24 - bar_w - 8) / 2);
+        let rows_i = rows as i32;
+        let size = ((h as i32 - title_h - rows_i * (label_h + 34)) / rows_i)
+            .min((w as i32 - 44 - 50 - 24 - bar_w - 8) / 2);
         let top = title_h + label_h;
-        let left = MapBox {
-            x0: 44,
-            y0: top,
-            size,
-        };
-        let right = MapBox {
-            x0: left.x0 + size + 50,
-            y0: top,
-            size,
-        };
-        for (b, name, grid, other) in [
-            (left, "observed samples", self.observed, self.expected),
-            (
-                right,
-                "expected (samples × ∫ pdf dω)",
-                self.expected,
-                self.observed,
-            ),
-        ] {
-            put_text(
-                root,
-                name,
-                (b.x0 + size / 2, top - 4),
-                15.0,
-                TEXT,
-                (HPos::Center, VPos::Bottom),
-            )?;
-            draw_disk_map(root, b, res, &colors(grid, other))?;
+        let n = res * res;
+        for (row, hemisphere) in HEMISPHERES.iter().enumerate().take(rows) {
+            let y0 = top + row as i32 * (size + label_h + 34);
+            let left = MapBox { x0: 44, y0, size };
+            let right = MapBox {
+                x0: left.x0 + size + 50,
+                y0,
+                size,
+            };
+            let (obs, exp) = (
+                &self.observed[row * n..(row + 1) * n],
+                &self.expected[row * n..(row + 1) * n],
+            );
+            let side = if rows > 1 {
+                format!(", {hemisphere}")
+            } else {
+                String::new()
+            };
+            for (b, name, grid, other) in [
+                (left, format!("observed samples{side}"), obs, exp),
+                (
+                    right,
+                    format!("expected (samples × ∫ pdf dω){side}"),
+                    exp,
+                    obs,
+                ),
+            ] {
+                put_text(
+                    root,
+                    &name,
+                    (b.x0 + size / 2, y0 - 4),
+                    fit_size(&name, 15.0, size + 40),
+                    TEXT,
+                    (HPos::Center, VPos::Bottom),
+                )?;
+                draw_disk_map(root, b, res, &colors(grid, other))?;
+            }
         }
+        let right_x0 = 44 + size + 50;
         draw_colorbar(
             root,
-            (right.x0 + size + 24, top),
+            (right_x0 + size + 24, top),
             (16, size),
             Orientation::Vertical {
                 name: &format!("samples per pixel ({res}×{res} pixels)"),
@@ -319,11 +349,17 @@ struct WeightMap<'a> {
     pixels: &'a [WeightPixel],
     res: usize,
     mirror: DVec2,
+    /// `wo` is below the surface (its mirror direction too).
+    mirror_below: bool,
 }
 
 impl Figure for WeightMap<'_> {
     fn size(&self) -> (u32, u32) {
-        WEIGHTS_SIZE
+        if self.pixels.len() > self.res * self.res {
+            WEIGHTS_SPHERE_SIZE
+        } else {
+            WEIGHTS_SIZE
+        }
     }
 
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DResult<DB> {
@@ -375,16 +411,37 @@ impl Figure for WeightMap<'_> {
         let (w, h) = root.dim_in_pixel();
         let legend_h = 44;
         let bar_w = colorbar_extent(16, &ticks);
-        let size = (h as i32 - title_h - legend_h - 30).min(w as i32 - 44 - 24 - bar_w - 8);
-        let b = MapBox {
-            x0: 44,
-            y0: title_h + 4,
-            size,
-        };
-        draw_disk_map(root, b, self.res, &colors)?;
+        let n = self.res * self.res;
+        let cols = (self.pixels.len() / n) as i32;
+        let label_h = if cols > 1 { 22 } else { 0 };
+        let size = (h as i32 - title_h - label_h - legend_h - 30)
+            .min((w as i32 - 44 - 24 - bar_w - 8 - (cols - 1) * 50) / cols);
+        let boxes: Vec<MapBox> = (0..cols)
+            .map(|c| MapBox {
+                x0: 44 + c * (size + 50),
+                y0: title_h + 4 + label_h,
+                size,
+            })
+            .collect();
+        for (c, b) in boxes.iter().enumerate() {
+            draw_disk_map(root, *b, self.res, &colors[c * n..(c + 1) * n])?;
+            if cols > 1 {
+                put_text(
+                    root,
+                    HEMISPHERES[c],
+                    (b.x0 + size / 2, b.y0 - 4),
+                    15.0,
+                    TEXT,
+                    (HPos::Center, VPos::Bottom),
+                )?;
+            }
+        }
+        let b = boxes[0];
+        let last = boxes[boxes.len() - 1];
 
-        // The mirror direction of wo.
-        let (mx, my) = b.to_px(self.mirror.x, self.mirror.y);
+        // The mirror direction of wo, on the side of wo.
+        let mb = if self.mirror_below { last } else { b };
+        let (mx, my) = mb.to_px(self.mirror.x, self.mirror.y);
         for (c, wd) in [(BLACK, 4), (WHITE, 2)] {
             root.draw(&PathElement::new(
                 vec![(mx - 7, my), (mx + 7, my)],
@@ -398,10 +455,10 @@ impl Figure for WeightMap<'_> {
 
         draw_colorbar(
             root,
-            (b.x0 + size + 24, b.y0),
+            (last.x0 + size + 24, b.y0),
             (16, size),
             Orientation::Vertical {
-                name: "weight f·cos θi / pdf (log scale)",
+                name: "weight f·|cos θi| / pdf (log scale)",
             },
             &ticks,
         )?;

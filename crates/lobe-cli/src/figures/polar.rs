@@ -16,6 +16,9 @@ use std::path::Path;
 /// Size in pixels of a polar plot.
 const POLAR_SIZE: (u32, u32) = (800, 500);
 
+/// Size of a polar plot round the full circle (a material that transmits).
+const POLAR_FULL_SIZE: (u32, u32) = (800, 820);
+
 /// Draws curves in the plane of incidence on one polar plot: the upper half
 /// disk, the angle θi measured from the normal (straight up), negative
 /// angles on the mirror side (left), positive on the viewer's side (right),
@@ -86,7 +89,11 @@ const POLAR_LEGEND_ROW_H: i32 = 22;
 
 impl Figure for Polar<'_> {
     fn size(&self) -> (u32, u32) {
-        POLAR_SIZE
+        if self.curves.full_circle {
+            POLAR_FULL_SIZE
+        } else {
+            POLAR_SIZE
+        }
     }
 
     #[allow(clippy::too_many_lines)]
@@ -136,22 +143,29 @@ impl Figure for Polar<'_> {
         )?;
 
         // Equal scale in x and y: fit [−1.14, 1.14] × [−0.12, 1.1] under
-        // the legend, centred.
+        // the legend, centred ([−1.1, 1.1] in y round the full circle).
+        let full = self.curves.full_circle;
+        let (y_min, y_span) = if full { (-1.1, 2.2) } else { (-0.12, 1.22) };
         let legend_rows = curves.len().div_ceil(POLAR_LEGEND_COLS) as i32;
         let legend_h = legend_rows * POLAR_LEGEND_ROW_H + 8;
         let area = root.margin(title_h + legend_h, 30, 6, 6);
         let (aw, ah) = area.dim_in_pixel();
-        let s = (f64::from(aw) / 2.28).min(f64::from(ah) / 1.22);
+        let s = (f64::from(aw) / 2.28).min(f64::from(ah) / y_span);
         let half_w = f64::from(aw) / (2.0 * s);
-        let y_lo = -0.12 - 0.5 * (f64::from(ah) / s - 1.22);
+        let y_lo = y_min - 0.5 * (f64::from(ah) / s - y_span);
         let y_hi = y_lo + f64::from(ah) / s;
         let mut chart = ChartBuilder::on(&area).build_cartesian_2d(-half_w..half_w, y_lo..y_hi)?;
+        let limit = if full {
+            std::f64::consts::PI
+        } else {
+            FRAC_PI_2
+        };
 
         let polar = lobe::experiment::polar::figure_xy;
         // Rings, rays and their labels.
         for (i, r) in [0.25, 0.5, 0.75, 1.0].into_iter().enumerate() {
-            let ring: Vec<(f64, f64)> = (0..=180)
-                .map(|k| polar(-FRAC_PI_2 + std::f64::consts::PI * f64::from(k) / 180.0, r))
+            let ring: Vec<(f64, f64)> = (0..=360)
+                .map(|k| polar(-limit + 2.0 * limit * f64::from(k) / 360.0, r))
                 .collect();
             let color = if i == 3 {
                 RGBColor(150, 150, 150)
@@ -167,7 +181,8 @@ impl Figure for Polar<'_> {
                 )))?;
             }
         }
-        for deg in (-75..=75).step_by(15) {
+        let max_deg = if full { 165 } else { 75 };
+        for deg in (-max_deg..=max_deg).step_by(15) {
             let t = f64::from(deg).to_radians();
             let color = if deg % 30 == 0 { GRID } else { LIGHT_GRID };
             chart.draw_series(LineSeries::new(
@@ -175,13 +190,20 @@ impl Figure for Polar<'_> {
                 color.stroke_width(1),
             ))?;
         }
-        for deg in (-90i32..=90).step_by(30) {
+        let label_deg: i32 = if full { 180 } else { 90 };
+        for deg in (-label_deg..=label_deg).step_by(30) {
+            if full && deg == -180 {
+                continue;
+            }
             let t = f64::from(deg).to_radians();
             let label = format!("{deg}°").replace('-', "−");
             let (pos, anchor) = match deg {
                 -90 => ((-1.03, 0.015), (HPos::Right, VPos::Bottom)),
                 90 => ((1.03, 0.015), (HPos::Left, VPos::Bottom)),
                 0 => (polar(t, 1.05), (HPos::Center, VPos::Bottom)),
+                180 => (polar(t, 1.05), (HPos::Center, VPos::Top)),
+                d if d.abs() > 90 && d < 0 => (polar(t, 1.04), (HPos::Right, VPos::Top)),
+                d if d.abs() > 90 => (polar(t, 1.04), (HPos::Left, VPos::Top)),
                 d if d < 0 => (polar(t, 1.04), (HPos::Right, VPos::Bottom)),
                 _ => (polar(t, 1.04), (HPos::Left, VPos::Bottom)),
             };
@@ -197,19 +219,26 @@ impl Figure for Polar<'_> {
             [(-1.12, 0.0), (1.12, 0.0)],
             BLACK.stroke_width(2),
         ))?;
-        chart.draw_series([
-            Text::new(
-                "mirror side (θi < 0)",
-                (-0.55, -0.03),
-                text_style(13.0, DIM_TEXT, HPos::Center, VPos::Top),
-            ),
-            Text::new(
-                "viewer's side (θi > 0)",
-                (0.55, -0.03),
-                text_style(13.0, DIM_TEXT, HPos::Center, VPos::Top),
-            ),
-        ])?;
-        // The ray toward the viewer.
+        let sides = if full {
+            [
+                ("mirror side (θi < 0)", (-0.62, 0.075), VPos::Bottom),
+                ("viewer's side (θi > 0)", (0.62, 0.075), VPos::Bottom),
+                ("below the surface", (-0.62, -0.03), VPos::Top),
+            ]
+        } else {
+            [
+                ("mirror side (θi < 0)", (-0.55, -0.03), VPos::Top),
+                ("viewer's side (θi > 0)", (0.55, -0.03), VPos::Top),
+                ("", (0.0, 0.0), VPos::Top),
+            ]
+        };
+        chart.draw_series(
+            sides
+                .into_iter()
+                .filter(|(t, _, _)| !t.is_empty())
+                .map(|(t, pos, v)| Text::new(t, pos, text_style(13.0, DIM_TEXT, HPos::Center, v))),
+        )?;
+        // The ray toward the viewer (on the viewer's side, above or below).
         let theta_o = self.curves.wo.z.clamp(-1.0, 1.0).acos();
         let view = polar(theta_o, 1.0);
         chart.draw_series(DashedLineSeries::new(
@@ -246,7 +275,7 @@ impl Figure for Polar<'_> {
                 .points
                 .iter()
                 .filter(|(t, _)| t.is_finite())
-                .map(|&(t, v)| polar(t.clamp(-FRAC_PI_2, FRAC_PI_2), radius(v)))
+                .map(|&(t, v)| polar(t.clamp(-limit, limit), radius(v)))
                 .collect();
             if c.kind == CurveKind::Integrand {
                 chart.draw_series(std::iter::once(Polygon::new(

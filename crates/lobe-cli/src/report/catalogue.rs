@@ -124,7 +124,7 @@ pub(super) fn given_models(specs: &[String]) -> Result<Vec<Model>> {
         .map(|(i, spec)| {
             let m =
                 crate::common::load_material(spec).with_context(|| format!("--material {spec}"))?;
-            crate::common::refuse_transmission(&m, "report")
+            crate::common::refuse_all_delta(&m, glam::DVec3::Z)
                 .with_context(|| format!("--material {spec}"))?;
             let vndf = if m.check(BsdfStrategy::Vndf).is_ok() {
                 vec![BsdfStrategy::Vndf]
@@ -165,6 +165,23 @@ pub(super) fn given_models(specs: &[String]) -> Result<Vec<Model>> {
                     .collect::<Vec<_>>()
                     .join(", ")
             );
+            let reach = m.reach();
+            if reach.transmits {
+                intro.push_str(
+                    "<p>It transmits: its integrals (the reference, the variances) are over \
+                     the whole sphere, uniform and cosine sampling draw from the whole sphere, \
+                     the polar plot goes round the full circle with the transmitted lobe below \
+                     the surface line, and the maps show both hemispheres.</p>\n",
+                );
+            }
+            if reach.delta {
+                intro.push_str(
+                    "<p>It has a delta part (a mirror reflection or smooth refraction): its \
+                     light is in the reference and the estimates, BSDF sampling draws it with \
+                     its probability, and the figures of densities leave it out (it has none); \
+                     the warp test counts its samples as lost.</p>\n",
+                );
+            }
             if let Some(t) = m.measured() {
                 let _ = writeln!(
                     intro,

@@ -602,8 +602,9 @@ fn bad_tables_are_one_line_errors_naming_the_file() {
 }
 
 /// `lobe report --material` of a measured RGL table and an analytic
-/// material: one section each, the table's summary, every strategy's row
-/// and every figure beside the page.
+/// material that transmits (rough glass): one section each, the table's
+/// summary, the glass's note, every strategy's row and every figure beside
+/// the page.
 #[test]
 fn report_takes_measured_materials() {
     let f = files();
@@ -616,7 +617,7 @@ fn report_takes_measured_materials() {
             "--material",
             &measured(&f.rgl),
             "--material",
-            ANALYTIC,
+            r#"{"type":"roughdielectric","distribution":"ggx","alpha":0.3}"#,
             "--out",
             out.to_str().unwrap(),
         ],
@@ -627,7 +628,8 @@ fn report_takes_measured_materials() {
     let html = std::fs::read_to_string(out.join("index.html")).unwrap();
     for text in [
         "Material 1: measured (t.bsdf)",
-        "Material 2: cook-torrance",
+        "Material 2: roughdielectric",
+        "It transmits: its integrals",
         "RGL table",
         "relative tolerance 1e-6",
         "<code>brdf</code>",

@@ -165,15 +165,38 @@ fn bad_input_fails_with_one_line() {
         (vec!["--strategy", "vndf", "--theta", "-1"], "--theta"),
         (vec!["--kind", "weights"], "--strategy"),
         (vec!["--strategy", "vndf", "--material", "{"], "material"),
-        // Glass is not drawn yet: refused by name, not half drawn.
+        // Smooth glass and mirrors have only delta lobes: no density to
+        // draw, refused by name rather than drawn empty.
         (
             vec![
+                "--strategy",
+                "brdf",
                 "--material",
-                r#"{"type":"roughdielectric","distribution":"ggx"}"#,
+                r#"{"type":"dielectric"}"#,
+            ],
+            "only into single directions",
+        ),
+        (
+            vec![
+                "--strategy",
+                "brdf",
+                "--material",
+                r#"{"type":"conductor"}"#,
+            ],
+            "only into single directions",
+        ),
+        // Fits and comparisons are of reflection.
+        (
+            vec![
+                "--kind",
+                "polar",
+                "--material",
+                r#"{"type":"roughdielectric"}"#,
+                "--against",
+                GGX,
             ],
             "transmits",
         ),
-        (vec!["--material", r#"{"type":"plastic"}"#], "delta part"),
         (vec!["--strategy", "vndf", "--out", under_file], "--out"),
     ];
     for (extra, needle) in cases {
@@ -338,4 +361,57 @@ fn polar_draws_a_material_against_another() {
         err.contains("--fit and --against draw polar figures"),
         "{err}"
     );
+}
+
+/// Glass and a two-sided material seen from below: the polar plot goes
+/// round the full circle (a taller figure, with ink below the surface
+/// line), the maps show both hemispheres (wider or taller figures), and
+/// the warp test passes over the sphere.
+#[test]
+fn glass_and_views_from_below_are_drawn_over_the_sphere() {
+    for (material, theta, strategy) in [
+        (
+            r#"{"type":"roughdielectric","distribution":"ggx","alpha":0.3}"#,
+            "40",
+            "vndf",
+        ),
+        (r#"{"type":"roughdielectric","alpha":0.3}"#, "150", "brdf"),
+        (r#"{"type":"roughplastic","alpha":0.2}"#, "30", "vndf"),
+        (
+            r#"{"type":"twosided","material":{"type":"roughconductor","alpha":0.3}}"#,
+            "120",
+            "vndf",
+        ),
+    ] {
+        let dir = fresh_dir(&format!("plot-sphere-{theta}-{strategy}"));
+        let d = dir.to_str().unwrap();
+        let out = lobe(&[
+            "plot",
+            "-q",
+            "--material",
+            material,
+            "--theta",
+            theta,
+            "--strategy",
+            strategy,
+            "--samples",
+            "100000",
+            "--res",
+            "32",
+            "--out",
+            d,
+        ]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(out.status.success(), "{material} {theta}: {err}");
+        assert!(err.contains("pass at 1%"), "{material} {theta}: {err}");
+        let sphere = !material.contains("plastic");
+        let (polar, hist, weights) = if sphere {
+            ((800, 820), (800, 740), (1000, 560))
+        } else {
+            ((800, 500), (800, 400), (640, 600))
+        };
+        check_png(&dir.join("polar.png"), polar);
+        check_png(&dir.join(format!("histogram-{strategy}.png")), hist);
+        check_png(&dir.join(format!("weights-{strategy}.png")), weights);
+    }
 }

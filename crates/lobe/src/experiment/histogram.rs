@@ -6,6 +6,11 @@
 //! Grids are `res × res`, row-major: pixel `(i, j)` at index `j * res + i`
 //! covers `x ∈ [−1 + 2i/res, −1 + 2(i+1)/res)` and likewise `y` with `j`, so
 //! row 0 is the bottom (`y = −1`).
+//!
+//! Over the whole sphere ([`over_sphere`]: the material transmits, or is
+//! seen from below), a map is two such grids, `2 res²` values: the upper
+//! hemisphere's (`z > 0`), then the lower one's (`z < 0`), each the
+//! projection of its hemisphere on the unit disk.
 
 use super::map_indices;
 use crate::math::luminance;
@@ -15,7 +20,8 @@ use glam::{DVec2, DVec3};
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64;
 
-/// Observed and expected sample counts over a `res × res` grid.
+/// Observed and expected sample counts over a `res × res` grid (two, one
+/// per hemisphere, over the sphere).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Histograms {
     /// Samples that fell in each pixel.
@@ -24,6 +30,24 @@ pub struct Histograms {
     pub expected: Vec<f64>,
     /// The grid's side.
     pub res: usize,
+    /// Two grids, the upper hemisphere's then the lower one's
+    /// ([`over_sphere`]).
+    pub sphere: bool,
+}
+
+/// Whether the maps of `m` at `wo` cover the whole sphere, two disks: it
+/// transmits, or it is seen from below (a two-sided material, whose lobe is
+/// then below).
+#[must_use]
+pub fn over_sphere(m: &Material, wo: DVec3) -> bool {
+    m.reach().transmits || wo.z < 0.0
+}
+
+/// The direction at disk point `c` (inside the unit disk) of hemisphere
+/// `k` (0 upper, 1 lower).
+fn disk_direction(c: DVec2, k: usize) -> DVec3 {
+    let z = (1.0 - c.length_squared()).max(0.0).sqrt();
+    DVec3::new(c.x, c.y, if k == 0 { z } else { -z })
 }
 
 /// The pixel column (or row) of a `res`-pixel side holding coordinate
@@ -39,9 +63,11 @@ pub fn disk_cell(x: f64, res: usize) -> usize {
 }
 
 /// Observed and expected sample counts of `sampler.sample(wo, ..)`
-/// over a `res × res` grid on the projected hemisphere (layout in the
-/// [module docs](self); `res` below 1 is taken as 1). Pixels outside the
-/// disk hold zero.
+/// over a `res × res` grid on the projected hemisphere, or two over the
+/// sphere ([`over_sphere`]; layout in the [module docs](self); `res` below 1
+/// is taken as 1). Pixels outside the disk hold zero. Samples of a delta
+/// part (a mirror reflection, smooth refraction) have no density to compare
+/// with: they fall in no pixel, like failed samples.
 ///
 /// The observed counts come from `samples` draws with the uniforms `uc`,
 /// `u.x`, `u.y` taken in that order from `Pcg64::seed_from_u64(seed)`, the
@@ -66,15 +92,21 @@ pub fn projected_histograms(
     const STEP: usize = 1 << 16;
     progress.start("histogram", samples as u64);
     let res = res.max(1);
-    let mut observed = vec![0.0; res * res];
+    let sphere = over_sphere(sampler.material(), wo);
+    let disks = if sphere { 2 } else { 1 };
+    let mut observed = vec![0.0; disks * res * res];
     let mut rng = Pcg64::seed_from_u64(seed);
     for n in 0..samples {
         let uc: f64 = rng.random();
         let ux: f64 = rng.random();
         let uy: f64 = rng.random();
-        if let Some(s) = sampler.sample(wo, uc, DVec2::new(ux, uy)) {
+        if let Some(s) = sampler.sample(wo, uc, DVec2::new(ux, uy))
+            && !s.scattering.is_specular()
+            && (sphere || s.wi.z >= 0.0)
+        {
             let (i, j) = (disk_cell(s.wi.x, res), disk_cell(s.wi.y, res));
-            observed[j * res + i] += 1.0;
+            let k = usize::from(s.wi.z < 0.0);
+            observed[k * res * res + j * res + i] += 1.0;
         }
         if (n + 1) % STEP == 0 {
             progress.advance(STEP as u64);
@@ -90,7 +122,8 @@ pub fn projected_histograms(
     let h = 2.0 / res as f64;
     let hs = h / sub as f64;
     let n = samples as f64;
-    let expected = map_indices(res * res, |k| {
+    let expected = map_indices(disks * res * res, |k| {
+        let (disk, k) = (k / (res * res), k % (res * res));
         let (i, j) = (k % res, k / res);
         let mut acc = 0.0;
         for b in 0..sub {
@@ -106,8 +139,7 @@ pub fn projected_histograms(
                 if r > 1.0 - 1e-7 {
                     c *= (1.0 - 1e-7) / r;
                 }
-                let wi = DVec3::new(c.x, c.y, (1.0 - c.length_squared()).max(0.0).sqrt());
-                let p = sampler.pdf(wo, wi);
+                let p = sampler.pdf(wo, disk_direction(c, disk));
                 if p.is_finite() && p > 0.0 {
                     acc += p * omega;
                 }
@@ -119,6 +151,7 @@ pub fn projected_histograms(
         observed,
         expected,
         res,
+        sphere,
     }
 }
 
@@ -196,14 +229,17 @@ pub enum WeightPixel {
     Weight(f64),
 }
 
-/// The sample weight `f·cos θi / pdf` (cosine included; `f` is the
+/// The sample weight `f·|cos θi| / pdf` (cosine included; `f` is the
 /// luminance of the material's `eval`) that `sampler` gives the direction at the
-/// centre of each pixel of a `res × res` grid over the projected hemisphere
-/// (layout in the [module docs](self)). `res` must be at least 1.
+/// centre of each pixel of a `res × res` grid over the projected hemisphere,
+/// or two over the sphere ([`over_sphere`]; layout in the
+/// [module docs](self)). `res` must be at least 1.
 #[must_use]
 pub fn weight_pixels(sampler: &BsdfSampler<'_>, wo: DVec3, res: usize) -> Vec<WeightPixel> {
     let material = sampler.material();
-    map_indices(res * res, |k| {
+    let disks = if over_sphere(material, wo) { 2 } else { 1 };
+    map_indices(disks * res * res, |k| {
+        let (disk, k) = (k / (res * res), k % (res * res));
         let (i, j) = (k % res, k / res);
         let x = -1.0 + (i as f64 + 0.5) * 2.0 / res as f64;
         let y = -1.0 + (j as f64 + 0.5) * 2.0 / res as f64;
@@ -211,7 +247,7 @@ pub fn weight_pixels(sampler: &BsdfSampler<'_>, wo: DVec3, res: usize) -> Vec<We
         if r2 >= 1.0 {
             return WeightPixel::Outside;
         }
-        let wi = DVec3::new(x, y, (1.0 - r2).sqrt());
+        let wi = disk_direction(DVec2::new(x, y), disk);
         let f = luminance(material.eval(wo, wi));
         let pdf = sampler.pdf(wo, wi);
         if f.is_nan() || f <= 0.0 {
@@ -219,7 +255,7 @@ pub fn weight_pixels(sampler: &BsdfSampler<'_>, wo: DVec3, res: usize) -> Vec<We
         } else if pdf.is_nan() || pdf <= 0.0 {
             WeightPixel::Unsampled
         } else {
-            WeightPixel::Weight(f * wi.z / pdf)
+            WeightPixel::Weight(f * wi.z.abs() / pdf)
         }
     })
 }

@@ -12,13 +12,19 @@
 //! warp-test histogram, the weight heat map, `x` to the right) and the
 //! fit's incidence-plane plot ([`crate::fit::incidence_plane`]) do.
 //!
+//! Where the material transmits, or is seen from below (two-sided), the
+//! curves go round the whole circle ([`PolarCurves::full_circle`]): `θi`
+//! from −π to π, the directions below the surface at `|θi| > π/2`, so that
+//! the transmitted lobe is drawn under the surface line. Delta parts (a
+//! mirror reflection, smooth refraction) have no density and no curve.
+//!
 //! Two kinds of curve share one unit, 1/sr, so they can be drawn over the
 //! same axes: the integrand of the furnace estimate divided by its integral,
 //! `f·cos θi / albedo` (the density of a zero-variance sampler), and the pdf
 //! in solid angle of a BSDF strategy. Where a strategy's pdf is much lower
 //! than the integrand, the few samples that land there carry large weights.
 
-use crate::estimator::{ShadingPoint, reference};
+use crate::estimator::{ShadingPoint, delta_reference, reference};
 use crate::math::luminance;
 use crate::{BsdfStrategy, Error, Light, Material, Rgb};
 use glam::DVec3;
@@ -26,7 +32,8 @@ use glam::DVec3;
 /// Relative tolerance of the quadrature albedo of [`integrand`].
 pub const ALBEDO_TOLERANCE: f64 = 1e-6;
 
-/// Points of a curve by default: 0.25° apart from −90° to 90°.
+/// Points of a curve by default: 0.25° apart from −90° to 90° (twice as
+/// many round the full circle).
 pub const DEFAULT_STEPS: usize = 720;
 
 /// What a [`PolarCurve`] shows.
@@ -44,7 +51,8 @@ pub enum CurveKind {
 pub struct PolarCurve {
     /// What the values are.
     pub kind: CurveKind,
-    /// `(θi in radians, value in 1/sr)`, θi increasing from −π/2 to π/2.
+    /// `(θi in radians, value in 1/sr)`, θi increasing from −π/2 to π/2
+    /// (−π to π round the full circle).
     pub points: Vec<(f64, f64)>,
 }
 
@@ -81,6 +89,9 @@ pub struct PolarCurves {
     pub integrand: PolarCurve,
     /// One pdf per strategy asked for, in the order asked.
     pub pdfs: Vec<PolarCurve>,
+    /// The curves go round the whole circle (the material transmits, or is
+    /// seen from below), not over the upper half only.
+    pub full_circle: bool,
 }
 
 impl PolarCurves {
@@ -91,13 +102,26 @@ impl PolarCurves {
     }
 }
 
-/// The signed angles of `steps + 1` points from −π/2 to π/2 (radians).
+/// The signed angles of `steps + 1` points from −π/2 to π/2 (radians), or
+/// with `full_circle` of `2 steps + 1` points from −π to π.
 #[must_use]
-pub fn angles(steps: usize) -> Vec<f64> {
+pub fn angles(steps: usize, full_circle: bool) -> Vec<f64> {
     let steps = steps.max(1);
-    (0..=steps)
-        .map(|i| (-90.0 + 180.0 * i as f64 / steps as f64).to_radians())
+    let (n, half) = if full_circle {
+        (2 * steps, 180.0)
+    } else {
+        (steps, 90.0)
+    };
+    (0..=n)
+        .map(|i| (-half + 2.0 * half * i as f64 / n as f64).to_radians())
         .collect()
+}
+
+/// Whether the curves of `m` at `wo` go round the whole circle: it
+/// transmits, or it is seen from below.
+#[must_use]
+pub fn full_circle(m: &Material, wo: DVec3) -> bool {
+    m.reach().transmits || wo.z < 0.0
 }
 
 /// Where a polar figure draws the point at signed angle `theta_i` (radians)
@@ -125,22 +149,24 @@ pub fn plane_direction(wo: DVec3, theta_i: f64) -> DVec3 {
     DVec3::new(s * cx, s * cy, theta_i.cos()).normalize()
 }
 
-/// The directional albedo `∫ f cos θi dω` at `wo` (luminance; the cosine is
-/// included), by adaptive quadrature to [`ALBEDO_TOLERANCE`].
+/// The directional albedo `∫ f |cos θi| dω` at `wo` of the material's
+/// density (luminance; the cosine is included; over the sphere where it
+/// transmits), by adaptive quadrature to [`ALBEDO_TOLERANCE`]: delta parts
+/// (a mirror reflection, smooth refraction), which have no curve, are left
+/// out, so that the integrand of [`integrand`] integrates to 1.
 #[must_use]
 pub fn albedo(m: &Material, wo: DVec3) -> f64 {
-    luminance(reference(
-        m,
-        &ShadingPoint::local(wo),
-        &Light::Constant(Rgb::ONE),
-        ALBEDO_TOLERANCE,
-    ))
+    let sp = ShadingPoint::local(wo);
+    let light = Light::Constant(Rgb::ONE);
+    luminance(reference(m, &sp, &light, ALBEDO_TOLERANCE) - delta_reference(m, &sp, &light))
 }
 
-/// `f·cos θi / albedo` (luminance, cosine included) at `steps + 1` angles,
-/// given the albedo; zero everywhere when the albedo is not positive.
+/// `f·|cos θi| / albedo` (luminance, cosine included) at the [`angles`]
+/// of `steps` ([`full_circle`] where it applies), given the albedo; zero
+/// everywhere when the albedo is not positive.
 #[must_use]
 pub fn integrand(m: &Material, wo: DVec3, albedo: f64, steps: usize) -> PolarCurve {
+    let full = full_circle(m, wo);
     let scale = if albedo > 0.0 && albedo.is_finite() {
         1.0 / albedo
     } else {
@@ -148,18 +174,20 @@ pub fn integrand(m: &Material, wo: DVec3, albedo: f64, steps: usize) -> PolarCur
     };
     PolarCurve {
         kind: CurveKind::Integrand,
-        points: angles(steps)
+        points: angles(steps, full)
             .into_iter()
             .map(|t| {
                 let wi = plane_direction(wo, t);
-                (t, luminance(m.eval(wo, wi)) * wi.z.max(0.0) * scale)
+                let cos = if full { wi.z.abs() } else { wi.z.max(0.0) };
+                (t, luminance(m.eval(wo, wi)) * cos * scale)
             })
             .collect(),
     }
 }
 
-/// The pdf in solid angle of `strategy` at `steps + 1` angles. The error
-/// says why the strategy does not apply to `m`.
+/// The pdf in solid angle of `strategy` at the [`angles`] of `steps`
+/// ([`full_circle`] where it applies). The error says why the strategy does
+/// not apply to `m`.
 pub fn pdf(
     m: &Material,
     strategy: BsdfStrategy,
@@ -169,7 +197,7 @@ pub fn pdf(
     let sampler = m.sampler(strategy)?;
     Ok(PolarCurve {
         kind: CurveKind::Pdf(strategy),
-        points: angles(steps)
+        points: angles(steps, full_circle(m, wo))
             .into_iter()
             .map(|t| (t, sampler.pdf(wo, plane_direction(wo, t))))
             .collect(),
@@ -195,6 +223,7 @@ pub fn curves(
         albedo: a,
         integrand: integrand(m, wo, a, steps),
         pdfs,
+        full_circle: full_circle(m, wo),
     })
 }
 
@@ -293,6 +322,64 @@ mod tests {
     }
 
     #[cfg(feature = "desc")]
+    /// Rough glass at the normal: the curves go round the full circle,
+    /// the integrand integrates to 1 over the sphere (both sides' halves,
+    /// up to θ = π), most of it below the surface, and each pdf to the
+    /// fraction of its samples that are kept.
+    #[cfg(feature = "desc")]
+    #[test]
+    fn glass_goes_round_the_full_circle_and_integrates_to_one() {
+        let m = Material::load(r#"{"type":"roughdielectric","distribution":"ggx","alpha":0.3}"#)
+            .unwrap();
+        let c = curves(
+            &m,
+            DVec3::Z,
+            &[BsdfStrategy::Uniform, BsdfStrategy::Vndf],
+            DEFAULT_STEPS,
+        )
+        .unwrap();
+        assert!(c.full_circle);
+        assert_eq!(c.integrand.points.len(), 2 * DEFAULT_STEPS + 1);
+        let (first, last) = (
+            c.integrand.points[0].0,
+            c.integrand.points[2 * DEFAULT_STEPS].0,
+        );
+        assert!(
+            (first + std::f64::consts::PI).abs() < 1e-12
+                && (last - std::f64::consts::PI).abs() < 1e-12
+        );
+        let whole = |curve: &PolarCurve| {
+            0.5 * (hemisphere_integral(curve, 1.0) + hemisphere_integral(curve, -1.0))
+        };
+        let i = whole(&c.integrand);
+        assert!((i - 1.0).abs() < 2e-3, "integrand over the sphere: {i}");
+        let below: f64 = c
+            .integrand
+            .points
+            .iter()
+            .filter(|p| p.0.abs() > std::f64::consts::FRAC_PI_2)
+            .map(|p| p.1)
+            .sum();
+        let above: f64 = c
+            .integrand
+            .points
+            .iter()
+            .filter(|p| p.0.abs() < std::f64::consts::FRAC_PI_2)
+            .map(|p| p.1)
+            .sum();
+        assert!(below > 5.0 * above, "below {below}, above {above}");
+        let uniform = whole(&c.pdfs[0]);
+        assert!(
+            (uniform - 1.0).abs() < 1e-3,
+            "uniform over the sphere: {uniform}"
+        );
+        let vndf = whole(&c.pdfs[1]);
+        assert!(vndf > 0.9 && vndf < 1.0 + 1e-3, "vndf: {vndf}");
+        // Smooth glass has no density: the albedo of its curves is 0.
+        let smooth = Material::load(r#"{"type":"dielectric"}"#).unwrap();
+        assert_eq!(albedo(&smooth, DVec3::Z), 0.0);
+    }
+
     #[test]
     fn the_peak_is_on_the_mirror_side_and_strategies_are_checked() {
         let m = ggx(0.1);

@@ -31,7 +31,8 @@ pub fn chi2_config(m: &Material) -> Chi2Settings {
 /// What [`warp_test`] found.
 #[derive(Debug, Clone, PartialEq)]
 pub struct WarpTest {
-    /// The draws and the expected counts over the projected hemisphere.
+    /// The draws and the expected counts over the projected hemisphere
+    /// (both hemispheres where the material transmits).
     pub histograms: Histograms,
     /// The chi-square test over the sphere.
     pub chi2: Chi2Result,
@@ -65,7 +66,12 @@ pub fn warp_test(
             if drawn.fetch_add(1, Ordering::Relaxed) % STEP == STEP - 1 {
                 progress.advance(STEP);
             }
-            sampler.sample(wo, uc, u).map(|x| x.wi)
+            // A delta part has no density: its samples count as lost, as
+            // the pdf leaves them out.
+            sampler
+                .sample(wo, uc, u)
+                .filter(|x| !x.scattering.is_specular())
+                .map(|x| x.wi)
         },
         |wi| {
             // The first pdf call starts the cubature of the expected counts.
