@@ -334,8 +334,10 @@ fn showcase_caption(s: &CompareSettings) -> Vec<String> {
             s.max_depth
         ),
         "brdf samples the BSDF only: it rarely finds the small sun, so the ground shows the blue sky with sun fireflies.".to_string(),
-        "light samples the sky and sun only: clean on the diffuse ground, noisy on glossy lobes, worst on sharp gold; it never hits a delta lobe, so smooth glass and the mirror fall back to brdf.".to_string(),
-        "mis gives each pixel's draws to BSDF sampling, the balance heuristic or the light, as its pilot finds best. The sparks under the glass are caustics: sunlight through glass, found only when a path from the ground happens to leave through the sphere toward the sun.".to_string(),
+        "light samples the sky and sun only: clean on the diffuse ground, noisy on glossy lobes, worst on sharp gold.".to_string(),
+        "Light samples never hit a delta lobe: on smooth glass and the mirror, light falls back to brdf.".to_string(),
+        "mis gives each pixel's draws to BSDF sampling, the balance heuristic or the light, as its pilot finds best.".to_string(),
+        "The sparks under the glass are caustics: sunlight through the glass, found only when a path from the ground leaves through the sphere toward the sun.".to_string(),
     ]
 }
 

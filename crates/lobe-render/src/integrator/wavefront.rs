@@ -112,6 +112,14 @@ impl<'a> Batch<'a> {
         let mut samplers = Vec::with_capacity(scene.objects.len());
         for (i, o) in scene.objects.iter().enumerate() {
             let m = &o.material;
+            if m.reach().transmits {
+                // Its frames keep the surface's orientation, and its light
+                // samples cross the surface: the scalar loop's.
+                return Err(format!(
+                    "object {i} ({}): glass takes the scalar loop (the batch loop renders opaque materials)",
+                    m.model_name()
+                ));
+            }
             let est = super::object_shading(strategy, m).estimator;
             // The scalar path's BSDF strategy for the object; light sampling
             // only evaluates `f`, which every strategy's kernel gives.

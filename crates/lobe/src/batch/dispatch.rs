@@ -9,6 +9,7 @@
 
 use super::SimdLevel;
 use super::block::{EvalIn, EvalOut, F_ONLY, PDF_ONLY, SampleIn, SampleOut};
+use super::kernel::dielectric::DielectricParams;
 use super::kernel::phong::{BLINN, LectureParams, PHONG};
 use super::kernel::{
     self, BECKMANN, BLINN_PHONG, BOUNDED, BRDF, CAPS, COSINE, CtParams, GGX, Sampled, UNIFORM, VNDF,
@@ -36,6 +37,8 @@ pub(crate) enum Kernel {
         strat: u8,
         p: LectureParams,
     },
+    /// A rough dielectric, GGX, visible normals.
+    Dielectric(DielectricParams),
 }
 
 /// A kernel's parameters, as the block loops run them: one vector of
@@ -111,6 +114,33 @@ impl VecKernel for LectureParams {
         wi: [L::F; 3],
     ) -> ([L::F; 3], L::F) {
         kernel::phong::eval_pdf::<L, A, B>(l, self, wo, wi)
+    }
+}
+
+impl VecKernel for DielectricParams {
+    #[inline(always)]
+    fn two_lobes(&self) -> bool {
+        true
+    }
+    #[inline(always)]
+    fn sample<L: Lanes, const A: u8, const B: u8>(
+        &self,
+        l: L,
+        wo: [L::F; 3],
+        u1: L::F,
+        u2: L::F,
+        uc: L::F,
+    ) -> Sampled<L> {
+        kernel::dielectric::sample(l, self, wo, u1, u2, uc)
+    }
+    #[inline(always)]
+    fn eval_pdf<L: Lanes, const A: u8, const B: u8>(
+        &self,
+        l: L,
+        wo: [L::F; 3],
+        wi: [L::F; 3],
+    ) -> ([L::F; 3], L::F) {
+        kernel::dielectric::eval_pdf(l, self, wo, wi)
     }
 }
 
@@ -568,6 +598,7 @@ macro_rules! instances {
                 _ => unreachable!("BatchSampler::new builds only these"),
             },
             Kernel::Measured(_) => unreachable!("run before the level's dispatch"),
+            Kernel::Dielectric(p) => $f::<_, _, GGX, VNDF>($l, p, $($args),*),
         }
     };
 }

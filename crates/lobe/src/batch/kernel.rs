@@ -57,11 +57,13 @@ pub(crate) const BOUNDED: u8 = 5;
 
 // Kernels in files of their own, children of this module (they share its
 // helpers): the spherical caps and bounded VNDF, the Blinn-Phong NDF, the
-// Phong and Blinn-Phong models.
+// Phong and Blinn-Phong models, the rough dielectric.
 #[path = "blinn_ndf.rs"]
 mod blinn_ndf;
 #[path = "caps.rs"]
 mod caps;
+#[path = "dielectric.rs"]
+pub(crate) mod dielectric;
 #[path = "phong.rs"]
 pub(crate) mod phong;
 

@@ -58,9 +58,16 @@
 //! is refused. (A lecture-form `ks` whose `ks · K` is beyond f32's range is
 //! refused with that reason.)
 //!
+//! Rough dielectrics (rough glass) with GGX, isotropic or anisotropic, by
+//! visible normals: reflection and refraction through the generalized half
+//! vector, seen from either side (`kernel::dielectric`; tested against the
+//! scalar path over the whole sphere in `tests_dielectric.rs`). The rest of
+//! rough dielectric: GGX vndf only (Beckmann, the other strategies and an
+//! index-matched interface take the scalar path).
+//!
 //! Refused with [`BatchError::Unsupported`], the scalar path serving them:
 //! not yet batched: glass, mirrors, plastic and two-sided materials (issue
-//! 42's models; their kernels are issues 42 and 44's work).
+//! 42's models but rough glass; their kernels are issue 44's work).
 //!
 //! Beckmann's visible slopes are drawn as the scalar path draws them (Heitz
 //! and d'Eon 2014: the slope CDF inverted by Newton's method inside a
@@ -562,6 +569,7 @@ impl BatchSampler {
             Kernel::CookTorrance { p, .. } => p.two_lobes,
             Kernel::Measured(k) => k.chooses_lobe(),
             Kernel::Lecture { p, .. } => p.two_lobes,
+            Kernel::Dielectric(_) => true,
         }
     }
 
@@ -864,6 +872,7 @@ fn kernel_for(m: &Material, strategy: BsdfStrategy) -> Result<Kernel, BatchError
                 }
             });
         }
+        Glossy::RoughDielectric(rd) => return dielectric_kernel(rd, strategy),
         #[allow(unreachable_patterns)]
         _ => {
             return unsupported(format!(
@@ -938,6 +947,55 @@ fn kernel_for(m: &Material, strategy: BsdfStrategy) -> Result<Kernel, BatchError
             two_lobes: m.chooses_lobe(strategy),
         },
     })
+}
+
+/// The rough dielectric's kernel: GGX with visible normals; Beckmann, the
+/// other strategies and the index-matched interface (a delta) are scalar
+/// only ("rough dielectric: GGX vndf only" in the module doc).
+fn dielectric_kernel(
+    rd: &crate::models::RoughDielectric,
+    strategy: BsdfStrategy,
+) -> Result<Kernel, BatchError> {
+    let unsupported = |reason: String| Err(BatchError::Unsupported { reason });
+    if rd.eta == 1.0 {
+        return unsupported(
+            "rough dielectric: GGX vndf only; index-matched (η = 1) it is a delta".into(),
+        );
+    }
+    if rd.microfacet.ndf() != Ndf::Ggx {
+        return unsupported("rough dielectric: GGX vndf only (this one is Beckmann)".into());
+    }
+    if strategy != BsdfStrategy::Vndf {
+        return unsupported(format!(
+            "rough dielectric: GGX vndf only (not `{strategy}`)"
+        ));
+    }
+    let (ax, ay) = rd.microfacet.alpha();
+    let c3 = |c: Rgb| [c.x as f32, c.y as f32, c.z as f32];
+    Ok(Kernel::Dielectric(kernel::dielectric::DielectricParams {
+        ct: CtParams {
+            ax: ax as f32,
+            ay: ay as f32,
+            inv_ax: (1.0 / ax) as f32,
+            inv_ay: (1.0 / ay) as f32,
+            inv_pi_axay: (crate::math::INV_PI / (ax * ay)) as f32,
+            fresnel: FresnelP::Schlick {
+                ks_f0: [0.0; 3],
+                ks_1mf0: [0.0; 3],
+            },
+            shadow: Shadow::Separable,
+            guess: &[],
+            has_glossy: true,
+            kd_pi: [0.0; 3],
+            kd_lum: 0.0,
+            two_lobes: false,
+        },
+        eta: rd.eta as f32,
+        inv_eta: (1.0 / rd.eta) as f32,
+        kr: c3(rd.specular_reflectance),
+        kt: c3(rd.specular_transmittance),
+        importance: rd.mode == crate::TransportMode::Importance,
+    }))
 }
 
 /// The kernel of a Phong (`model = PHONG`) or Blinn-Phong material with

@@ -1186,6 +1186,10 @@ fn two_vectors_at_a_time_give_the_same_bits() {
 #[path = "tests_grid.rs"]
 mod grid;
 
+/// The rough dielectric kernel over the sphere.
+#[path = "tests_dielectric.rs"]
+mod dielectric;
+
 /// A zeroed `n`-value slice of `v` starting at a 128-byte boundary plus
 /// `shift` values.
 fn aligned_part(v: &mut Vec<f32>, n: usize, shift: usize) -> &mut [f32] {
