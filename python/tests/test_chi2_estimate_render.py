@@ -162,6 +162,11 @@ def test_ctrl_c_stops_a_render():
         "object": [{"type": "sphere", "center": [0, 0, 0], "radius": 1,
                     "material": {"type": "cook-torrance", "distribution": "ggx", "alpha": 0.3}}],
     }
+    # Python's own Ctrl-C handler, whatever this process inherited: a
+    # process started in the background by a non-interactive shell (a CI
+    # runner's `cmd &`) begins with SIGINT ignored, and Python then installs
+    # no handler, so the signal would never arrive.
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
     timer = threading.Timer(0.5, lambda: os.kill(os.getpid(), signal.SIGINT))
     t0 = time.monotonic()
     timer.start()
@@ -170,6 +175,7 @@ def test_ctrl_c_stops_a_render():
             lobe.render(scene, spp=1 << 18, seed=1)
     finally:
         timer.cancel()
+        signal.signal(signal.SIGINT, previous)
     elapsed = time.monotonic() - t0
     assert elapsed < 10, f"the render went on for {elapsed:.1f} s after Ctrl-C"
     # The package works afterwards.
