@@ -65,6 +65,19 @@ fn mean_se(img: &Image, pixels: &[(usize, usize)], f: impl Fn(Rgb) -> f64) -> (f
     (m, (var / n).sqrt())
 }
 
+/// `a − b`, pixel by pixel.
+fn difference(a: &Image, b: &Image) -> Image {
+    Image {
+        pixels: a
+            .pixels
+            .iter()
+            .zip(&b.pixels)
+            .map(|(x, y)| *x - *y)
+            .collect(),
+        ..a.clone()
+    }
+}
+
 fn furnace_scene(width: u32, height: u32) -> Scene {
     let camera = Camera::new(
         DVec3::new(0.0, 0.0, 3.5),
@@ -254,15 +267,7 @@ fn techniques_agree_pixel_by_pixel() {
         let mut o = opts(method, 32);
         o.seed = 11;
         let img = render(&scene, &o, |_| {});
-        let diff = Image {
-            pixels: img
-                .pixels
-                .iter()
-                .zip(&reference.pixels)
-                .map(|(a, b)| *a - *b)
-                .collect(),
-            ..img.clone()
-        };
+        let diff = difference(&img, &reference);
         let (m, se) = mean_se(&diff, &px, lobe::math::luminance);
         assert!(m.abs() < 4.5 * se, "{method}: mean difference {m} ± {se}");
     }
@@ -328,15 +333,7 @@ fn batch_loop_matches_the_scalar_loop() {
             "{method}: same seed, batch {a} scalar {b}"
         );
         let other = render(&scene, &RenderSettings { seed: 11, ..o }, |_| {});
-        let diff = Image {
-            pixels: other
-                .pixels
-                .iter()
-                .zip(&reference.pixels)
-                .map(|(a, b)| *a - *b)
-                .collect(),
-            ..other.clone()
-        };
+        let diff = difference(&other, &reference);
         let (m, se) = mean_se(&diff, &px, lobe::math::luminance);
         assert!(m.abs() < 4.5 * se, "{method}: mean difference {m} ± {se}");
         assert_eq!(same.stats.camera_rays, reference.stats.camera_rays);

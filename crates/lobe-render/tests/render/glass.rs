@@ -253,15 +253,7 @@ fn strategies_agree_with_glass_and_mis_is_never_much_worse_than_its_parts() {
             for (i, px) in objects.iter().enumerate() {
                 err[i] += squared_error(&img, &reference, px);
             }
-            let diff = Image {
-                pixels: img
-                    .pixels
-                    .iter()
-                    .zip(&reference.pixels)
-                    .map(|(a, b)| *a - *b)
-                    .collect(),
-                ..img.clone()
-            };
+            let diff = difference(&img, &reference);
             let all: Vec<_> = objects.iter().flatten().copied().collect();
             let (m, se) = mean_se(&diff, &all, lobe::math::luminance);
             assert!(
@@ -350,15 +342,7 @@ fn a_failed_bsdf_draw_ends_the_path_whatever_the_strategy() {
                 if a == b {
                     continue;
                 }
-                let diff = Image {
-                    pixels: ia
-                        .pixels
-                        .iter()
-                        .zip(&ib.pixels)
-                        .map(|(x, y)| *x - *y)
-                        .collect(),
-                    ..ia.clone()
-                };
+                let diff = difference(ia, ib);
                 let (m, se) = mean_se(&diff, &px, |p| p.y);
                 assert!(m.abs() < 4.5 * se, "{json}: {a} − {b}: {m} ± {se}");
             }
