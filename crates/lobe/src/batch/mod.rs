@@ -830,21 +830,12 @@ fn kernel_for(m: &Material, strategy: BsdfStrategy) -> Result<Kernel, BatchError
                 ndf: kernel::GGX,
                 strat,
                 p: CtParams {
-                    ax: 1.0,
-                    ay: 1.0,
-                    inv_ax: 1.0,
-                    inv_ay: 1.0,
                     inv_pi_axay: 0.0,
-                    fresnel: FresnelP::Schlick {
-                        ks_f0: [0.0; 3],
-                        ks_1mf0: [0.0; 3],
-                    },
                     shadow: Shadow::Correlated,
-                    guess: &[],
                     has_glossy: false,
                     kd_pi,
                     kd_lum,
-                    two_lobes: false,
+                    ..microfacets_only(1.0, 1.0)
                 },
             });
         }
@@ -949,6 +940,29 @@ fn kernel_for(m: &Material, strategy: BsdfStrategy) -> Result<Kernel, BatchError
     })
 }
 
+/// The microfacets of `(ax, ay)` alone, as [`CtParams`]: a glossy lobe
+/// with no Fresnel term (Schlick with `F0 = 0`), separable shadowing, no
+/// diffuse term and no lobe choice; callers set what differs.
+fn microfacets_only(ax: f64, ay: f64) -> CtParams {
+    CtParams {
+        ax: ax as f32,
+        ay: ay as f32,
+        inv_ax: (1.0 / ax) as f32,
+        inv_ay: (1.0 / ay) as f32,
+        inv_pi_axay: (crate::math::INV_PI / (ax * ay)) as f32,
+        fresnel: FresnelP::Schlick {
+            ks_f0: [0.0; 3],
+            ks_1mf0: [0.0; 3],
+        },
+        shadow: Shadow::Separable,
+        guess: &[],
+        has_glossy: true,
+        kd_pi: [0.0; 3],
+        kd_lum: 0.0,
+        two_lobes: false,
+    }
+}
+
 /// The rough dielectric's kernel: GGX with visible normals; Beckmann, the
 /// other strategies and the index-matched interface (a delta) are scalar
 /// only ("rough dielectric: GGX vndf only" in the module doc).
@@ -973,23 +987,7 @@ fn dielectric_kernel(
     let (ax, ay) = rd.microfacet.alpha();
     let c3 = |c: Rgb| [c.x as f32, c.y as f32, c.z as f32];
     Ok(Kernel::Dielectric(kernel::dielectric::DielectricParams {
-        ct: CtParams {
-            ax: ax as f32,
-            ay: ay as f32,
-            inv_ax: (1.0 / ax) as f32,
-            inv_ay: (1.0 / ay) as f32,
-            inv_pi_axay: (crate::math::INV_PI / (ax * ay)) as f32,
-            fresnel: FresnelP::Schlick {
-                ks_f0: [0.0; 3],
-                ks_1mf0: [0.0; 3],
-            },
-            shadow: Shadow::Separable,
-            guess: &[],
-            has_glossy: true,
-            kd_pi: [0.0; 3],
-            kd_lum: 0.0,
-            two_lobes: false,
-        },
+        ct: microfacets_only(ax, ay),
         eta: rd.eta as f32,
         inv_eta: (1.0 / rd.eta) as f32,
         kr: c3(rd.specular_reflectance),
