@@ -24,6 +24,7 @@
 //! in solid angle of a BSDF strategy. Where a strategy's pdf is much lower
 //! than the integrand, the few samples that land there carry large weights.
 
+use super::histogram::over_sphere;
 use crate::estimator::{ShadingPoint, delta_reference, reference};
 use crate::math::luminance;
 use crate::{BsdfStrategy, Error, Light, Material, Rgb};
@@ -117,11 +118,12 @@ pub fn angles(steps: usize, full_circle: bool) -> Vec<f64> {
         .collect()
 }
 
-/// Whether the curves of `m` at `wo` go round the whole circle: it
-/// transmits, or it is seen from below.
+/// Whether the curves of `m` at `wo` go round the whole circle: where the
+/// maps cover the whole sphere ([`over_sphere`]: it transmits, or it is
+/// seen from below).
 #[must_use]
 pub fn full_circle(m: &Material, wo: DVec3) -> bool {
-    m.reach().transmits || wo.z < 0.0
+    over_sphere(m, wo)
 }
 
 /// Where a polar figure draws the point at signed angle `theta_i` (radians)
