@@ -1186,7 +1186,8 @@ impl Context<'_> {
             };
             let frame = Frame::from_normal(ns);
             let wo = frame.to_local(wo_world);
-            if wo.z <= 0.0 && !(shading.transmits && wo.z < 0.0) {
+            // At the horizon, or below an opaque surface: nothing scatters.
+            if wo.z == 0.0 || (wo.z < 0.0 && !shading.transmits) {
                 break;
             }
             let sp = ShadingPoint { frame, wo };
