@@ -18,10 +18,12 @@ mod eval_batch;
 mod eval_line;
 mod figures;
 mod fit;
+mod furnace;
 mod plot;
 mod render;
 mod report;
 mod tabulate;
+mod tabulate_energy;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -56,7 +58,9 @@ enum Command {
     Compare(compare::CompareArgs),
     Bench(bench::BenchArgs),
     Tabulate(tabulate::TabulateArgs),
+    TabulateEnergy(tabulate_energy::TabulateEnergyArgs),
     Fit(fit::FitArgs),
+    Furnace(furnace::FurnaceArgs),
 }
 
 fn main() -> ExitCode {
@@ -75,7 +79,9 @@ fn main() -> ExitCode {
         Command::Compare(args) => compare::run(&args),
         Command::Bench(args) => bench::run(&args),
         Command::Tabulate(args) => tabulate::run(&args),
+        Command::TabulateEnergy(args) => tabulate_energy::run(&args),
         Command::Fit(args) => fit::run(&args),
+        Command::Furnace(args) => furnace::run(&args),
     });
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -252,6 +252,8 @@ pub struct MaterialDesc {
     pub sample_visible: Option<bool>,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub mode: Option<String>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub multiscatter: Option<String>,
     /// The directory relative paths (`path`) are taken from: the directory
     /// of the file the description was read from; `None` for the working
     /// directory. Not a key.
@@ -290,7 +292,7 @@ impl MaterialDesc {
         self
     }
 
-    pub(crate) fn present_fields(&self) -> [(&'static str, bool); 27] {
+    pub(crate) fn present_fields(&self) -> [(&'static str, bool); 28] {
         [
             ("albedo", self.albedo.is_some()),
             ("ks", self.ks.is_some()),
@@ -322,6 +324,7 @@ impl MaterialDesc {
             ("nonlinear", self.nonlinear.is_some()),
             ("sample_visible", self.sample_visible.is_some()),
             ("mode", self.mode.is_some()),
+            ("multiscatter", self.multiscatter.is_some()),
         ]
     }
 }

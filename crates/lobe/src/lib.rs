@@ -72,6 +72,7 @@ pub mod bsdf_strategy;
 #[cfg(feature = "desc")]
 pub mod desc;
 pub mod envmap;
+pub mod energy;
 pub mod error;
 pub mod estimator;
 pub mod experiment;
@@ -84,6 +85,7 @@ pub mod material;
 pub mod math;
 pub mod microfacet;
 pub mod models;
+pub(crate) mod parallel;
 pub mod progress;
 pub mod sample;
 pub mod sequence;

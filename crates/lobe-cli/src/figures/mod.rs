@@ -1,6 +1,6 @@
 //! Figures drawn with plotters: convergence plots, polar plots of a BRDF,
-//! warp-test histograms, sample-weight heat maps, and a material against
-//! its fit.
+//! warp-test histograms, sample-weight heat maps, a material against
+//! its fit, and the white furnace.
 //!
 //! Every function writes one file and chooses the format from its extension:
 //! `.png` (a bitmap at a size meant to be read on screen) or `.svg`. The text
@@ -14,11 +14,13 @@
 
 mod convergence;
 mod fit;
+mod furnace;
 mod maps;
 mod polar;
 
 pub use convergence::{Series, convergence_plot};
 pub use fit::{fit_curves_plot, fit_polar_plot};
+pub use furnace::furnace_plot;
 pub use maps::{PASS_LEVEL, warp_histogram, weight_heatmap};
 pub use polar::{PolarScale, polar_plot};
 

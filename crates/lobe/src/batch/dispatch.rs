@@ -30,7 +30,7 @@ pub(crate) enum Kernel {
     /// kernel's const parameters).
     CookTorrance { ndf: u8, strat: u8, p: CtParams },
     /// A measured table (per lane, the same at every level: `super::measured`).
-    Measured(super::measured::MeasuredKernel),
+    Measured(Box<super::measured::MeasuredKernel>),
     /// Phong or Blinn-Phong (`model`: `PHONG`, `BLINN`) with strategy `strat`.
     Lecture {
         model: u8,

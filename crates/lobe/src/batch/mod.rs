@@ -818,6 +818,12 @@ fn kernel_for(m: &Material, strategy: BsdfStrategy) -> Result<Kernel, BatchError
     let kd_pi = c3(kd * crate::math::INV_PI);
     let kd_lum = crate::math::luminance(kd) as f32;
     let lobe = match &m.glossy {
+        Glossy::CookTorrance(lobe) if lobe.multiscatter != crate::energy::Multiscatter::None => {
+            return unsupported(format!(
+                "not yet batched: energy compensation (multiscatter {})",
+                lobe.multiscatter.kind()
+            ));
+        }
         Glossy::CookTorrance(lobe) => *lobe,
         Glossy::None => {
             // A Lambertian material: cosine-weighted (uniform for uniform).
@@ -841,7 +847,7 @@ fn kernel_for(m: &Material, strategy: BsdfStrategy) -> Result<Kernel, BatchError
         }
         Glossy::Measured(lobe) => {
             return match measured::MeasuredKernel::new(m, lobe, strategy) {
-                Some(k) => Ok(Kernel::Measured(k)),
+                Some(k) => Ok(Kernel::Measured(Box::new(k))),
                 None => unsupported(format!("strategy `{strategy}` of a measured table")),
             };
         }
@@ -872,11 +878,13 @@ fn kernel_for(m: &Material, strategy: BsdfStrategy) -> Result<Kernel, BatchError
             ));
         }
     };
+    // Compensated lobes were refused above.
     let CookTorrance {
         ks,
         microfacet,
         shadowing,
         fresnel,
+        multiscatter: _,
     } = lobe;
     let ndf = match microfacet.ndf() {
         Ndf::Ggx => kernel::GGX,

@@ -13,6 +13,9 @@
 //!   incidence (`lobe plot --kind polar`, `lobe report`).
 //! * [`warp_test`]: Nori's warp test of a sampler, histograms and
 //!   chi-square (`lobe plot`, `lobe report`; feature `stats`).
+//! * [`furnace`]: the white furnace, albedo against `θo` and `α` with and
+//!   without energy compensation and by the random walk (`lobe furnace`;
+//!   feature `desc`).
 //! * [`variance`]: exact variances by quadrature (the baseline of "vs
 //!   uniform") and the largest directional albedo of a material.
 //!
@@ -25,6 +28,8 @@
 
 pub mod converge;
 pub mod estimate;
+#[cfg(feature = "desc")]
+pub mod furnace;
 pub mod histogram;
 pub mod polar;
 pub mod table;
@@ -39,20 +44,7 @@ use crate::estimator::{
 use crate::progress::Progress;
 use crate::{Error, Light, Material, Rgb};
 
-/// `(0..n).map(f)` collected in index order: on rayon's pool with the
-/// feature `parallel`, else on this thread.
-#[cfg(feature = "parallel")]
-pub(crate) fn map_indices<T: Send>(n: usize, f: impl Fn(usize) -> T + Sync + Send) -> Vec<T> {
-    use rayon::prelude::*;
-    (0..n).into_par_iter().map(f).collect()
-}
-
-/// `(0..n).map(f)` collected in index order: on rayon's pool with the
-/// feature `parallel`, else on this thread.
-#[cfg(not(feature = "parallel"))]
-pub(crate) fn map_indices<T: Send>(n: usize, f: impl Fn(usize) -> T + Sync + Send) -> Vec<T> {
-    (0..n).map(f).collect()
-}
+pub(crate) use crate::parallel::map_indices;
 
 /// [`crate::estimator::estimate`] with its chunks run in parallel (feature
 /// `parallel`) and merged in chunk order: the same numbers as the serial

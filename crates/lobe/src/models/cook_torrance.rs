@@ -11,6 +11,7 @@
 //! | `roughness` | ≥ 0 | — | instead of `alpha`: `alpha = roughness²` |
 //! | `shadowing` | `smith-separable`, `smith-correlated`, `v-cavity` | `smith-correlated` | the term `G` |
 //! | `fresnel` | `none`, `schlick`, `dielectric`, `conductor` | `none` | the term `F`: an object with that `type` and its keys |
+//! | `multiscatter` | `none`, `kulla-conty`, `turquin` | `none` | energy compensation for the light that bounces between microfacets ([`crate::energy::compensation`]; GGX or Beckmann with a Smith term; not a Mitsuba key, and `none` is Mitsuba's lobe) |
 //!
 //! (This table is [`PARAMS`]; a test checks that they agree. The Fresnel
 //! terms and their keys are in [`crate::Fresnel`].)
@@ -31,7 +32,8 @@
 //! The sampling densities use Smith's `G1` whatever `G` term `eval` uses.
 
 use super::{Bxdf, ModelInfo, Param, Range, Value};
-use crate::math::{Rgb, luminance, reflect};
+use crate::energy::compensation::{self, Compensation, Multiscatter};
+use crate::math::{INV_PI, Rgb, luminance, reflect};
 use crate::sample::{LobeSample, Scattering};
 use crate::microfacet::{MAX_ALPHA, MIN_ALPHA, Microfacet, Ndf, Shadowing};
 use crate::{Fresnel, BsdfStrategy};
@@ -108,6 +110,7 @@ pub const PARAMS: &[Param] = &[
     ROUGHNESS,
     SHADOWING,
     FRESNEL,
+    super::keys::MULTISCATTER,
 ];
 
 pub const DEFAULT_ALPHA: f64 = ALPHA.default.number();
@@ -149,7 +152,8 @@ fn from_desc(d: &crate::desc::MaterialDesc) -> crate::error::Result<super::Lobes
         .fresnel
         .as_ref()
         .map_or(Ok(Fresnel::None), crate::desc::FresnelDesc::build)?;
-    let lobe = CookTorrance::new(super::colour(d.ks, KS), mf, shadowing, fresnel)?;
+    let lobe = CookTorrance::new(super::colour(d.ks, KS), mf, shadowing, fresnel)?
+        .with_multiscatter(super::keys::multiscatter(d)?)?;
     super::Lobes::with_diffuse(super::colour(d.kd, super::KD), super::Glossy::CookTorrance(lobe))
 }
 
@@ -194,6 +198,9 @@ pub struct CookTorrance {
     pub microfacet: Microfacet,
     pub shadowing: Shadowing,
     pub fresnel: Fresnel,
+    /// Energy compensation (`multiscatter`); [`Multiscatter::None`] from
+    /// [`CookTorrance::new`].
+    pub multiscatter: Multiscatter,
 }
 
 impl CookTorrance {
@@ -208,7 +215,77 @@ impl CookTorrance {
             microfacet,
             shadowing,
             fresnel,
+            multiscatter: Multiscatter::None,
         })
+    }
+
+    /// The same lobe with energy compensation `kind`, from lobe's built-in
+    /// albedo tables; the error (naming `multiscatter`) says why the lobe
+    /// cannot have it (a distribution or shadowing term without a table).
+    pub fn with_multiscatter(self, kind: Compensation) -> crate::error::Result<Self> {
+        if kind == Compensation::None {
+            return Ok(CookTorrance {
+                multiscatter: Multiscatter::None,
+                ..self
+            });
+        }
+        let ndf = self.microfacet.ndf();
+        let table = crate::energy::AlbedoTables::builtin()
+            .get(ndf, self.shadowing)
+            .ok_or_else(|| {
+                crate::Error::param(
+                    "multiscatter",
+                    format!(
+                        "{kind} needs a table of the lobe's albedo, and lobe has them for \
+                         distribution ggx or beckmann with shadowing smith-separable or \
+                         smith-correlated, not {} with {}",
+                        ndf.name(),
+                        self.shadowing.name()
+                    ),
+                )
+            })?;
+        let (ax, ay) = self.microfacet.alpha();
+        let (ks, fresnel) = (self.ks, self.fresnel);
+        Ok(CookTorrance {
+            multiscatter: Multiscatter::new(kind, table, (ax * ay).sqrt(), |mu| {
+                ks * fresnel.eval(mu)
+            }),
+            ..self
+        })
+    }
+
+    /// With Kulla-Conty compensation, the probability that a sample is
+    /// drawn from the added lobe (by cosine sampling) at `wo`; else 0.
+    #[inline]
+    fn cosine_probability(&self, wo: DVec3) -> f64 {
+        match &self.multiscatter {
+            Multiscatter::KullaConty(kc) => {
+                kc.cosine_probability(wo, kc.single_albedo(wo, self.ks * self.fresnel.eval(wo.z)))
+            }
+            _ => 0.0,
+        }
+    }
+
+    /// The single-scattering lobe's `f` with the compensation added or
+    /// applied; `f` itself without compensation (the same bits).
+    #[inline]
+    fn compensated(&self, f: Rgb, wo: DVec3, wi: DVec3) -> Rgb {
+        match &self.multiscatter {
+            Multiscatter::None => f,
+            Multiscatter::KullaConty(kc) => f + kc.eval(wo, wi),
+            Multiscatter::Turquin(t) => f * t.scale(wo),
+        }
+    }
+
+    /// The mixture density of Kulla-Conty sampling: `p` the microfacet
+    /// sampler's, `q` the cosine's share.
+    #[inline]
+    fn mixed_pdf(p: f64, q: f64, wi: DVec3) -> f64 {
+        if q > 0.0 {
+            (1.0 - q) * p + q * wi.z.max(0.0) * INV_PI
+        } else {
+            p
+        }
     }
 }
 
@@ -270,6 +347,108 @@ impl CookTorrance {
     }
 }
 
+/// The single-scattering lobe (without compensation), which the
+/// [`Bxdf`] methods compensate.
+impl CookTorrance {
+    #[inline]
+    /// `f` of the single-scattering lobe.
+    #[must_use]
+    pub fn single_eval(&self, wo: DVec3, wi: DVec3) -> Rgb {
+        let Some(h) = (wo + wi).try_normalize() else {
+            return Rgb::ZERO;
+        };
+        let cos_oh = wo.dot(h);
+        if cos_oh <= 0.0 {
+            return Rgb::ZERO;
+        }
+        let mf = &self.microfacet;
+        let dg = mf.d(h) * mf.g(self.shadowing, wo, wi, h) / (4.0 * wo.z * wi.z);
+        if !(dg.is_finite()) {
+            return Rgb::ZERO;
+        }
+        self.ks * self.fresnel.eval(cos_oh) * dg
+    }
+
+    /// The sampled `wm` is the half vector of `wo` and the reflected `wi`,
+    /// so `D(wm)` and `Λ(wo)` serve `f` and the pdf at once.
+    #[inline]
+    fn single_sample_eval(
+        &self,
+        sampler: MicrofacetSampler,
+        wo: DVec3,
+        u: DVec2,
+    ) -> Option<LobeSample> {
+        let (wi, wm) = self.sample_wm(sampler, wo, u)?;
+        let mf = &self.microfacet;
+        let cos_oh = wo.dot(wm);
+        let d = mf.d(wm);
+        let lo = mf.lambda(wo);
+        let g = mf.g_with_lambda_o(self.shadowing, lo, wo, wi, wm);
+        let inv4o = 0.25 / wo.z;
+        let dg = d * g * inv4o / wi.z;
+        let pdf = match sampler {
+            MicrofacetSampler::Visible | MicrofacetSampler::SphericalCaps => {
+                Microfacet::pdf_visible_reflect(d, lo, wo)
+            }
+            MicrofacetSampler::BoundedVisible => mf.pdf_reflect_bounded(wo, wi),
+            MicrofacetSampler::DCos => mf.pdf_wm(wm) * 0.25 / cos_oh,
+        };
+        if !(dg.is_finite() && pdf.is_finite()) {
+            return None;
+        }
+        Some(LobeSample {
+            wi,
+            f: self.ks * self.fresnel.eval(cos_oh) * dg,
+            pdf,
+            scattering: Scattering::GlossyReflection,
+        })
+    }
+
+    #[inline]
+    fn single_pdf(&self, sampler: MicrofacetSampler, wo: DVec3, wi: DVec3) -> f64 {
+        let mf = &self.microfacet;
+        // Every sampler draws `wi` by reflecting `wo` about a normal `wm`
+        // with `wo·wm > 0`, so no sampler's density reaches a pair whose
+        // half vector faces away from `wo` (for unit vectors only
+        // `wi = −wo`; for vectors rounded to f32, pairs near it).
+        let Some(h) = (wo + wi).try_normalize() else {
+            return 0.0;
+        };
+        let cos_oh = wo.dot(h);
+        if cos_oh <= 0.0 {
+            return 0.0;
+        }
+        let p = self.pdf_of(sampler, wo, h, cos_oh, mf.d(h), || mf.lambda(wo));
+        if p.is_finite() { p } else { 0.0 }
+    }
+
+    /// `eval` and `pdf` sharing the half vector, `D(h)` and `Λ(wo)`; the
+    /// same numbers as the two calls.
+    #[inline]
+    fn single_eval_pdf(&self, sampler: MicrofacetSampler, wo: DVec3, wi: DVec3) -> (Rgb, f64) {
+        let mf = &self.microfacet;
+        // As `pdf`: no sampler reaches a pair with `wo·h <= 0`.
+        let Some(h) = (wo + wi).try_normalize() else {
+            return (Rgb::ZERO, 0.0);
+        };
+        let cos_oh = wo.dot(h);
+        if cos_oh <= 0.0 {
+            return (Rgb::ZERO, 0.0);
+        }
+        let d = mf.d(h);
+        let lo = mf.lambda(wo);
+        let dg = d * mf.g_with_lambda_o(self.shadowing, lo, wo, wi, h) / (4.0 * wo.z * wi.z);
+        let f = if dg.is_finite() {
+            self.ks * self.fresnel.eval(cos_oh) * dg
+        } else {
+            Rgb::ZERO
+        };
+        let p = self.pdf_of(sampler, wo, h, cos_oh, d, || lo);
+        (f, if p.is_finite() { p } else { 0.0 })
+    }
+
+}
+
 impl Bxdf for CookTorrance {
     type Sampler = MicrofacetSampler;
 
@@ -304,57 +483,42 @@ impl Bxdf for CookTorrance {
 
     #[inline]
     fn eval(&self, wo: DVec3, wi: DVec3) -> Rgb {
-        let Some(h) = (wo + wi).try_normalize() else {
-            return Rgb::ZERO;
-        };
-        let cos_oh = wo.dot(h);
-        if cos_oh <= 0.0 {
-            return Rgb::ZERO;
-        }
-        let mf = &self.microfacet;
-        let dg = mf.d(h) * mf.g(self.shadowing, wo, wi, h) / (4.0 * wo.z * wi.z);
-        if !(dg.is_finite()) {
-            return Rgb::ZERO;
-        }
-        self.ks * self.fresnel.eval(cos_oh) * dg
+        self.compensated(self.single_eval(wo, wi), wo, wi)
     }
 
+    /// With Kulla-Conty compensation, `u.x` first chooses between cosine
+    /// sampling (the added lobe, probability `q(wo)`) and the sampler.
     #[inline]
     fn sample(&self, sampler: MicrofacetSampler, wo: DVec3, _uc: f64, u: DVec2) -> Option<DVec3> {
+        let q = self.cosine_probability(wo);
+        if q > 0.0 {
+            return match compensation::choose(u, q) {
+                Ok(u) => Some(crate::warp::square_to_cosine_hemisphere(u)).filter(|w| w.z > 0.0),
+                Err(u) => self.sample_wm(sampler, wo, u).map(|(wi, _)| wi),
+            };
+        }
         self.sample_wm(sampler, wo, u).map(|(wi, _)| wi)
     }
 
     /// The sampled `wm` is the half vector of `wo` and the reflected `wi`,
-    /// so `D(wm)` and `Λ(wo)` serve `f` and the pdf at once.
+    /// so `D(wm)` and `Λ(wo)` serve `f` and the pdf at once (without
+    /// compensation; with it, `eval_pdf` at the sampled direction).
     #[inline]
     fn sample_eval(
         &self,
         sampler: MicrofacetSampler,
         wo: DVec3,
-        _uc: f64,
+        uc: f64,
         u: DVec2,
     ) -> Option<LobeSample> {
-        let (wi, wm) = self.sample_wm(sampler, wo, u)?;
-        let mf = &self.microfacet;
-        let cos_oh = wo.dot(wm);
-        let d = mf.d(wm);
-        let lo = mf.lambda(wo);
-        let g = mf.g_with_lambda_o(self.shadowing, lo, wo, wi, wm);
-        let inv4o = 0.25 / wo.z;
-        let dg = d * g * inv4o / wi.z;
-        let pdf = match sampler {
-            MicrofacetSampler::Visible | MicrofacetSampler::SphericalCaps => {
-                Microfacet::pdf_visible_reflect(d, lo, wo)
-            }
-            MicrofacetSampler::BoundedVisible => mf.pdf_reflect_bounded(wo, wi),
-            MicrofacetSampler::DCos => mf.pdf_wm(wm) * 0.25 / cos_oh,
-        };
-        if !(dg.is_finite() && pdf.is_finite()) {
-            return None;
+        if self.multiscatter == Multiscatter::None {
+            return self.single_sample_eval(sampler, wo, u);
         }
-        Some(LobeSample {
+        let wi = self.sample(sampler, wo, uc, u)?;
+        let (f, pdf) = self.eval_pdf(sampler, wo, wi);
+        (pdf > 0.0).then_some(LobeSample {
             wi,
-            f: self.ks * self.fresnel.eval(cos_oh) * dg,
+            f,
             pdf,
             scattering: Scattering::GlossyReflection,
         })
@@ -362,48 +526,29 @@ impl Bxdf for CookTorrance {
 
     #[inline]
     fn pdf(&self, sampler: MicrofacetSampler, wo: DVec3, wi: DVec3) -> f64 {
-        let mf = &self.microfacet;
-        // Every sampler draws `wi` by reflecting `wo` about a normal `wm`
-        // with `wo·wm > 0`, so no sampler's density reaches a pair whose
-        // half vector faces away from `wo` (for unit vectors only
-        // `wi = −wo`; for vectors rounded to f32, pairs near it).
-        let Some(h) = (wo + wi).try_normalize() else {
-            return 0.0;
-        };
-        let cos_oh = wo.dot(h);
-        if cos_oh <= 0.0 {
-            return 0.0;
-        }
-        let p = self.pdf_of(sampler, wo, h, cos_oh, mf.d(h), || mf.lambda(wo));
-        if p.is_finite() { p } else { 0.0 }
+        Self::mixed_pdf(
+            self.single_pdf(sampler, wo, wi),
+            self.cosine_probability(wo),
+            wi,
+        )
     }
 
     /// `eval` and `pdf` sharing the half vector, `D(h)` and `Λ(wo)`; the
     /// same numbers as the two calls.
     #[inline]
     fn eval_pdf(&self, sampler: MicrofacetSampler, wo: DVec3, wi: DVec3) -> (Rgb, f64) {
-        let mf = &self.microfacet;
-        // As `pdf`: no sampler reaches a pair with `wo·h <= 0`.
-        let Some(h) = (wo + wi).try_normalize() else {
-            return (Rgb::ZERO, 0.0);
-        };
-        let cos_oh = wo.dot(h);
-        if cos_oh <= 0.0 {
-            return (Rgb::ZERO, 0.0);
-        }
-        let d = mf.d(h);
-        let lo = mf.lambda(wo);
-        let dg = d * mf.g_with_lambda_o(self.shadowing, lo, wo, wi, h) / (4.0 * wo.z * wi.z);
-        let f = if dg.is_finite() {
-            self.ks * self.fresnel.eval(cos_oh) * dg
-        } else {
-            Rgb::ZERO
-        };
-        let p = self.pdf_of(sampler, wo, h, cos_oh, d, || lo);
-        (f, if p.is_finite() { p } else { 0.0 })
+        let (f, p) = self.single_eval_pdf(sampler, wo, wi);
+        (
+            self.compensated(f, wo, wi),
+            Self::mixed_pdf(p, self.cosine_probability(wo), wi),
+        )
     }
 
     fn albedo_hint(&self, wo: DVec3) -> f64 {
-        luminance(self.ks * self.fresnel.eval(wo.z))
+        let single = luminance(self.ks * self.fresnel.eval(wo.z));
+        match &self.multiscatter {
+            Multiscatter::KullaConty(kc) => single + kc.albedo(wo),
+            _ => single,
+        }
     }
 }

@@ -41,6 +41,13 @@ pub const MODE: Param = Param {
     default: Value::Name("radiance"),
     meaning: "what is carried: radiance scales refraction by `(η_i/η_t)²`, importance does not (not a Mitsuba key: its context says)",
 };
+pub const MULTISCATTER: Param = Param {
+    name: "multiscatter",
+    range: Range::Names(crate::energy::Compensation::NAMES),
+    note: "",
+    default: Value::Name("none"),
+    meaning: "energy compensation for the light that bounces between microfacets ([`crate::energy::compensation`]; GGX or Beckmann with a Smith term; not a Mitsuba key, and `none` is Mitsuba's lobe)",
+};
 pub const MATERIAL: Param = Param {
     name: "material",
     range: Range::Conductor,
@@ -86,6 +93,17 @@ pub(crate) fn relative_ior(
 #[cfg(feature = "desc")]
 pub(crate) fn mode(d: &crate::desc::MaterialDesc) -> crate::error::Result<crate::TransportMode> {
     d.mode.as_deref().unwrap_or(MODE.default.name()).parse()
+}
+
+/// The key `multiscatter`, `none` when absent.
+#[cfg(feature = "desc")]
+pub(crate) fn multiscatter(
+    d: &crate::desc::MaterialDesc,
+) -> crate::error::Result<crate::energy::Compensation> {
+    d.multiscatter
+        .as_deref()
+        .unwrap_or(MULTISCATTER.default.name())
+        .parse()
 }
 
 /// A conductor's Fresnel term from `material` or `eta` and `k` (or lobe's

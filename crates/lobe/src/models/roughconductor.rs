@@ -12,6 +12,7 @@
 //! | `k` | RGB ≥ 0 | `material`'s, else 1 | imaginary part of the conductor's index (absorption) |
 //! | `specular_reflectance` | RGB in [0, 1] | 1 | multiplies the reflected part (not physical; Mitsuba's) |
 //! | `sample_visible` | bool | true | Mitsuba's switch; lobe takes the strategy from each call instead, so only `true` is accepted |
+//! | `multiscatter` | `none`, `kulla-conty`, `turquin` | `none` | energy compensation for the light that bounces between microfacets ([`crate::energy::compensation`]; GGX or Beckmann with a Smith term; not a Mitsuba key, and `none` is Mitsuba's lobe) |
 //!
 //! (This table is [`PARAMS`]; a test checks that they agree.)
 //!
@@ -38,6 +39,7 @@ pub const PARAMS: &[Param] = &[
     K,
     SPECULAR_REFLECTANCE,
     SAMPLE_VISIBLE,
+    super::keys::MULTISCATTER,
 ];
 
 pub const INFO: ModelInfo = ModelInfo {
@@ -55,6 +57,7 @@ fn from_desc(d: &crate::desc::MaterialDesc) -> crate::error::Result<super::Lobes
         mf,
         crate::Shadowing::SmithSeparable,
         keys::conductor_fresnel(d)?,
-    )?;
+    )?
+    .with_multiscatter(keys::multiscatter(d)?)?;
     Ok(super::Lobes::only(super::Glossy::CookTorrance(lobe)))
 }

@@ -6,7 +6,6 @@
 
 use crate::common;
 use glam::{DVec2, DVec3};
-use lobe::stats::chi2::{Chi2Settings, chi2_test, sidak};
 use lobe::{BsdfStrategy, Material, Rgb, Scattering};
 
 fn load(json: &str) -> Material {
@@ -19,71 +18,12 @@ fn wo(theta: f64) -> DVec3 {
     lobe::frame::wo_from_theta(theta, 0.3f64.to_degrees())
 }
 
-/// Chi-square tests of `(material, strategy, θo)`: the density part of each
-/// sampler against its pdf over the whole sphere. Samples of a delta part
-/// count as lost (the pdf leaves them out, so `1 − ∫pdf` is their share).
-fn run(cases: &[(&str, &[BsdfStrategy], &[f64])]) {
-    use rayon::prelude::*;
-    let jobs: Vec<(Material, &str, BsdfStrategy, f64)> = cases
-        .iter()
-        .flat_map(|&(json, strategies, views)| {
-            let m = load(json);
-            strategies
-                .iter()
-                .flat_map(move |&s| views.iter().map(move |&t| (s, t)))
-                .map(move |(s, t)| (m.clone(), json, s, t))
-        })
-        .collect();
-    let alpha = sidak(0.01, jobs.len());
-    let cfg = Chi2Settings::default();
-    let failures: Vec<String> = jobs
-        .par_iter()
-        .filter_map(|(m, json, s, theta)| {
-            let sampler = m.sampler(*s).unwrap_or_else(|e| panic!("{json} {s}: {e}"));
-            let wo = wo(*theta);
-            let r = chi2_test(
-                &cfg,
-                |uc, u| {
-                    sampler
-                        .sample(wo, uc, u)
-                        .filter(|x| !x.scattering.is_specular())
-                        .map(|x| x.wi)
-                },
-                |wi| sampler.pdf(wo, wi),
-            );
-            if r.passes(alpha) {
-                return None;
-            }
-            let name: String = json
-                .chars()
-                .filter(|c| c.is_ascii_alphanumeric() || *c == '.' || *c == '_')
-                .collect();
-            let label = format!("glass_{name}_{s}_theta{theta}");
-            let path = common::write_failure(&r, &cfg, &label);
-            Some(format!(
-                "{json} {s} θ={theta}: χ²={:.1} dof={} p={:.3e} < {alpha:.2e} {} (tables: {})",
-                r.statistic,
-                r.dof,
-                r.p_value,
-                r.message.clone().unwrap_or_default(),
-                path.display()
-            ))
-        })
-        .collect();
-    assert!(
-        failures.is_empty(),
-        "{} failed:\n{}",
-        failures.len(),
-        failures.join("\n")
-    );
-}
-
 const OUTSIDE_AND_IN: &[f64] = &[0.0, 60.0, 89.0, 140.0];
 
 #[test]
 fn chi2_rough_dielectric() {
     use BsdfStrategy::{Brdf, Cosine, SphericalCaps, Uniform, Vndf};
-    run(&[
+    common::chi2_over_sphere("glass", &[
         (
             r#"{"type":"roughdielectric","distribution":"ggx","alpha":0.3}"#,
             &[Brdf, Vndf, SphericalCaps, Uniform, Cosine],
@@ -116,7 +56,7 @@ fn chi2_rough_dielectric() {
 #[test]
 fn chi2_plastic_and_two_sided() {
     use BsdfStrategy::{BoundedVndf, Brdf, Cosine, SphericalCaps, Uniform, Vndf};
-    run(&[
+    common::chi2_over_sphere("glass", &[
         (
             r#"{"type":"roughplastic","distribution":"ggx","alpha":0.2,"diffuse_reflectance":[0.2,0.5,0.8]}"#,
             &[Brdf, Vndf, SphericalCaps, BoundedVndf, Uniform, Cosine],

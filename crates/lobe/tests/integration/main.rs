@@ -10,6 +10,7 @@ mod common;
 mod adaptive_mis;
 mod checklist;
 mod chi2;
+mod energy;
 mod estimator;
 mod glass;
 mod lights;

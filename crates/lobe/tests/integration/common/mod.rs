@@ -3,6 +3,7 @@
 //! angles 0 to 89°.
 
 use glam::DVec3;
+use lobe::stats::chi2::{Chi2Settings, chi2_test, sidak};
 use lobe::{BsdfStrategy, Material, MaterialDesc};
 
 /// One material of the grid, with a name for messages and failure files.
@@ -140,4 +141,65 @@ pub fn write_failure(
     let path = dir.join(format!("{label}.csv"));
     r.write_tables(cfg, &path).unwrap();
     path
+}
+
+/// Chi-square tests of `(material, strategy, θo)` (`θo` beyond 90°: seen
+/// from inside, at a small azimuth): the density part of each sampler
+/// against its pdf over the whole sphere, Šidák-corrected; `prefix` starts
+/// the names of the failure files. Samples of a delta part
+/// count as lost (the pdf leaves them out, so `1 − ∫pdf` is their share).
+pub fn chi2_over_sphere(prefix: &str, cases: &[(&str, &[BsdfStrategy], &[f64])]) {
+    use rayon::prelude::*;
+    let jobs: Vec<(Material, &str, BsdfStrategy, f64)> = cases
+        .iter()
+        .flat_map(|&(json, strategies, views)| {
+            let m = Material::load(json).unwrap_or_else(|e| panic!("{json}: {e}"));
+            strategies
+                .iter()
+                .flat_map(move |&s| views.iter().map(move |&t| (s, t)))
+                .map(move |(s, t)| (m.clone(), json, s, t))
+        })
+        .collect();
+    let alpha = sidak(0.01, jobs.len());
+    let cfg = Chi2Settings::default();
+    let failures: Vec<String> = jobs
+        .par_iter()
+        .filter_map(|(m, json, s, theta)| {
+            let sampler = m.sampler(*s).unwrap_or_else(|e| panic!("{json} {s}: {e}"));
+            let wo = lobe::frame::wo_from_theta(*theta, 0.3f64.to_degrees());
+            let r = chi2_test(
+                &cfg,
+                |uc, u| {
+                    sampler
+                        .sample(wo, uc, u)
+                        .filter(|x| !x.scattering.is_specular())
+                        .map(|x| x.wi)
+                },
+                |wi| sampler.pdf(wo, wi),
+            );
+            if r.passes(alpha) {
+                return None;
+            }
+            let name: String = json
+                .chars()
+                .filter(|c| c.is_ascii_alphanumeric() || *c == '.' || *c == '_')
+                .collect();
+            let label = format!("{prefix}_{name}_{s}_theta{theta}");
+            let path = write_failure(&r, &cfg, &label);
+            Some(format!(
+                "{json} {s} θ={theta}: χ²={:.1} dof={} p={:.3e} < {alpha:.2e} {} (tables: {})",
+                r.statistic,
+                r.dof,
+                r.p_value,
+                r.message.clone().unwrap_or_default(),
+                path.display()
+            ))
+        })
+        .collect();
+    assert!(
+        failures.is_empty(),
+        "{} failed:\n{}",
+        failures.len(),
+        failures.join("\n")
+    );
 }

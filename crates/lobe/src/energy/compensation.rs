@@ -1,0 +1,235 @@
+//! Energy compensation of a microfacet reflection lobe: the light that a
+//! single-scattering model loses between microfacets, given back.
+//!
+//! | `multiscatter` | what is added | reciprocal | sampling |
+//! |---|---|---|---|
+//! | `none` | nothing (Mitsuba 3 and pbrt-v4's lobe, bit for bit) | yes | the lobe's |
+//! | `kulla-conty` | `f_ms = F_ms (1 − E(μo))(1 − E(μi)) / (π (1 − E_avg))` | yes | the lobe's, or cosine with probability `q(μo)` |
+//! | `turquin` | `f · F0 (1 − E(μo)) / E(μo)` | no | the lobe's |
+//!
+//! `E(μ, α)` and `E_avg(α)` are the albedo and average albedo of the lobe
+//! with `F = 1` ([`super::table`]). Kulla and Conty 2017's colour term is
+//! `F_ms = F_avg² E_avg / (1 − F_avg (1 − E_avg))`, `F_avg = 2 ∫ F(μ) μ dμ`
+//! the cosine-weighted average of the lobe's reflectance (tint times
+//! Fresnel): light that bounces `k` times is tinted `k` times, so rough
+//! coloured metals gain saturation. Turquin 2019 scales the lobe by
+//! `1 + F0 (1 − E)/E`, `F0` the reflectance at normal incidence. With
+//! `F = 1` both reflect `E(μo) + 1 − E(μo)`: all of a white furnace.
+//!
+//! An anisotropic lobe is compensated with the tables of `α = √(αu αv)`
+//! (the tables are isotropic): approximate, and said where the key is.
+
+use super::table::AlbedoTable;
+use crate::math::{INV_PI, Rgb, luminance};
+use glam::{DVec2, DVec3};
+
+/// The value of the material key `multiscatter`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Compensation {
+    None,
+    KullaConty,
+    Turquin,
+}
+
+impl Compensation {
+    pub const ALL: [Compensation; 3] = [
+        Compensation::None,
+        Compensation::KullaConty,
+        Compensation::Turquin,
+    ];
+    pub const NAMES: &'static str = "none, kulla-conty, turquin";
+
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Compensation::None => "none",
+            Compensation::KullaConty => "kulla-conty",
+            Compensation::Turquin => "turquin",
+        }
+    }
+}
+
+impl std::fmt::Display for Compensation {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::str::FromStr for Compensation {
+    type Err = crate::Error;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        Compensation::ALL
+            .into_iter()
+            .find(|c| c.name() == s)
+            .ok_or_else(|| crate::Error::UnknownName {
+                field: "multiscatter".into(),
+                value: s.into(),
+                expected: Compensation::NAMES.into(),
+            })
+    }
+}
+
+/// The compensation of one lobe, with what it needs precomputed: a small
+/// `Copy` value (its table is `'static`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Multiscatter {
+    None,
+    KullaConty(KullaConty),
+    Turquin(Turquin),
+}
+
+impl Multiscatter {
+    /// Which compensation this is.
+    #[must_use]
+    pub fn kind(&self) -> Compensation {
+        match self {
+            Multiscatter::None => Compensation::None,
+            Multiscatter::KullaConty(_) => Compensation::KullaConty,
+            Multiscatter::Turquin(_) => Compensation::Turquin,
+        }
+    }
+
+    /// The compensation `kind` of a lobe of width `alpha` (`√(αu αv)`)
+    /// whose reflectance (tint times Fresnel) at cosine `μ` is
+    /// `reflectance(μ)`, from `table` (the lobe's distribution and
+    /// shadowing term).
+    #[must_use]
+    pub fn new(
+        kind: Compensation,
+        table: &'static AlbedoTable,
+        alpha: f64,
+        reflectance: impl Fn(f64) -> Rgb,
+    ) -> Self {
+        match kind {
+            Compensation::None => Multiscatter::None,
+            Compensation::KullaConty => {
+                Multiscatter::KullaConty(KullaConty::new(table, alpha, reflectance))
+            }
+            Compensation::Turquin => Multiscatter::Turquin(Turquin {
+                table,
+                alpha,
+                f0: reflectance(1.0),
+            }),
+        }
+    }
+}
+
+/// Kulla and Conty's added lobe (see the module documentation).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct KullaConty {
+    table: &'static AlbedoTable,
+    alpha: f64,
+    /// `F_ms / (π (1 − E_avg))`: the lobe is this times `(1 − E(μo))(1 − E(μi))`.
+    scale: Rgb,
+    /// The albedo of the added lobe is `ms_albedo (1 − E(μo))`: `F_ms`'s luminance.
+    ms_albedo: f64,
+}
+
+impl KullaConty {
+    #[must_use]
+    pub fn new(table: &'static AlbedoTable, alpha: f64, reflectance: impl Fn(f64) -> Rgb) -> Self {
+        let e_avg = table.e_avg(alpha);
+        let f_avg = cosine_average(reflectance);
+        let f_ms = f_avg * f_avg * e_avg / (Rgb::ONE - f_avg * (1.0 - e_avg));
+        // Below 1e-9 of lost energy the lobe is nothing (and 1/(1 − E_avg)
+        // would only amplify the table's rounding).
+        let lost = 1.0 - e_avg;
+        let scale = if lost > 1e-9 {
+            f_ms * (INV_PI / lost)
+        } else {
+            Rgb::ZERO
+        };
+        KullaConty {
+            table,
+            alpha,
+            scale,
+            ms_albedo: if lost > 1e-9 { luminance(f_ms) } else { 0.0 },
+        }
+    }
+
+    /// `1 − E(μ)`, at least 0.
+    #[inline]
+    fn lost(&self, mu: f64) -> f64 {
+        (1.0 - self.table.e(mu, self.alpha)).max(0.0)
+    }
+
+    /// The added lobe `f_ms(wo, wi)` (no cosine), zero below the horizon.
+    #[inline]
+    #[must_use]
+    pub fn eval(&self, wo: DVec3, wi: DVec3) -> Rgb {
+        if wo.z <= 0.0 || wi.z <= 0.0 {
+            return Rgb::ZERO;
+        }
+        self.scale * (self.lost(wo.z) * self.lost(wi.z))
+    }
+
+    /// The added lobe's albedo at `wo` (luminance).
+    #[must_use]
+    pub fn albedo(&self, wo: DVec3) -> f64 {
+        self.ms_albedo * self.lost(wo.z)
+    }
+
+    /// The probability of drawing the added lobe by cosine sampling, given
+    /// the luminance of the single-scattering lobe's albedo at `wo`
+    /// (`E(μo)` times its reflectance): the added lobe's share of the
+    /// albedo, at most 0.9.
+    #[inline]
+    #[must_use]
+    pub fn cosine_probability(&self, wo: DVec3, single: f64) -> f64 {
+        let ms = self.albedo(wo);
+        if ms > 0.0 {
+            (ms / (ms + single.max(0.0))).min(0.9)
+        } else {
+            0.0
+        }
+    }
+
+    /// The single-scattering lobe's albedo estimate for
+    /// [`KullaConty::cosine_probability`]: `E(μo)` times the luminance of
+    /// `reflectance`.
+    #[inline]
+    #[must_use]
+    pub fn single_albedo(&self, wo: DVec3, reflectance: Rgb) -> f64 {
+        self.table.e(wo.z, self.alpha) * luminance(reflectance)
+    }
+}
+
+/// Turquin's scaling (see the module documentation).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Turquin {
+    table: &'static AlbedoTable,
+    alpha: f64,
+    f0: Rgb,
+}
+
+impl Turquin {
+    /// The factor `1 + F0 (1 − E(μo)) / E(μo)` of the lobe at `wo`.
+    #[inline]
+    #[must_use]
+    pub fn scale(&self, wo: DVec3) -> Rgb {
+        let e = self.table.e(wo.z, self.alpha).max(1e-3);
+        Rgb::ONE + self.f0 * ((1.0 - e) / e)
+    }
+}
+
+/// `2 ∫₀¹ r(μ) μ dμ` by 32-point Gauss-Legendre.
+fn cosine_average(r: impl Fn(f64) -> Rgb) -> Rgb {
+    let mut sum = Rgb::ZERO;
+    for (t, w) in crate::stats::quadrature::gauss_legendre(32) {
+        let mu = 0.5 * (t + 1.0);
+        sum += r(mu) * (w * mu);
+    }
+    sum
+}
+
+/// Choose between two samplers with one uniform: `Ok(u)` for the first
+/// (probability `q`), `Err(u)` for the second, `u.x` rescaled to `[0, 1)`
+/// for the chosen one.
+#[inline]
+pub fn choose(u: DVec2, q: f64) -> Result<DVec2, DVec2> {
+    if u.x < q {
+        Ok(DVec2::new(u.x / q, u.y))
+    } else {
+        Err(DVec2::new(((u.x - q) / (1.0 - q)).min(1.0 - f64::EPSILON / 2.0), u.y))
+    }
+}

@@ -1,0 +1,347 @@
+//! Energy compensation (issue 43): chi-square of the compensated samplers,
+//! the white furnace of compensated conductors, the random walk as the
+//! reference for coloured conductors and for the lobe's shape, the stored
+//! albedo tables against a recomputation, the uncompensated lobes' bits,
+//! and bad input.
+
+use crate::common;
+use glam::{DVec2, DVec3};
+use lobe::energy::random_walk::RgbEstimate;
+use lobe::energy::tabulate::{TABLES, node_estimate};
+use lobe::energy::{AlbedoTables, RandomWalk};
+use lobe::experiment::furnace::{FurnaceSettings, furnace};
+use lobe::{BsdfStrategy, Glossy, Material, MaterialDesc};
+
+const ALPHAS: [f64; 8] = [0.05, 0.1, 0.2, 0.3, 0.5, 0.7, 0.85, 1.0];
+const THETAS: [f64; 8] = [0.0, 15.0, 30.0, 45.0, 60.0, 75.0, 85.0, 89.0];
+
+fn desc(json: &str) -> MaterialDesc {
+    MaterialDesc::from_json(json).unwrap_or_else(|e| panic!("{json}: {e}"))
+}
+
+#[test]
+fn chi2_compensated_samplers() {
+    use BsdfStrategy::{BoundedVndf, Brdf, SphericalCaps, Vndf};
+    let views: &[f64] = &[0.0, 60.0, 89.0];
+    common::chi2_over_sphere(
+        "energy",
+        &[
+            (
+                r#"{"type":"cook-torrance","alpha":0.3,"multiscatter":"kulla-conty"}"#,
+                &[Brdf, Vndf, SphericalCaps, BoundedVndf],
+                views,
+            ),
+            (
+                r#"{"type":"cook-torrance","alpha":1.0,"fresnel":{"type":"conductor"},"multiscatter":"kulla-conty"}"#,
+                &[Brdf, Vndf],
+                views,
+            ),
+            (
+                r#"{"type":"roughconductor","distribution":"beckmann","alpha":0.7,"material":"Cu","multiscatter":"kulla-conty"}"#,
+                &[Brdf, Vndf],
+                views,
+            ),
+            (
+                r#"{"type":"roughconductor","distribution":"ggx","alpha":0.5,"multiscatter":"turquin"}"#,
+                &[Vndf, BoundedVndf],
+                views,
+            ),
+            (
+                r#"{"type":"cook-torrance","alpha_u":0.2,"alpha_v":0.8,"multiscatter":"kulla-conty"}"#,
+                &[Vndf],
+                views,
+            ),
+            (
+                r#"{"type":"cook-torrance","alpha":0.6,"kd":0.3,"multiscatter":"kulla-conty"}"#,
+                &[Vndf],
+                views,
+            ),
+        ],
+    );
+}
+
+/// A sample's weight is `f cos θi / pdf` with the compensated `f` and the
+/// mixture pdf, and `eval_pdf` is the two calls.
+#[test]
+fn compensated_samples_weigh_f_cos_over_pdf() {
+    for json in [
+        r#"{"type":"cook-torrance","alpha":0.8,"fresnel":{"type":"conductor"},"multiscatter":"kulla-conty"}"#,
+        r#"{"type":"roughconductor","distribution":"beckmann","alpha":0.4,"material":"Au","multiscatter":"turquin"}"#,
+    ] {
+        let m = Material::load(json).unwrap();
+        let s = m.sampler(BsdfStrategy::Vndf).unwrap();
+        let mut rng = lobe::sequence::chunk_rng(3, 0);
+        for k in 0..2000 {
+            use rand::RngExt;
+            let wo = lobe::frame::wo_from_theta(f64::from(k % 89), 30.0);
+            let u = DVec2::new(rng.random(), rng.random());
+            let Some(x) = s.sample(wo, rng.random(), u) else {
+                continue;
+            };
+            let (f, pdf) = s.eval_pdf(wo, x.wi);
+            assert!((pdf - x.pdf).abs() <= 1e-12 * pdf, "{json}: {pdf} vs {}", x.pdf);
+            assert!((f - m.eval(wo, x.wi)).abs().max_element() <= 1e-12 * f.max_element());
+            let w = f * x.wi.z / pdf;
+            assert!((w - x.weight).abs().max_element() <= 1e-9 * w.max_element());
+        }
+    }
+}
+
+/// Compensated white conductors reflect 1 within 0.5% for every θo and α
+/// of the issue's range, GGX and Beckmann, Smith's separable (Mitsuba's
+/// `roughconductor`) and height-correlated (`cook-torrance`) terms, both
+/// kinds of compensation; the uncompensated lobes lose up to 70%.
+#[test]
+fn white_furnace_of_compensated_conductors() {
+    let s = FurnaceSettings {
+        thetas: THETAS.to_vec(),
+        alphas: ALPHAS.to_vec(),
+        walks: 0,
+        seed: 1,
+    };
+    let mut worst = (0.0f64, String::new());
+    let mut darkest = 1.0f64;
+    for json in [
+        r#"{"type":"roughconductor","distribution":"ggx"}"#,
+        r#"{"type":"roughconductor","distribution":"beckmann"}"#,
+        r#"{"type":"cook-torrance","distribution":"ggx"}"#,
+        r#"{"type":"cook-torrance","distribution":"beckmann"}"#,
+    ] {
+        let f = furnace(&desc(json), &s, &()).unwrap();
+        for r in &f.rows {
+            darkest = darkest.min(r.none.x);
+            for (kind, a) in [("kulla-conty", r.kulla_conty), ("turquin", r.turquin)] {
+                let err = (a.x - 1.0).abs();
+                if err > worst.0 {
+                    worst = (err, format!("{json} {kind} α {} θo {}: {}", r.alpha, r.theta, a.x));
+                }
+            }
+        }
+    }
+    eprintln!("white furnace: worst |albedo − 1| {:.2e} ({}); darkest uncompensated {darkest:.3}", worst.0, worst.1);
+    assert!(worst.0 < 5e-3, "{}", worst.1);
+    assert!(darkest < 0.35, "the uncompensated lobes should lose energy: {darkest}");
+}
+
+/// Gold and copper: the random walk (every bounce, a Fresnel term at each)
+/// against Kulla-Conty's compensated lobe on the height-correlated
+/// single-scattering lobe the walk starts with. Compensation brings every
+/// channel closer to the walk; the light it adds is more saturated than the
+/// single-scattering lobe's, as in the walk (blue/red falls); and the
+/// albedo is within 2% of the walk's for α ≤ 0.5 at θo ≤ 45°. (At α = 1
+/// Kulla-Conty's colour term falls short by up to 7% in green and blue:
+/// its Fresnel average weighs bounces by the cosine, the walk's bounces
+/// meet the facets at more grazing angles, where the metals reflect more.)
+#[test]
+fn coloured_conductors_gain_saturation_like_the_random_walk() {
+    let s = FurnaceSettings {
+        thetas: vec![0.0, 45.0, 75.0],
+        alphas: vec![0.2, 0.5, 1.0],
+        walks: 40_000,
+        seed: 5,
+    };
+    for metal in ["Au", "Cu"] {
+        let (eta, k) = lobe::ior::conductor("material", metal).unwrap();
+        let json = format!(
+            r#"{{"type":"cook-torrance","fresnel":{{"type":"conductor","eta":[{},{},{}],"k":[{},{},{}]}}}}"#,
+            eta.x, eta.y, eta.z, k.x, k.y, k.z
+        );
+        let f = furnace(&desc(&json), &s, &()).unwrap();
+        for r in &f.rows {
+            let RgbEstimate { mean: w, std_error: se } = r.walk.unwrap();
+            let (none, kc) = (r.none, r.kulla_conty);
+            let at = format!("{metal} α {} θo {}", r.alpha, r.theta);
+            for c in 0..3 {
+                assert!(
+                    (kc[c] - w[c]).abs() < (none[c] - w[c]).abs() + 4.0 * se[c],
+                    "{at} channel {c}: compensated {} uncompensated {} walk {} ± {}",
+                    kc[c],
+                    none[c],
+                    w[c],
+                    se[c]
+                );
+                if r.alpha <= 0.5 && r.theta <= 45.0 {
+                    assert!(
+                        (kc[c] / w[c] - 1.0).abs() < 0.02 + 4.0 * se[c] / w[c],
+                        "{at} channel {c}: compensated {} walk {} ± {}",
+                        kc[c],
+                        w[c],
+                        se[c]
+                    );
+                }
+            }
+            // Saturation of what multiple scattering adds: blue over red.
+            let ratio = |c: lobe::Rgb| c.z / c.x;
+            let (walk_ms, kc_ms) = (w - none, kc - none);
+            assert!(
+                ratio(kc_ms) < ratio(none) && ratio(walk_ms) < ratio(none),
+                "{at}: b/r of the single lobe {:.3}, of the added light: compensated {:.3}, walk {:.3}",
+                ratio(none),
+                ratio(kc_ms),
+                ratio(walk_ms)
+            );
+        }
+    }
+}
+
+/// The compensated lobe's shape: `f` on a grid of directions (θo 0°, 45°,
+/// 75°; θi 0° to 80°; φ 0°, 90°, 180°) against the random walk's estimate
+/// of `f`, where the walk's standard error is below 2%.
+///
+/// The issue's aim is 10% everywhere; Kulla-Conty's lobe does not meet it.
+/// Its added lobe `(1 − E(μo))(1 − E(μi))` has no azimuth, while the
+/// walk's multiply scattered light at α = 0.3 gathers around the mirror
+/// direction (twice to five times Kulla-Conty's there) and is thinner on
+/// the viewer's side (0.65×): measured (2·10⁴ walks a point) worst 25% at
+/// α 0.3, θo 45°, θi 60° on the viewer's side; 16% at α 1 (θo 0°, θi
+/// 80°); 5% at α 0.6; the median is 2.5%. This test holds that state (worst
+/// below 30%, median below 5%) so that it cannot get worse unseen.
+#[test]
+fn lobe_shape_against_the_random_walk() {
+    let mut errors: Vec<(f64, String)> = Vec::new();
+    for alpha in [0.3, 0.6, 1.0] {
+        let m = Material::load(&format!(
+            r#"{{"type":"cook-torrance","alpha":{alpha},"multiscatter":"kulla-conty"}}"#
+        ))
+        .unwrap();
+        let Glossy::CookTorrance(ct) = &m.glossy else {
+            unreachable!()
+        };
+        let walk = RandomWalk::conductor(ct.microfacet, ct.ks, ct.fresnel).unwrap();
+        let mut stream = 0;
+        for theta_o in [0.0, 45.0, 75.0] {
+            let wo = lobe::frame::wo_from_theta(theta_o, 0.0);
+            for theta_i in [0.0, 20.0, 40.0, 60.0, 80.0] {
+                for phi in [0.0, 90.0, 180.0] {
+                    let wi = lobe::frame::wo_from_theta(theta_i, phi);
+                    stream += 1;
+                    let e = walk.eval(wo, wi, 20_000, 9, stream);
+                    let (w, se) = (e.mean.x, e.std_error.x);
+                    if !(w > 0.0 && se < 0.02 * w) {
+                        continue;
+                    }
+                    let f = m.eval(wo, wi).x;
+                    errors.push((
+                        (f / w - 1.0).abs(),
+                        format!("α {alpha} θo {theta_o} θi {theta_i} φ {phi}: f {f:.4} walk {w:.4} ± {se:.4}"),
+                    ));
+                }
+            }
+        }
+    }
+    errors.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let median = errors[errors.len() / 2].0;
+    let worst = errors.last().unwrap();
+    let within = errors.iter().filter(|e| e.0 < 0.10).count();
+    eprintln!(
+        "lobe shape: {} directions, {within} within 10%, median {median:.3}, worst {:.3} ({})",
+        errors.len(),
+        worst.0,
+        worst.1
+    );
+    assert!(errors.len() > 100, "{}", errors.len());
+    assert!(median < 0.05, "median {median}");
+    assert!(worst.0 < 0.30, "{}", worst.1);
+}
+
+/// The built-in tables against a recomputation of some of their nodes
+/// with another seed: within the combined standard error.
+#[test]
+fn stored_tables_match_a_recomputation() {
+    let tables = AlbedoTables::builtin();
+    let mut checked = 0;
+    for (ndf, sh) in TABLES {
+        let t = tables.get(ndf, sh).unwrap();
+        for (j, i) in [(1, 1), (6, 3), (10, 0), (20, 40), (31, 63), (45, 10), (63, 2), (63, 63)] {
+            let (j, i) = (j * (t.n_alpha - 1) / 63, i * (t.n_mu - 1) / 63);
+            let m = node_estimate(ndf, sh, (j, i), (t.n_mu, t.n_alpha), 1 << 14, 12_345);
+            let k = j * t.n_mu + i;
+            let se = (m.std_error().powi(2) + t.std_errors[k].powi(2)).sqrt();
+            assert!(
+                (m.mean() - t.values[k]).abs() <= 5.0 * se + 1e-12,
+                "{ndf:?} {sh:?} node ({j}, {i}): stored {} ± {}, recomputed {} ± {}",
+                t.values[k],
+                t.std_errors[k],
+                m.mean(),
+                m.std_error()
+            );
+            checked += 1;
+        }
+    }
+    assert_eq!(checked, 32);
+}
+
+/// Without compensation the lobes give the bits they gave before energy
+/// compensation existed (values printed by lobe at commit 30bb039).
+#[test]
+fn uncompensated_lobes_are_unchanged_bit_for_bit() {
+    let golden = include_str!("energy_golden.txt");
+    let mats = [
+        r#"{"type":"roughconductor","distribution":"ggx","alpha":0.3,"material":"Au"}"#,
+        r#"{"type":"roughconductor","distribution":"beckmann","alpha":0.7}"#,
+        r#"{"type":"cook-torrance","distribution":"ggx","alpha":0.5,"kd":0.2,"fresnel":{"type":"schlick"}}"#,
+    ];
+    let mut lines = golden.lines();
+    for j in mats {
+        for none in [false, true] {
+            let json = if none {
+                j.replacen('{', r#"{"multiscatter":"none","#, 1)
+            } else {
+                j.to_string()
+            };
+            let m = Material::load(&json).unwrap();
+            let mut lines = lines.clone();
+            for s in [BsdfStrategy::Brdf, BsdfStrategy::Vndf] {
+                let smp = m.sampler(s).unwrap();
+                for (k, t) in [10.0f64, 50.0, 80.0].iter().enumerate() {
+                    let wo = lobe::frame::wo_from_theta(*t, 20.0);
+                    let u = DVec2::new(0.3 + 0.2 * k as f64, 0.7);
+                    let x = smp.sample(wo, 0.4, u).unwrap();
+                    let wi = DVec3::new(-0.3, 0.1 * k as f64, 0.8).normalize();
+                    let f = m.eval(wo, wi);
+                    let p = smp.pdf(wo, wi);
+                    let now = format!(
+                        "{:#x} {:#x} {:#x} {:#x} {:#x} {:#x} {:#x}",
+                        x.wi.x.to_bits(),
+                        x.weight.y.to_bits(),
+                        x.pdf.to_bits(),
+                        f.x.to_bits(),
+                        f.z.to_bits(),
+                        p.to_bits(),
+                        x.f.y.to_bits()
+                    );
+                    assert_eq!(Some(now.as_str()), lines.next(), "{json} {s} θo {t}");
+                }
+            }
+        }
+        for _ in 0..6 {
+            lines.next();
+        }
+    }
+}
+
+#[test]
+fn bad_input_names_the_field() {
+    let err = |json: &str| Material::load(json).unwrap_err().to_string();
+    let e = err(r#"{"type":"cook-torrance","multiscatter":"heitz"}"#);
+    assert!(e.contains("multiscatter") && e.contains("kulla-conty"), "{e}");
+    let e = err(r#"{"type":"cook-torrance","shadowing":"v-cavity","multiscatter":"kulla-conty"}"#);
+    assert!(e.contains("multiscatter") && e.contains("v-cavity"), "{e}");
+    let e = err(r#"{"type":"cook-torrance","distribution":"blinn-phong","multiscatter":"turquin"}"#);
+    assert!(e.contains("multiscatter") && e.contains("blinn-phong"), "{e}");
+    let e = err(r#"{"type":"phong","multiscatter":"kulla-conty"}"#);
+    assert!(e.contains("multiscatter"), "{e}");
+    // The furnace refuses what it cannot compare.
+    let s = FurnaceSettings {
+        walks: 0,
+        ..FurnaceSettings::standard()
+    };
+    let e = furnace(&desc(r#"{"type":"phong"}"#), &s, &()).unwrap_err().to_string();
+    assert!(e.contains("type") || e.contains("alpha"), "{e}");
+    let bad = FurnaceSettings {
+        thetas: vec![90.0],
+        ..s.clone()
+    };
+    let e = furnace(&desc(r#"{"type":"cook-torrance"}"#), &bad, &()).unwrap_err().to_string();
+    assert!(e.contains("theta") && e.contains("89.9"), "{e}");
+}
