@@ -35,6 +35,15 @@ pub const MATERIALS: &[(&str, &str)] = &[
         "kd0.3-ggx-alpha0.2",
         r#"{"type":"cook-torrance","distribution":"ggx","alpha":0.2,"kd":0.3}"#,
     ),
+    // Energy compensation: the f64 path's cost beside ggx-alpha0.2's.
+    (
+        "ggx-alpha0.2-kulla-conty",
+        r#"{"type":"cook-torrance","distribution":"ggx","alpha":0.2,"multiscatter":"kulla-conty"}"#,
+    ),
+    (
+        "ggx-alpha0.2-turquin",
+        r#"{"type":"cook-torrance","distribution":"ggx","alpha":0.2,"multiscatter":"turquin"}"#,
+    ),
 ];
 
 /// The material a JSON description builds (a panic naming it otherwise).

@@ -115,7 +115,12 @@ pub fn run(args: &FurnaceArgs) -> Result<()> {
         print!("{}", out.trim_start());
     }
     if let Some(p) = &args.out {
-        let title = format!("White furnace: {} ({origin})", f.model);
+        let what = if args.material.len() <= 90 && !args.material.starts_with('@') {
+            args.material.clone()
+        } else {
+            origin.clone()
+        };
+        let title = format!("White furnace (light 1 from every direction): {what}");
         crate::figures::furnace_plot(p, &title, &f)?;
         eprintln!("wrote {}", p.display());
     }

@@ -69,7 +69,7 @@ pub fn run(args: &TabulateEnergyArgs) -> Result<()> {
         .flat_map(|t| t.std_errors.iter().copied())
         .fold(0.0, f64::max);
     eprintln!(
-        "wrote {} ({} tables of {} × {} nodes, {} samples each; largest standard error {:.1e}) in {:.1} s",
+        "wrote {} ({} tables of {} × {} nodes, {} samples each; largest s.e. of a node {:.1e}) in {:.1} s",
         args.out.display(),
         TABLES.len(),
         s.n_mu,

@@ -289,6 +289,23 @@ pub(super) fn section(h: &mut String, model: &Model, r: &ModelResult, st: &Repor
          its samples.{}</p>",
         heat_note(model)
     );
+    if let Some(f) = &r.furnace {
+        figure(
+            h,
+            f,
+            &format!(
+                "<b>White furnace.</b> The directional albedo ∫&thinsp;f<sub>r</sub>&thinsp;cos&thinsp;θ<sub>i</sub>&thinsp;dω<sub>i</sub> \
+                 (light 1 from every direction) against θ<sub>o</sub>, one panel per α, by quadrature: \
+                 the single-scattering lobe (<code>multiscatter</code> <code>none</code>, grey), and with \
+                 Kulla and Conty's and Turquin's energy compensation; the black points are Heitz et al.'s \
+                 random walk on the microsurface ({} walks a point), which follows every bounce between \
+                 microfacets and loses nothing. A white single-scattering lobe reflects less than 1: the \
+                 light that bounces more than once is lost, up to 70% at α&nbsp;=&nbsp;1, and rough \
+                 metals render too dark. The compensated lobes give it back (docs/energy.md).",
+                st.furnace_walks
+            ),
+        );
+    }
     h.push_str("</section>\n");
 }
 

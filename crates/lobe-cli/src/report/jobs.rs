@@ -1,15 +1,17 @@
 //! The work of the report and its results: the comparison tables one at a
 //! time (so that their times are undisturbed), then the convergence curves,
-//! polar plots, warp tests, weight maps and lost-sample fractions in
-//! parallel, with a progress bar.
+//! polar plots, warp tests, weight maps, lost-sample fractions and (for
+//! Cook-Torrance) the white furnace in parallel, with a progress bar.
 
 use super::catalogue::{Model, THETAS, build, figure_point, plain_point, view};
+use super::format::strip_tags;
 use crate::common::progress;
 use crate::converge;
 use crate::figures::{self, PolarScale};
 use anyhow::{Context, Result, anyhow};
 use lobe::estimator::Strategy;
 use lobe::experiment::converge::{Curve, CurveSettings, curves};
+use lobe::experiment::furnace::{FurnaceSettings, furnace};
 use lobe::experiment::histogram::lost_fraction;
 use lobe::experiment::polar;
 use lobe::experiment::table::{Table, TableSettings, run_table};
@@ -39,6 +41,10 @@ pub(super) struct ReportSettings {
     pub(super) heat_res: usize,
     /// Samples for the fraction of lost samples.
     pub(super) lost_samples: usize,
+    /// The white furnace: its θo step in degrees, its α values and walks.
+    pub(super) furnace_step: f64,
+    pub(super) furnace_alphas: &'static [f64],
+    pub(super) furnace_walks: u64,
 }
 
 impl ReportSettings {
@@ -54,6 +60,9 @@ impl ReportSettings {
                 chi2_nphi: 16,
                 heat_res: 48,
                 lost_samples: 4096,
+                furnace_step: 20.0,
+                furnace_alphas: &[0.1, 0.5, 1.0],
+                furnace_walks: 2000,
             }
         } else {
             ReportSettings {
@@ -66,6 +75,9 @@ impl ReportSettings {
                 chi2_nphi: 40,
                 heat_res: 128,
                 lost_samples: 1 << 14,
+                furnace_step: 5.0,
+                furnace_alphas: &[0.05, 0.1, 0.2, 0.3, 0.5, 0.7, 0.85, 1.0],
+                furnace_walks: 20_000,
             }
         }
     }
@@ -106,6 +118,8 @@ pub(super) struct ModelResult {
     pub(super) polar: Figure,
     pub(super) warps: Vec<Warp>,
     pub(super) heat: Vec<(BsdfStrategy, Figure)>,
+    /// The white furnace of a Cook-Torrance section.
+    pub(super) furnace: Option<Figure>,
 }
 
 /// The work of the second phase.
@@ -115,6 +129,7 @@ pub(super) enum Job {
     Warp(usize, BsdfStrategy),
     Heat(usize, BsdfStrategy),
     Lost(usize),
+    Furnace(usize),
 }
 
 pub(super) enum Done {
@@ -123,6 +138,7 @@ pub(super) enum Done {
     Warp(Warp),
     Heat(BsdfStrategy, Figure),
     Lost(Vec<Vec<f64>>),
+    Furnace(Figure),
 }
 
 /// Runs every job of the report's `models` with the sizes of `settings` and the
@@ -164,6 +180,9 @@ pub(super) fn run_all(
             jobs.push(Job::Heat(i, s));
         }
         jobs.push(Job::Lost(i));
+        if furnace_desc(model).is_some() {
+            jobs.push(Job::Furnace(i));
+        }
     }
     let tables: usize = models.iter().map(|m| m.values.len() * THETAS.len()).sum();
     let pb = progress((tables + jobs.len()) as u64, "report", quiet);
@@ -237,6 +256,14 @@ pub(super) fn run_all(
         let Some(Done::Lost(lost)) = done.next() else {
             unreachable!("jobs come in order")
         };
+        let furnace = if furnace_desc(model).is_some() {
+            let Some(Done::Furnace(f)) = done.next() else {
+                unreachable!("jobs come in order")
+            };
+            Some(f)
+        } else {
+            None
+        };
         let points = std::mem::take(&mut tables_of[i])
             .into_iter()
             .zip(lost)
@@ -254,6 +281,7 @@ pub(super) fn run_all(
             polar,
             warps,
             heat,
+            furnace,
         });
     }
     Ok(results)
@@ -395,6 +423,30 @@ pub(super) fn run_job(
                 },
             ))
         }
+        Job::Furnace(i) => {
+            let model = &models[i];
+            let desc = furnace_desc(model).expect("only Cook-Torrance sections have the job");
+            let mut thetas: Vec<f64> = (0..)
+                .map(|k| f64::from(k) * st.furnace_step)
+                .take_while(|t| *t < 89.0)
+                .collect();
+            thetas.push(89.0);
+            let s = FurnaceSettings {
+                thetas,
+                alphas: st.furnace_alphas.to_vec(),
+                walks: st.furnace_walks,
+                seed,
+            };
+            let f = furnace(&desc, &s, &())?;
+            let file = format!("{}-furnace.png", model.id);
+            let title = format!("{}: white furnace, with and without energy compensation", model.title);
+            figures::furnace_plot(&dir.join(&file), &strip_tags(&title), &f)
+                .with_context(|| format!("cannot write {file}"))?;
+            Ok(Done::Furnace(Figure {
+                file,
+                alt: format!("Furnace: {}", strip_tags(&title)),
+            }))
+        }
         Job::Lost(i) => {
             let model = &models[i];
             let lost = tables[i]
@@ -425,6 +477,18 @@ pub(super) fn run_job(
 /// The series of a report's convergence plot: every strategy but cosine and
 /// spherical caps (the same density as VNDF) with independent samples, and
 /// the best samplers with stratified and Sobol points.
+/// The description a Cook-Torrance section's furnace starts from (its α is
+/// replaced by the furnace's); `None` for other sections and for a given
+/// material (whose description the report does not keep).
+fn furnace_desc(model: &Model) -> Option<lobe::MaterialDesc> {
+    let super::catalogue::Source::Lecture(json) = &model.source else {
+        return None;
+    };
+    lobe::MaterialDesc::from_json(&json(model.values[model.figure_value]))
+        .ok()
+        .filter(|d| d.kind == "cook-torrance")
+}
+
 pub(super) fn convergence_series(m: &Material) -> Vec<(Strategy, Sequence)> {
     let has = |s| m.check(s).is_ok();
     let mut v = vec![

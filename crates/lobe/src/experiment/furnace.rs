@@ -175,9 +175,7 @@ pub fn furnace(
         row
     });
     Ok(Furnace {
-        model: cells
-            .first()
-            .map_or(String::new(), |c| c.1[0].model_name().to_string()),
+        model: desc.kind.clone(),
         rows,
     })
 }
