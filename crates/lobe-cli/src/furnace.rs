@@ -15,11 +15,13 @@ const DEFAULT_MATERIAL: &str = r#"{"type":"roughconductor","distribution":"ggx"}
 #[derive(Args, Debug)]
 #[command(
     about = "The white furnace: albedo against θo and α, with and without energy compensation, against the random walk",
-    long_about = "The directional albedo ∫ f cos θi dωi of a microfacet material (cook-torrance or \
-                  roughconductor) in a white furnace, against θo and α: without compensation \
+    long_about = "The directional albedo ∫ f |cos θi| dωi of a microfacet material (cook-torrance, \
+                  roughconductor, or roughdielectric: R + T in importance mode) in a white \
+                  furnace, against θo and α: without compensation \
                   (multiscatter none, what Mitsuba 3 and pbrt-v4 render), with Kulla and Conty's \
                   and with Turquin's, by quadrature, and Heitz et al.'s random walk on the \
-                  microsurface (every bounce; mean ± standard error of --walks walks). The \
+                  microsurface (every bounce, conductors; mean ± standard error of --walks \
+                  walks). The \
                   material's alpha and multiscatter are replaced by each cell's. Prints \
                   luminance per α; --json writes every RGB number.",
     after_help = "Examples:\n  \
@@ -77,7 +79,7 @@ pub fn run(args: &FurnaceArgs) -> Result<()> {
             .map(|r| {
                 serde_json::json!({
                     "theta": r.theta, "alpha": r.alpha,
-                    "none": rgb(r.none), "kulla-conty": rgb(r.kulla_conty), "turquin": rgb(r.turquin),
+                    "none": rgb(r.none), "kulla-conty": r.kulla_conty.map(rgb), "turquin": r.turquin.map(rgb),
                     "walk": r.walk.map(|w| rgb(w.mean)),
                     "walk_std_error": r.walk.map(|w| rgb(w.std_error)),
                 })
@@ -102,13 +104,17 @@ pub fn run(args: &FurnaceArgs) -> Result<()> {
             let walk = r.walk.map_or("—".to_string(), |w| {
                 format!("{:.4} ± {:.4}", luminance(w.mean), luminance(w.std_error))
             });
+            let lum = |kind| {
+                r.albedo(kind)
+                    .map_or("—".to_string(), |c| format!("{:.4}", luminance(c)))
+            };
             let _ = writeln!(
                 out,
-                "{:>6} {:>9.4} {:>12.4} {:>9.4} {:>18}",
+                "{:>6} {:>9} {:>12} {:>9} {:>18}",
                 r.theta,
-                luminance(r.albedo(Compensation::None)),
-                luminance(r.kulla_conty),
-                luminance(r.turquin),
+                lum(Compensation::None),
+                lum(Compensation::KullaConty),
+                lum(Compensation::Turquin),
                 walk
             );
         }

@@ -3,7 +3,7 @@
 
 use anyhow::{Context, Result};
 use clap::Args;
-use lobe::energy::tabulate::{TABLES, TabulateSettings, tabulate_all};
+use lobe::energy::tabulate::{Shape, TABLES, TabulateSettings, tabulate_all};
 
 const B: TabulateSettings = TabulateSettings::BUILTIN;
 
@@ -26,13 +26,16 @@ pub struct TabulateEnergyArgs {
     #[arg(long, short = 'o', value_name = "FILE")]
     out: std::path::PathBuf,
     /// Nodes along μ = cos θo.
-    #[arg(long, default_value_t = B.n_mu as u16, value_parser = clap::value_parser!(u16).range(2..=1024))]
+    #[arg(long, default_value_t = B.conductor.n_mu as u16, value_parser = clap::value_parser!(u16).range(4..=1024))]
     mu: u16,
-    /// Nodes along α.
-    #[arg(long, default_value_t = B.n_alpha as u16, value_parser = clap::value_parser!(u16).range(2..=1024))]
+    /// Nodes along α (conductors; dielectrics have half as many).
+    #[arg(long, default_value_t = B.conductor.n_alpha as u16, value_parser = clap::value_parser!(u16).range(4..=1024))]
     alpha: u16,
-    /// Samples per node.
-    #[arg(long, default_value_t = B.samples, value_parser = |s: &str| crate::common::parse_count(s, 16, 1 << 30, "samples"))]
+    /// Nodes along η (dielectrics).
+    #[arg(long, default_value_t = B.dielectric.n_eta as u16, value_parser = clap::value_parser!(u16).range(2..=1024))]
+    eta: u16,
+    /// Samples per node (conductors; dielectrics have 1/16 of it).
+    #[arg(long, default_value_t = B.conductor.samples, value_parser = |s: &str| crate::common::parse_count(s, 256, 1 << 30, "samples"))]
     samples: u64,
     /// Seed of the random streams.
     #[arg(long, default_value_t = B.seed)]
@@ -44,10 +47,20 @@ pub struct TabulateEnergyArgs {
 
 pub fn run(args: &TabulateEnergyArgs) -> Result<()> {
     crate::common::prepare_output_files("--out", std::slice::from_ref(&args.out))?;
+    let (mu, alpha) = (usize::from(args.mu), usize::from(args.alpha));
     let s = TabulateSettings {
-        n_mu: usize::from(args.mu),
-        n_alpha: usize::from(args.alpha),
-        samples: args.samples,
+        conductor: Shape {
+            n_mu: mu,
+            n_alpha: alpha,
+            n_eta: 1,
+            samples: args.samples,
+        },
+        dielectric: Shape {
+            n_mu: mu,
+            n_alpha: alpha / 2,
+            n_eta: usize::from(args.eta),
+            samples: args.samples / 16,
+        },
         seed: args.seed,
     };
     let t0 = std::time::Instant::now();
@@ -55,11 +68,13 @@ pub fn run(args: &TabulateEnergyArgs) -> Result<()> {
     let tables = tabulate_all(&s, &bar);
     bar.finish();
     let comment = format!(
-        "Directional albedo E(mu, alpha) of single-scattering microfacet reflection, F = 1.\n\
-         Made by: lobe tabulate-energy --mu {} --alpha {} --samples {} --seed {}\n\
-         Nodes: mu = (i/(N_MU-1))^2 (node 0 at 1e-4), alpha = 2 (j/(N_ALPHA-1))^2 (node 0 at 1e-4).\n\
-         Each table: N_ALPHA rows of E (one per alpha node), then N_ALPHA rows of standard errors.",
-        s.n_mu, s.n_alpha, s.samples, s.seed
+        "Directional albedo E(mu, alpha) of single-scattering microfacet lobes: conductors with F = 1,\n\
+         dielectrics R + T with exact Fresnel (importance mode) against eta as well.\n\
+         Made by: lobe tabulate-energy --mu {} --alpha {} --eta {} --samples {} --seed {}\n\
+         Nodes: mu = (i/(N_MU-1))^2 (node 0 at 1e-4), alpha = 2 (j/(N_ALPHA-1))^2 (node 0 at 1e-4),\n\
+         eta = 3^(2k/(N_ETA-1) - 1). Each table: N_ETA x N_ALPHA rows of E (one per alpha node,\n\
+         eta node by eta node), then as many rows of standard errors.",
+        args.mu, args.alpha, args.eta, args.samples, args.seed
     );
     std::fs::write(&args.out, tables.to_text(&comment))
         .with_context(|| format!("--out {}", args.out.display()))?;
@@ -69,12 +84,16 @@ pub fn run(args: &TabulateEnergyArgs) -> Result<()> {
         .flat_map(|t| t.std_errors.iter().copied())
         .fold(0.0, f64::max);
     eprintln!(
-        "wrote {} ({} tables of {} × {} nodes, {} samples each; largest s.e. of a node {:.1e}) in {:.1} s",
+        "wrote {} ({} tables; conductors {} × {} nodes of {} samples, dielectrics {} × {} × {} of {}; largest s.e. of a node {:.1e}) in {:.1} s",
         args.out.display(),
         TABLES.len(),
-        s.n_mu,
-        s.n_alpha,
-        s.samples,
+        s.conductor.n_mu,
+        s.conductor.n_alpha,
+        s.conductor.samples,
+        s.dielectric.n_eta,
+        s.dielectric.n_alpha,
+        s.dielectric.n_mu,
+        s.dielectric.samples,
         worst,
         t0.elapsed().as_secs_f64()
     );

@@ -10,12 +10,13 @@ use lobe::math::luminance;
 use plotters::prelude::*;
 use std::path::Path;
 
-/// Colours of the curves: none, kulla-conty, turquin (Okabe-Ito), and the
-/// random walk in black.
-const CURVES: [(Compensation, RGBColor); 3] = [
-    (Compensation::None, RGBColor(150, 150, 150)),
-    (Compensation::KullaConty, RGBColor(0, 114, 178)),
-    (Compensation::Turquin, RGBColor(213, 94, 0)),
+/// Colours and widths of the curves: none, turquin (wide, under),
+/// kulla-conty (thin, over it: where the two agree both show), Okabe-Ito;
+/// the random walk in black.
+const CURVES: [(Compensation, RGBColor, u32); 3] = [
+    (Compensation::None, RGBColor(150, 150, 150), 2),
+    (Compensation::Turquin, RGBColor(213, 94, 0), 5),
+    (Compensation::KullaConty, RGBColor(0, 114, 178), 2),
 ];
 
 /// One panel per α (four per row), luminance of the albedo against θo.
@@ -34,7 +35,11 @@ pub fn furnace_plot(path: &Path, title: &str, f: &Furnace) -> Result<()> {
         .iter()
         .flat_map(|r| {
             let w = r.walk.map_or(0.0, |w| luminance(w.mean));
-            [luminance(r.kulla_conty), luminance(r.turquin), w]
+            [
+                r.kulla_conty.map_or(0.0, luminance),
+                r.turquin.map_or(0.0, luminance),
+                w,
+            ]
         })
         .fold(1.0f64, f64::max)
         * 1.05;
@@ -44,9 +49,9 @@ pub fn furnace_plot(path: &Path, title: &str, f: &Furnace) -> Result<()> {
         let root = root.titled(title, ("sans-serif", 20)).map_err(|x| e(&x))?;
         let (legend, body) = root.split_vertically(34);
         let mut x = 20;
-        for (kind, colour) in CURVES {
+        for (kind, colour, width) in CURVES {
             legend
-                .draw(&PathElement::new([(x, 14), (x + 28, 14)], colour.stroke_width(3)))
+                .draw(&PathElement::new([(x, 14), (x + 28, 14)], colour.stroke_width(width)))
                 .map_err(|x| e(&x))?;
             let label = format!("multiscatter {kind}");
             legend
@@ -82,11 +87,13 @@ pub fn furnace_plot(path: &Path, title: &str, f: &Furnace) -> Result<()> {
                 .label_style(("sans-serif", 12))
                 .draw()
                 .map_err(|x| e(&x))?;
-            for (kind, colour) in CURVES {
+            for (kind, colour, width) in CURVES {
                 chart
                     .draw_series(LineSeries::new(
-                        cells.iter().map(|r| (r.theta, luminance(r.albedo(kind)))),
-                        colour.stroke_width(2),
+                        cells
+                            .iter()
+                            .filter_map(|r| r.albedo(kind).map(|c| (r.theta, luminance(c)))),
+                        colour.stroke_width(width),
                     ))
                     .map_err(|x| e(&x))?;
             }

@@ -869,6 +869,14 @@ fn kernel_for(m: &Material, strategy: BsdfStrategy) -> Result<Kernel, BatchError
                 }
             });
         }
+        Glossy::RoughDielectric(rd)
+            if rd.multiscatter != crate::energy::DielectricMultiscatter::None =>
+        {
+            return unsupported(format!(
+                "not yet batched: energy compensation (multiscatter {})",
+                rd.multiscatter.kind()
+            ));
+        }
         Glossy::RoughDielectric(rd) => return dielectric_kernel(rd, strategy),
         #[allow(unreachable_patterns)]
         _ => {

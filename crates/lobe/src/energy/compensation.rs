@@ -212,6 +212,54 @@ impl Turquin {
     }
 }
 
+/// The compensation of a rough dielectric interface.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum DielectricMultiscatter {
+    None,
+    Turquin(DielectricTurquin),
+}
+
+impl DielectricMultiscatter {
+    /// Which compensation this is.
+    #[must_use]
+    pub fn kind(&self) -> Compensation {
+        match self {
+            DielectricMultiscatter::None => Compensation::None,
+            DielectricMultiscatter::Turquin(_) => Compensation::Turquin,
+        }
+    }
+}
+
+/// Turquin's scaling of a rough dielectric: reflection and transmission
+/// both divided by `E(μo, α, η)`, the single-scattering lobe's `R + T`
+/// (exact Fresnel, energy as importance carries it), so that a clear
+/// interface passes on all the energy it receives. `E` below
+/// [`MIN_DIELECTRIC_E`] (within a degree of the horizon at an interface of
+/// nearly matched indices) is taken as that.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DielectricTurquin {
+    table: &'static AlbedoTable,
+    alpha: f64,
+}
+
+/// The smallest `E` a dielectric's scaling divides by.
+pub const MIN_DIELECTRIC_E: f64 = 0.01;
+
+impl DielectricTurquin {
+    #[must_use]
+    pub fn new(table: &'static AlbedoTable, alpha: f64) -> Self {
+        DielectricTurquin { table, alpha }
+    }
+
+    /// The factor `1/E(μo, α, η)` at `|cos θo| = mu`, `η` the relative
+    /// index of the far side over the side of `wo`.
+    #[inline]
+    #[must_use]
+    pub fn scale(&self, mu: f64, eta: f64) -> f64 {
+        1.0 / self.table.e_eta(mu, self.alpha, eta).max(MIN_DIELECTRIC_E)
+    }
+}
+
 /// `2 ∫₀¹ r(μ) μ dμ` by 32-point Gauss-Legendre.
 fn cosine_average(r: impl Fn(f64) -> Rgb) -> Rgb {
     let mut sum = Rgb::ZERO;

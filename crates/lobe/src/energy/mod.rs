@@ -17,6 +17,6 @@ pub mod random_walk;
 pub mod table;
 pub mod tabulate;
 
-pub use compensation::{Compensation, Multiscatter};
+pub use compensation::{Compensation, DielectricMultiscatter, Multiscatter};
 pub use random_walk::RandomWalk;
 pub use table::{AlbedoTable, AlbedoTables};

@@ -1,7 +1,9 @@
-//! The white furnace: the directional albedo `∫ f cos θi dωi` of a
+//! The white furnace: the directional albedo `∫ f |cos θi| dωi` of a
 //! microfacet material against `θo` and `α`, without energy compensation,
 //! with each kind of it, and by Heitz et al.'s random walk (the reference
-//! with every bounce), per RGB channel (`lobe furnace`).
+//! with every bounce; conductors), per RGB channel (`lobe furnace`). A
+//! rough dielectric's is `R + T` over the whole sphere, in importance mode
+//! (the energy it passes on).
 //!
 //! The albedos of the models are adaptive quadratures of `eval` over half
 //! the hemisphere (the cells are isotropic and `wo` is at `φ = 0`, so
@@ -55,20 +57,22 @@ impl FurnaceSettings {
 pub struct FurnaceRow {
     pub theta: f64,
     pub alpha: f64,
-    /// The albedo without compensation, with Kulla-Conty's, with Turquin's.
+    /// The albedo without compensation, with Kulla-Conty's, with
+    /// Turquin's (`None` where the model does not have that kind).
     pub none: Rgb,
-    pub kulla_conty: Rgb,
-    pub turquin: Rgb,
-    /// The random walk's, with its standard error (`None` without walks).
+    pub kulla_conty: Option<Rgb>,
+    pub turquin: Option<Rgb>,
+    /// The random walk's, with its standard error (`None` without walks,
+    /// or for a dielectric).
     pub walk: Option<RgbEstimate>,
 }
 
 impl FurnaceRow {
-    /// The albedo of compensation `kind`.
+    /// The albedo of compensation `kind`, where the model has it.
     #[must_use]
-    pub fn albedo(&self, kind: Compensation) -> Rgb {
+    pub fn albedo(&self, kind: Compensation) -> Option<Rgb> {
         match kind {
-            Compensation::None => self.none,
+            Compensation::None => Some(self.none),
             Compensation::KullaConty => self.kulla_conty,
             Compensation::Turquin => self.turquin,
         }
@@ -83,29 +87,40 @@ pub struct Furnace {
     pub rows: Vec<FurnaceRow>,
 }
 
-/// `∫ f cos θi dωi` at `wo` (`φ = 0`) of an isotropic material, per
-/// channel: twice the integral over `φ ∈ [0, π]`.
+/// `∫ f |cos θi| dωi` at `wo` (`φ = 0`) of an isotropic material, per
+/// channel: twice the integral over `φ ∈ [0, π]`, over the lower
+/// hemisphere too where it transmits.
 fn albedo(m: &Material, wo: DVec3) -> Rgb {
+    let below = m.reach().transmits;
     let channel = |c: usize| {
-        let f = |wi: DVec3| m.eval(wo, wi)[c] * wi.z;
+        let f = |wi: DVec3| m.eval(wo, wi)[c] * wi.z.abs();
         let tol = Tolerance::relative(TOLERANCE).with_initial(32, 32);
-        2.0 * integrate_sphere_region(f, (0.0, FRAC_PI_2), (0.0, PI), tol).value
+        let mut sum = integrate_sphere_region(f, (0.0, FRAC_PI_2), (0.0, PI), tol).value;
+        if below {
+            sum += integrate_sphere_region(f, (FRAC_PI_2, PI), (0.0, PI), tol).value;
+        }
+        2.0 * sum
     };
     Rgb::new(channel(0), channel(1), channel(2))
 }
 
-/// `desc` at width `alpha` (isotropic) with compensation `kind`.
+/// `desc` at width `alpha` (isotropic) with compensation `kind` (in
+/// importance mode where the model has modes).
 fn at(desc: &MaterialDesc, alpha: f64, kind: Compensation) -> Result<Material, Error> {
     let mut d = desc.clone();
     d.alpha = Some(alpha);
     (d.alpha_u, d.alpha_v, d.roughness) = (None, None, None);
     d.multiscatter = Some(kind.name().to_string());
+    if d.kind == "roughdielectric" {
+        d.mode = Some("importance".into());
+    }
     d.build()
 }
 
-/// The furnace table of `desc` (a `cook-torrance` or `roughconductor`
-/// description; its `alpha`, `roughness` and `multiscatter` are replaced
-/// by each cell's). Reports one step per cell to `progress` (after `start`).
+/// The furnace table of `desc` (a `cook-torrance`, `roughconductor` or
+/// `roughdielectric` description; its `alpha`, `roughness` and
+/// `multiscatter` are replaced by each cell's, and a dielectric's `mode` by
+/// `importance`). Reports one step per cell to `progress` (after `start`).
 /// The error names the setting or key that is wrong.
 pub fn furnace(
     desc: &MaterialDesc,
@@ -128,24 +143,26 @@ pub fn furnace(
     // Build every material once, so that a bad key or α fails before any work.
     let mut cells = Vec::with_capacity(s.alphas.len());
     for &a in &s.alphas {
-        let ms = Compensation::ALL.map(|k| at(desc, a, k));
-        let [none, kc, tq] = ms;
-        let none = none.map_err(|e| match e {
+        let none = at(desc, a, Compensation::None).map_err(|e| match e {
             Error::Param { field, message } if field == "alpha" => Error::Param {
                 field: "alpha".into(),
                 message: format!("furnace α {a}: {message}"),
             },
             e => e,
         })?;
-        let Glossy::CookTorrance(ct) = &none.glossy else {
-            return Err(Error::param(
-                "type",
-                format!(
-                    "the furnace compares energy compensation of microfacet reflection \
-                     (cook-torrance, roughconductor), not {}",
-                    none.model_name()
-                ),
-            ));
+        let walk = match &none.glossy {
+            Glossy::CookTorrance(ct) => Some(RandomWalk::conductor(ct.microfacet, ct.ks, ct.fresnel)?),
+            Glossy::RoughDielectric(_) => None,
+            _ => {
+                return Err(Error::param(
+                    "type",
+                    format!(
+                        "the furnace compares energy compensation of microfacet models \
+                         (cook-torrance, roughconductor, roughdielectric), not {}",
+                        desc.kind
+                    ),
+                ));
+            }
         };
         if none.diffuse.albedo != Rgb::ZERO {
             return Err(Error::param(
@@ -153,23 +170,31 @@ pub fn furnace(
                 "the furnace measures the microfacet lobe alone: leave kd out",
             ));
         }
-        let walk = RandomWalk::conductor(ct.microfacet, ct.ks, ct.fresnel)?;
-        cells.push((a, [none, kc?, tq?], walk));
+        // A kind the model does not have is left out; any other error is the user's.
+        let optional = |kind| match at(desc, a, kind) {
+            Ok(m) => Ok(Some(m)),
+            Err(Error::Param { field, message }) if field == "multiscatter" && message.contains("not yet") => Ok(None),
+            Err(e) => Err(e),
+        };
+        let (kc, tq) = (optional(Compensation::KullaConty)?, optional(Compensation::Turquin)?);
+        cells.push((a, none, kc, tq, walk));
     }
     let nt = s.thetas.len();
     progress.start("furnace", (s.alphas.len() * nt) as u64);
     let rows = crate::parallel::map_indices(s.alphas.len() * nt, |k| {
-        let (a, ms, walk) = &cells[k / nt];
+        let (a, none, kc, tq, walk) = &cells[k / nt];
         let theta = s.thetas[k % nt];
         let wo = crate::frame::wo_from_theta(theta, 0.0);
-        let albedo = |m: &Material| albedo(m, wo);
         let row = FurnaceRow {
             theta,
             alpha: *a,
-            none: albedo(&ms[0]),
-            kulla_conty: albedo(&ms[1]),
-            turquin: albedo(&ms[2]),
-            walk: (s.walks > 0).then(|| walk.albedo(wo, s.walks, s.seed, k)),
+            none: albedo(none, wo),
+            kulla_conty: kc.as_ref().map(|m| albedo(m, wo)),
+            turquin: tq.as_ref().map(|m| albedo(m, wo)),
+            walk: walk
+                .as_ref()
+                .filter(|_| s.walks > 0)
+                .map(|w| w.albedo(wo, s.walks, s.seed, k)),
         };
         progress.advance(1);
         row

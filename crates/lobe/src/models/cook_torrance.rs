@@ -231,7 +231,7 @@ impl CookTorrance {
         }
         let ndf = self.microfacet.ndf();
         let table = crate::energy::AlbedoTables::builtin()
-            .get(ndf, self.shadowing)
+            .get(ndf, crate::energy::table::Surface::Conductor(self.shadowing))
             .ok_or_else(|| {
                 crate::Error::param(
                     "multiscatter",

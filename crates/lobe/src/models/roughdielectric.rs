@@ -13,6 +13,7 @@
 //! | `specular_transmittance` | RGB in [0, 1] | 1 | multiplies the transmitted part (not physical; Mitsuba's) |
 //! | `sample_visible` | bool | true | Mitsuba's switch; lobe takes the strategy from each call instead, so only `true` is accepted |
 //! | `mode` | `radiance`, `importance` | `radiance` | what is carried: radiance scales refraction by `(η_i/η_t)²`, importance does not (not a Mitsuba key: its context says) |
+//! | `multiscatter` | `none`, `kulla-conty`, `turquin` | `none` | energy compensation for the light that bounces between microfacets ([`crate::energy::compensation`]; GGX or Beckmann with a Smith term; not a Mitsuba key, and `none` is Mitsuba's lobe) |
 //!
 //! (This table is [`PARAMS`]; a test checks that they agree.)
 //!
@@ -44,6 +45,7 @@ use super::dielectric::{check_eta, refraction_scale};
 use super::keys;
 use super::keys::{EXT_IOR, INT_IOR, MODE, SPECULAR_REFLECTANCE, SPECULAR_TRANSMITTANCE};
 use super::{Bxdf, ModelInfo, Param, Range, Value};
+use crate::energy::compensation::{Compensation, DielectricMultiscatter, DielectricTurquin};
 use crate::fresnel::{fresnel_dielectric, refract_about};
 use crate::math::Rgb;
 use crate::microfacet::{Microfacet, Ndf};
@@ -97,6 +99,7 @@ pub const PARAMS: &[Param] = &[
     SPECULAR_TRANSMITTANCE,
     SAMPLE_VISIBLE,
     MODE,
+    super::keys::MULTISCATTER,
 ];
 
 pub const INFO: ModelInfo = ModelInfo {
@@ -114,7 +117,8 @@ fn from_desc(d: &crate::desc::MaterialDesc) -> crate::error::Result<super::Lobes
         keys::checked_colour(d.specular_reflectance, SPECULAR_REFLECTANCE)?,
         keys::checked_colour(d.specular_transmittance, SPECULAR_TRANSMITTANCE)?,
         keys::mode(d)?,
-    )?;
+    )?
+    .with_multiscatter(keys::multiscatter(d)?)?;
     Ok(super::Lobes::only(super::Glossy::RoughDielectric(lobe)))
 }
 
@@ -180,6 +184,8 @@ pub struct RoughDielectric {
     pub specular_reflectance: Rgb,
     pub specular_transmittance: Rgb,
     pub mode: TransportMode,
+    /// Energy compensation (`multiscatter`); none from [`RoughDielectric::new`].
+    pub multiscatter: DielectricMultiscatter,
 }
 
 impl RoughDielectric {
@@ -204,6 +210,43 @@ impl RoughDielectric {
             specular_transmittance: SPECULAR_TRANSMITTANCE
                 .check_colour(specular_transmittance, None)?,
             mode,
+            multiscatter: DielectricMultiscatter::None,
+        })
+    }
+
+    /// The same interface with energy compensation `kind` from lobe's
+    /// built-in tables: `turquin` divides the lobe by its `R + T`;
+    /// `kulla-conty` is refused (not yet: its added lobes need a table of
+    /// each side's reflection and transmission).
+    pub fn with_multiscatter(self, kind: Compensation) -> crate::error::Result<Self> {
+        let multiscatter = match kind {
+            Compensation::None => DielectricMultiscatter::None,
+            Compensation::Turquin => {
+                let table = crate::energy::AlbedoTables::builtin()
+                    .get(self.microfacet.ndf(), crate::energy::table::Surface::Dielectric)
+                    .ok_or_else(|| {
+                        crate::Error::param(
+                            "multiscatter",
+                            format!(
+                                "no built-in table of a {} dielectric",
+                                self.microfacet.ndf().name()
+                            ),
+                        )
+                    })?;
+                let (ax, ay) = self.microfacet.alpha();
+                DielectricMultiscatter::Turquin(DielectricTurquin::new(table, (ax * ay).sqrt()))
+            }
+            Compensation::KullaConty => {
+                return Err(crate::Error::param(
+                    "multiscatter",
+                    "kulla-conty is not yet there for roughdielectric (its added reflection and \
+                     transmission lobes need tables of both sides); turquin is",
+                ));
+            }
+        };
+        Ok(RoughDielectric {
+            multiscatter,
+            ..self
         })
     }
 
@@ -296,6 +339,10 @@ impl RoughDielectric {
             }
             let pdf = pm * t * eta * eta * cos_im.abs() / denom2;
             (self.specular_transmittance * f, pdf)
+        };
+        let f = match &self.multiscatter {
+            DielectricMultiscatter::None => f,
+            DielectricMultiscatter::Turquin(t) => f * t.scale(wo.z.abs(), self.eta_beyond(wo)),
         };
         let ok = |x: f64| x.is_finite() && x >= 0.0;
         if !(ok(pdf) && f.to_array().into_iter().all(ok)) {
