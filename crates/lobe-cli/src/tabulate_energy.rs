@@ -9,15 +9,15 @@ const B: TabulateSettings = TabulateSettings::BUILTIN;
 
 #[derive(Args, Debug)]
 #[command(
-    about = "Compute the albedo tables E(μ, α) that energy compensation (multiscatter) uses",
+    about = "Compute the albedo tables E(μ, α) (and η for glass) that energy compensation (multiscatter) uses",
     long_about = "Compute the directional albedo E(μ, α) of the single-scattering microfacet lobe \
                   with F = 1, for GGX and Beckmann with Smith's separable and height-correlated \
-                  terms, by lobe's own estimator (visible-normal samples, an independent random \
-                  stream per node), and write the tables with each node's standard error. The \
+                  terms, and R + T of rough glass against η as well, by lobe's own estimator \
+                  (visible-normal samples, an independent random stream per node), and write the tables with each node's standard error. The \
                   defaults are the settings of the tables built into lobe \
-                  (crates/lobe/data/energy.txt); the same settings give the same file on any \
-                  machine and thread count: `lobe tabulate-energy --out energy.txt` remakes the \
-                  built-in file in about 4 minutes on 2 cores.",
+                  (crates/lobe/data/energy.txt); the same settings give the same file for any \
+                  thread count: `lobe tabulate-energy --out energy.txt` remakes the built-in \
+                  file in about 5 minutes on 2 cores.",
     after_help = "Examples:\n  \
                   lobe tabulate-energy --mu 16 --alpha 16 --samples 1024 --out small.txt"
 )]

@@ -29,7 +29,7 @@ use rand::RngExt;
 use rand_pcg::Pcg64;
 
 /// Bounces after which a walk is cut (its light is lost): far beyond what
-/// carries energy (at α = 2 a white walk of 100 bounces is rarer than 1e-9).
+/// carries energy (the tests' white walks, α up to 2, all leave before it).
 pub const MAX_BOUNCES: u32 = 1000;
 
 /// A height above the microsurface, where every walk starts.
