@@ -71,8 +71,8 @@ pub mod batch;
 pub mod bsdf_strategy;
 #[cfg(feature = "desc")]
 pub mod desc;
-pub mod envmap;
 pub mod energy;
+pub mod envmap;
 pub mod error;
 pub mod estimator;
 pub mod experiment;

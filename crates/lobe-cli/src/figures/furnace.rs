@@ -51,7 +51,10 @@ pub fn furnace_plot(path: &Path, title: &str, f: &Furnace) -> Result<()> {
         let mut x = 20;
         for (kind, colour, width) in CURVES {
             legend
-                .draw(&PathElement::new([(x, 14), (x + 28, 14)], colour.stroke_width(width)))
+                .draw(&PathElement::new(
+                    [(x, 14), (x + 28, 14)],
+                    colour.stroke_width(width),
+                ))
                 .map_err(|x| e(&x))?;
             let label = format!("multiscatter {kind}");
             legend

@@ -439,7 +439,10 @@ pub(super) fn run_job(
             };
             let f = furnace(&desc, &s, &())?;
             let file = format!("{}-furnace.png", model.id);
-            let title = format!("{}: white furnace, with and without energy compensation", model.title);
+            let title = format!(
+                "{}: white furnace, with and without energy compensation",
+                model.title
+            );
             figures::furnace_plot(&dir.join(&file), &strip_tags(&title), &f)
                 .with_context(|| format!("cannot write {file}"))?;
             Ok(Done::Furnace(Figure {

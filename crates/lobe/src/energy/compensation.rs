@@ -278,6 +278,9 @@ pub fn choose(u: DVec2, q: f64) -> Result<DVec2, DVec2> {
     if u.x < q {
         Ok(DVec2::new(u.x / q, u.y))
     } else {
-        Err(DVec2::new(((u.x - q) / (1.0 - q)).min(1.0 - f64::EPSILON / 2.0), u.y))
+        Err(DVec2::new(
+            ((u.x - q) / (1.0 - q)).min(1.0 - f64::EPSILON / 2.0),
+            u.y,
+        ))
     }
 }

@@ -86,7 +86,11 @@ fn inv_c1(u: f64) -> f64 {
 impl RandomWalk {
     /// The walk on `microfacet` (GGX or Beckmann) with facets of
     /// reflectance `ks F`; the error names the distribution it lacks.
-    pub fn conductor(microfacet: Microfacet, ks: Rgb, fresnel: Fresnel) -> crate::error::Result<Self> {
+    pub fn conductor(
+        microfacet: Microfacet,
+        ks: Rgb,
+        fresnel: Fresnel,
+    ) -> crate::error::Result<Self> {
         if !matches!(microfacet.ndf(), Ndf::Ggx | Ndf::Beckmann) {
             return Err(crate::Error::param(
                 "distribution",

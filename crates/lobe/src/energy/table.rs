@@ -145,7 +145,9 @@ impl AlbedoTable {
         std_errors: Vec<f64>,
     ) -> std::result::Result<Self, String> {
         if n_mu < 2 || n_alpha < 2 {
-            return Err(format!("needs at least 2 × 2 nodes, has {n_mu} × {n_alpha}"));
+            return Err(format!(
+                "needs at least 2 × 2 nodes, has {n_mu} × {n_alpha}"
+            ));
         }
         let dielectric = surface == Surface::Dielectric;
         if dielectric != (n_eta >= 2) || n_eta == 0 {
@@ -172,7 +174,10 @@ impl AlbedoTable {
                 k % n_mu
             ));
         }
-        if let Some(k) = std_errors.iter().position(|v| !(v.is_finite() && *v >= 0.0)) {
+        if let Some(k) = std_errors
+            .iter()
+            .position(|v| !(v.is_finite() && *v >= 0.0))
+        {
             return Err(format!(
                 "standard error {} at alpha node {}, mu node {} is not a number >= 0",
                 std_errors[k],
@@ -333,8 +338,11 @@ impl AlbedoTables {
         static TABLES: std::sync::OnceLock<AlbedoTables> = std::sync::OnceLock::new();
         TABLES.get_or_init(|| {
             // A test parses this file: a failure here is a bug of the build.
-            AlbedoTables::parse(include_str!("../../data/energy.txt"), "energy.txt (built in)")
-                .unwrap_or_else(|e| panic!("{e}"))
+            AlbedoTables::parse(
+                include_str!("../../data/energy.txt"),
+                "energy.txt (built in)",
+            )
+            .unwrap_or_else(|e| panic!("{e}"))
         })
     }
 
@@ -360,7 +368,10 @@ impl AlbedoTables {
             .map(|(k, l)| (k + 1, l.trim()))
             .filter(|(_, l)| !l.is_empty() && !l.starts_with('#'));
         let Some((n, first)) = lines.next() else {
-            return Err(fail(1, format!("empty: a table file starts `{FORMAT} {VERSION}`")));
+            return Err(fail(
+                1,
+                format!("empty: a table file starts `{FORMAT} {VERSION}`"),
+            ));
         };
         match first.split_whitespace().collect::<Vec<_>>()[..] {
             [f, v] if f == FORMAT => {
@@ -390,7 +401,16 @@ impl AlbedoTables {
                     ),
                 )
             };
-            let ["table", ndf, surface, n_mu, n_alpha, samples, seed, ref rest @ ..] = words[..]
+            let [
+                "table",
+                ndf,
+                surface,
+                n_mu,
+                n_alpha,
+                samples,
+                seed,
+                ref rest @ ..,
+            ] = words[..]
             else {
                 return Err(expected());
             };
@@ -429,7 +449,10 @@ impl AlbedoTables {
                     let before = out.len();
                     for w in row.split_whitespace() {
                         out.push(w.parse::<f64>().map_err(|_| {
-                            fail(ln, format!("`{w}` is not a number ({what}, alpha node {j})"))
+                            fail(
+                                ln,
+                                format!("`{w}` is not a number ({what}, alpha node {j})"),
+                            )
                         })?);
                     }
                     if out.len() - before != n_mu {
@@ -513,7 +536,13 @@ mod tests {
         // E = 1 everywhere: E_avg = 1; E = x = √μ: 2∫√μ μ dμ = 4/5.
         let t = table(vec![1.0; 12], 4, 3);
         assert!((t.e_avg(0.3) - 1.0).abs() < 1e-14);
-        let t = table((0..3).flat_map(|_| (0..4).map(|i| i as f64 / 3.0)).collect(), 4, 3);
+        let t = table(
+            (0..3)
+                .flat_map(|_| (0..4).map(|i| i as f64 / 3.0))
+                .collect(),
+            4,
+            3,
+        );
         assert!((t.e_avg(0.3) - 0.8).abs() < 1e-14);
     }
 
@@ -540,11 +569,22 @@ mod tests {
             })
             .collect();
         let e = vec![0.001; values.len()];
-        let t = AlbedoTable::new(Ndf::Ggx, Surface::Dielectric, (nm, na, ne), (16, 1), values, e)
-            .unwrap();
+        let t = AlbedoTable::new(
+            Ndf::Ggx,
+            Surface::Dielectric,
+            (nm, na, ne),
+            (16, 1),
+            values,
+            e,
+        )
+        .unwrap();
         let eta = 1.3f64;
         let want = 0.1 * eta.ln() * eta.ln();
-        assert!((t.e_eta(0.5, 0.3, eta) - want).abs() < 1e-12, "{}", t.e_eta(0.5, 0.3, eta));
+        assert!(
+            (t.e_eta(0.5, 0.3, eta) - want).abs() < 1e-12,
+            "{}",
+            t.e_eta(0.5, 0.3, eta)
+        );
         assert!((t.e_avg_eta(0.3, eta) - want).abs() < 1e-12);
         let text = AlbedoTables { tables: vec![t] }.to_text("");
         assert!(text.contains("table ggx dielectric 3 2 16 1 5"), "{text}");
@@ -576,7 +616,10 @@ mod tests {
         assert!(err(&good.replace("ggx", "gauss")).contains("gauss"));
         assert!(err(&good.replacen("9.000000e-1", "nan", 1)).contains("not an albedo"));
         assert!(err(&good.replacen("9.000000e-1", "x", 1)).contains("`x` is not a number"));
-        let twice = format!("{good}{}", good.lines().skip(1).collect::<Vec<_>>().join("\n"));
+        let twice = format!(
+            "{good}{}",
+            good.lines().skip(1).collect::<Vec<_>>().join("\n")
+        );
         assert!(err(&twice).contains("second table"));
     }
 
@@ -584,7 +627,10 @@ mod tests {
     fn the_builtin_tables_parse() {
         let b = AlbedoTables::builtin();
         for (ndf, s) in crate::energy::tabulate::TABLES {
-            assert!(b.get(ndf, s).is_some(), "no built-in table of {ndf:?} {s:?}");
+            assert!(
+                b.get(ndf, s).is_some(),
+                "no built-in table of {ndf:?} {s:?}"
+            );
         }
     }
 }

@@ -29,7 +29,10 @@ pub const TABLES: [(Ndf, Surface); 6] = [
     (Ndf::Ggx, Surface::Conductor(Shadowing::SmithSeparable)),
     (Ndf::Ggx, Surface::Conductor(Shadowing::SmithCorrelated)),
     (Ndf::Beckmann, Surface::Conductor(Shadowing::SmithSeparable)),
-    (Ndf::Beckmann, Surface::Conductor(Shadowing::SmithCorrelated)),
+    (
+        Ndf::Beckmann,
+        Surface::Conductor(Shadowing::SmithCorrelated),
+    ),
     (Ndf::Ggx, Surface::Dielectric),
     (Ndf::Beckmann, Surface::Dielectric),
 ];
@@ -179,7 +182,13 @@ pub fn tabulate(
     let shape = s.shape(surface);
     let (nm, na) = (shape.n_mu, shape.n_alpha);
     let nodes = crate::parallel::map_indices(nm * na * shape.n_eta, |n| {
-        let m = node_estimate(ndf, surface, (n / (nm * na), n / nm % na, n % nm), shape, s.seed);
+        let m = node_estimate(
+            ndf,
+            surface,
+            (n / (nm * na), n / nm % na, n % nm),
+            shape,
+            s.seed,
+        );
         progress.advance(1);
         (m.mean().clamp(0.0, 1.0), m.std_error())
     });

@@ -151,7 +151,9 @@ pub fn furnace(
             e => e,
         })?;
         let walk = match &none.glossy {
-            Glossy::CookTorrance(ct) => Some(RandomWalk::conductor(ct.microfacet, ct.ks, ct.fresnel)?),
+            Glossy::CookTorrance(ct) => {
+                Some(RandomWalk::conductor(ct.microfacet, ct.ks, ct.fresnel)?)
+            }
             Glossy::RoughDielectric(_) => None,
             _ => {
                 return Err(Error::param(
@@ -173,10 +175,17 @@ pub fn furnace(
         // A kind the model does not have is left out; any other error is the user's.
         let optional = |kind| match at(desc, a, kind) {
             Ok(m) => Ok(Some(m)),
-            Err(Error::Param { field, message }) if field == "multiscatter" && message.contains("not yet") => Ok(None),
+            Err(Error::Param { field, message })
+                if field == "multiscatter" && message.contains("not yet") =>
+            {
+                Ok(None)
+            }
             Err(e) => Err(e),
         };
-        let (kc, tq) = (optional(Compensation::KullaConty)?, optional(Compensation::Turquin)?);
+        let (kc, tq) = (
+            optional(Compensation::KullaConty)?,
+            optional(Compensation::Turquin)?,
+        );
         cells.push((a, none, kc, tq, walk));
     }
     let nt = s.thetas.len();

@@ -85,7 +85,11 @@ fn compensated_samples_weigh_f_cos_over_pdf() {
                 continue;
             };
             let (f, pdf) = s.eval_pdf(wo, x.wi);
-            assert!((pdf - x.pdf).abs() <= 1e-12 * pdf, "{json}: {pdf} vs {}", x.pdf);
+            assert!(
+                (pdf - x.pdf).abs() <= 1e-12 * pdf,
+                "{json}: {pdf} vs {}",
+                x.pdf
+            );
             assert!((f - m.eval(wo, x.wi)).abs().max_element() <= 1e-12 * f.max_element());
             let w = f * x.wi.z.abs() / pdf;
             assert!((w - x.weight).abs().max_element() <= 1e-9 * w.max_element());
@@ -116,17 +120,29 @@ fn white_furnace_of_compensated_conductors() {
         let f = furnace(&desc(json), &s, &()).unwrap();
         for r in &f.rows {
             darkest = darkest.min(r.none.x);
-            for (kind, a) in [("kulla-conty", r.kulla_conty.unwrap()), ("turquin", r.turquin.unwrap())] {
+            for (kind, a) in [
+                ("kulla-conty", r.kulla_conty.unwrap()),
+                ("turquin", r.turquin.unwrap()),
+            ] {
                 let err = (a.x - 1.0).abs();
                 if err > worst.0 {
-                    worst = (err, format!("{json} {kind} α {} θo {}: {}", r.alpha, r.theta, a.x));
+                    worst = (
+                        err,
+                        format!("{json} {kind} α {} θo {}: {}", r.alpha, r.theta, a.x),
+                    );
                 }
             }
         }
     }
-    eprintln!("white furnace: worst |albedo − 1| {:.2e} ({}); darkest uncompensated {darkest:.3}", worst.0, worst.1);
+    eprintln!(
+        "white furnace: worst |albedo − 1| {:.2e} ({}); darkest uncompensated {darkest:.3}",
+        worst.0, worst.1
+    );
     assert!(worst.0 < 5e-3, "{}", worst.1);
-    assert!(darkest < 0.35, "the uncompensated lobes should lose energy: {darkest}");
+    assert!(
+        darkest < 0.35,
+        "the uncompensated lobes should lose energy: {darkest}"
+    );
 }
 
 /// Compensated rough glass passes on all it receives: `R + T` (importance
@@ -150,14 +166,26 @@ fn white_furnace_of_compensated_rough_glass() {
     ] {
         let f = furnace(&desc(json), &s, &()).unwrap();
         for r in &f.rows {
-            assert!(r.kulla_conty.is_none(), "{json}: kulla-conty is not there for glass yet");
+            assert!(
+                r.kulla_conty.is_none(),
+                "{json}: kulla-conty is not there for glass yet"
+            );
             let t = r.turquin.unwrap().x;
             if (t - 1.0).abs() > worst.0 {
-                worst = ((t - 1.0).abs(), format!("{json} α {} θo {}: {t} (none {})", r.alpha, r.theta, r.none.x));
+                worst = (
+                    (t - 1.0).abs(),
+                    format!(
+                        "{json} α {} θo {}: {t} (none {})",
+                        r.alpha, r.theta, r.none.x
+                    ),
+                );
             }
         }
     }
-    eprintln!("rough glass furnace: worst |R + T − 1| {:.2e} ({})", worst.0, worst.1);
+    eprintln!(
+        "rough glass furnace: worst |R + T − 1| {:.2e} ({})",
+        worst.0, worst.1
+    );
     assert!(worst.0 < 0.01, "{}", worst.1);
 }
 
@@ -186,7 +214,10 @@ fn coloured_conductors_gain_saturation_like_the_random_walk() {
         );
         let f = furnace(&desc(&json), &s, &()).unwrap();
         for r in &f.rows {
-            let RgbEstimate { mean: w, std_error: se } = r.walk.unwrap();
+            let RgbEstimate {
+                mean: w,
+                std_error: se,
+            } = r.walk.unwrap();
             let (none, kc) = (r.none, r.kulla_conty.unwrap());
             let at = format!("{metal} α {} θo {}", r.alpha, r.theta);
             for c in 0..3 {
@@ -296,8 +327,21 @@ fn stored_tables_match_a_recomputation() {
             n_eta: t.n_eta,
             samples: 1 << 14,
         };
-        for (e, j, i) in [(0, 1, 1), (3, 6, 3), (5, 10, 0), (12, 20, 40), (20, 31, 63), (24, 45, 10), (9, 63, 2), (16, 63, 63)] {
-            let (e, j, i) = (e * (t.n_eta - 1) / 24, j * (t.n_alpha - 1) / 63, i * (t.n_mu - 1) / 63);
+        for (e, j, i) in [
+            (0, 1, 1),
+            (3, 6, 3),
+            (5, 10, 0),
+            (12, 20, 40),
+            (20, 31, 63),
+            (24, 45, 10),
+            (9, 63, 2),
+            (16, 63, 63),
+        ] {
+            let (e, j, i) = (
+                e * (t.n_eta - 1) / 24,
+                j * (t.n_alpha - 1) / 63,
+                i * (t.n_mu - 1) / 63,
+            );
             let m = node_estimate(ndf, surface, (e, j, i), shape, 12_345);
             let k = (e * t.n_alpha + j) * t.n_mu + i;
             let se = (m.std_error().powi(2) + t.std_errors[k].powi(2)).sqrt();
@@ -368,11 +412,18 @@ fn uncompensated_lobes_are_unchanged_bit_for_bit() {
 fn bad_input_names_the_field() {
     let err = |json: &str| Material::load(json).unwrap_err().to_string();
     let e = err(r#"{"type":"cook-torrance","multiscatter":"heitz"}"#);
-    assert!(e.contains("multiscatter") && e.contains("kulla-conty"), "{e}");
+    assert!(
+        e.contains("multiscatter") && e.contains("kulla-conty"),
+        "{e}"
+    );
     let e = err(r#"{"type":"cook-torrance","shadowing":"v-cavity","multiscatter":"kulla-conty"}"#);
     assert!(e.contains("multiscatter") && e.contains("v-cavity"), "{e}");
-    let e = err(r#"{"type":"cook-torrance","distribution":"blinn-phong","multiscatter":"turquin"}"#);
-    assert!(e.contains("multiscatter") && e.contains("blinn-phong"), "{e}");
+    let e =
+        err(r#"{"type":"cook-torrance","distribution":"blinn-phong","multiscatter":"turquin"}"#);
+    assert!(
+        e.contains("multiscatter") && e.contains("blinn-phong"),
+        "{e}"
+    );
     let e = err(r#"{"type":"phong","multiscatter":"kulla-conty"}"#);
     assert!(e.contains("multiscatter"), "{e}");
     let e = err(r#"{"type":"roughdielectric","multiscatter":"kulla-conty"}"#);
@@ -382,12 +433,16 @@ fn bad_input_names_the_field() {
         walks: 0,
         ..FurnaceSettings::standard()
     };
-    let e = furnace(&desc(r#"{"type":"phong"}"#), &s, &()).unwrap_err().to_string();
+    let e = furnace(&desc(r#"{"type":"phong"}"#), &s, &())
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("type") || e.contains("alpha"), "{e}");
     let bad = FurnaceSettings {
         thetas: vec![90.0],
         ..s.clone()
     };
-    let e = furnace(&desc(r#"{"type":"cook-torrance"}"#), &bad, &()).unwrap_err().to_string();
+    let e = furnace(&desc(r#"{"type":"cook-torrance"}"#), &bad, &())
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("theta") && e.contains("89.9"), "{e}");
 }

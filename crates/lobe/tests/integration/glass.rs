@@ -23,68 +23,74 @@ const OUTSIDE_AND_IN: &[f64] = &[0.0, 60.0, 89.0, 140.0];
 #[test]
 fn chi2_rough_dielectric() {
     use BsdfStrategy::{Brdf, Cosine, SphericalCaps, Uniform, Vndf};
-    common::chi2_over_sphere("glass", &[
-        (
-            r#"{"type":"roughdielectric","distribution":"ggx","alpha":0.3}"#,
-            &[Brdf, Vndf, SphericalCaps, Uniform, Cosine],
-            OUTSIDE_AND_IN,
-        ),
-        (
-            r#"{"type":"roughdielectric","distribution":"ggx","alpha":0.05,"int_ior":1.33}"#,
-            &[Vndf],
-            OUTSIDE_AND_IN,
-        ),
-        (
-            r#"{"type":"roughdielectric","distribution":"beckmann","alpha":0.5}"#,
-            &[Brdf, Vndf],
-            OUTSIDE_AND_IN,
-        ),
-        (
-            r#"{"type":"roughdielectric","distribution":"ggx","alpha_u":0.05,"alpha_v":0.4}"#,
-            &[Vndf],
-            OUTSIDE_AND_IN,
-        ),
-        // Light from the denser side: from outside, total internal reflection past 41.8°.
-        (
-            r#"{"type":"roughdielectric","distribution":"ggx","alpha":0.2,"int_ior":1.0,"ext_ior":1.5}"#,
-            &[Brdf, Vndf],
-            OUTSIDE_AND_IN,
-        ),
-    ]);
+    common::chi2_over_sphere(
+        "glass",
+        &[
+            (
+                r#"{"type":"roughdielectric","distribution":"ggx","alpha":0.3}"#,
+                &[Brdf, Vndf, SphericalCaps, Uniform, Cosine],
+                OUTSIDE_AND_IN,
+            ),
+            (
+                r#"{"type":"roughdielectric","distribution":"ggx","alpha":0.05,"int_ior":1.33}"#,
+                &[Vndf],
+                OUTSIDE_AND_IN,
+            ),
+            (
+                r#"{"type":"roughdielectric","distribution":"beckmann","alpha":0.5}"#,
+                &[Brdf, Vndf],
+                OUTSIDE_AND_IN,
+            ),
+            (
+                r#"{"type":"roughdielectric","distribution":"ggx","alpha_u":0.05,"alpha_v":0.4}"#,
+                &[Vndf],
+                OUTSIDE_AND_IN,
+            ),
+            // Light from the denser side: from outside, total internal reflection past 41.8°.
+            (
+                r#"{"type":"roughdielectric","distribution":"ggx","alpha":0.2,"int_ior":1.0,"ext_ior":1.5}"#,
+                &[Brdf, Vndf],
+                OUTSIDE_AND_IN,
+            ),
+        ],
+    );
 }
 
 #[test]
 fn chi2_plastic_and_two_sided() {
     use BsdfStrategy::{BoundedVndf, Brdf, Cosine, SphericalCaps, Uniform, Vndf};
-    common::chi2_over_sphere("glass", &[
-        (
-            r#"{"type":"roughplastic","distribution":"ggx","alpha":0.2,"diffuse_reflectance":[0.2,0.5,0.8]}"#,
-            &[Brdf, Vndf, SphericalCaps, BoundedVndf, Uniform, Cosine],
-            &[0.0, 60.0, 89.0],
-        ),
-        (
-            r#"{"type":"roughplastic","alpha":0.4,"nonlinear":true}"#,
-            &[Brdf, Vndf],
-            &[0.0, 60.0, 89.0],
-        ),
-        // The density part of smooth plastic: its base.
-        (
-            r#"{"type":"plastic","diffuse_reflectance":0.3}"#,
-            &[Brdf],
-            &[0.0, 60.0, 89.0],
-        ),
-        // Seen from below, a two-sided material is its front mirrored.
-        (
-            r#"{"type":"twosided","bsdf":{"type":"roughconductor","distribution":"ggx","alpha":0.3,"material":"Cu"}}"#,
-            &[Vndf, Cosine],
-            &[30.0, 150.0],
-        ),
-        (
-            r#"{"type":"twosided","material":{"type":"diffuse","reflectance":0.6}}"#,
-            &[Brdf],
-            &[120.0],
-        ),
-    ]);
+    common::chi2_over_sphere(
+        "glass",
+        &[
+            (
+                r#"{"type":"roughplastic","distribution":"ggx","alpha":0.2,"diffuse_reflectance":[0.2,0.5,0.8]}"#,
+                &[Brdf, Vndf, SphericalCaps, BoundedVndf, Uniform, Cosine],
+                &[0.0, 60.0, 89.0],
+            ),
+            (
+                r#"{"type":"roughplastic","alpha":0.4,"nonlinear":true}"#,
+                &[Brdf, Vndf],
+                &[0.0, 60.0, 89.0],
+            ),
+            // The density part of smooth plastic: its base.
+            (
+                r#"{"type":"plastic","diffuse_reflectance":0.3}"#,
+                &[Brdf],
+                &[0.0, 60.0, 89.0],
+            ),
+            // Seen from below, a two-sided material is its front mirrored.
+            (
+                r#"{"type":"twosided","bsdf":{"type":"roughconductor","distribution":"ggx","alpha":0.3,"material":"Cu"}}"#,
+                &[Vndf, Cosine],
+                &[30.0, 150.0],
+            ),
+            (
+                r#"{"type":"twosided","material":{"type":"diffuse","reflectance":0.6}}"#,
+                &[Brdf],
+                &[120.0],
+            ),
+        ],
+    );
 }
 
 /// The delta parts: reflection with probability `F` (the pane's `R'`, the
