@@ -134,16 +134,16 @@ impl KullaConty {
         // Below 1e-9 of lost energy the lobe is nothing (and 1/(1 − E_avg)
         // would only amplify the table's rounding).
         let lost = 1.0 - e_avg;
-        let scale = if lost > 1e-9 {
-            f_ms * (INV_PI / lost)
+        let (scale, ms_albedo) = if lost > 1e-9 {
+            (f_ms * (INV_PI / lost), luminance(f_ms))
         } else {
-            Rgb::ZERO
+            (Rgb::ZERO, 0.0)
         };
         KullaConty {
             table,
             alpha,
             scale,
-            ms_albedo: if lost > 1e-9 { luminance(f_ms) } else { 0.0 },
+            ms_albedo,
         }
     }
 
@@ -169,28 +169,22 @@ impl KullaConty {
         self.ms_albedo * self.lost(wo.z)
     }
 
-    /// The probability of drawing the added lobe by cosine sampling, given
-    /// the luminance of the single-scattering lobe's albedo at `wo`
-    /// (`E(μo)` times its reflectance): the added lobe's share of the
-    /// albedo, at most 0.9.
+    /// The probability of drawing the added lobe by cosine sampling at
+    /// `wo`, given the single-scattering lobe's reflectance there (tint
+    /// times Fresnel): the added lobe's share of the albedo, its
+    /// `ms_albedo (1 − E(μo))` against `E(μo)` times the luminance of
+    /// `reflectance`, at most 0.9. One table lookup.
     #[inline]
     #[must_use]
-    pub fn cosine_probability(&self, wo: DVec3, single: f64) -> f64 {
-        let ms = self.albedo(wo);
+    pub fn cosine_probability(&self, wo: DVec3, reflectance: Rgb) -> f64 {
+        let e = self.table.e(wo.z, self.alpha);
+        let ms = self.ms_albedo * (1.0 - e).max(0.0);
+        let single = e * luminance(reflectance);
         if ms > 0.0 {
             (ms / (ms + single.max(0.0))).min(0.9)
         } else {
             0.0
         }
-    }
-
-    /// The single-scattering lobe's albedo estimate for
-    /// [`KullaConty::cosine_probability`]: `E(μo)` times the luminance of
-    /// `reflectance`.
-    #[inline]
-    #[must_use]
-    pub fn single_albedo(&self, wo: DVec3, reflectance: Rgb) -> f64 {
-        self.table.e(wo.z, self.alpha) * luminance(reflectance)
     }
 }
 

@@ -150,11 +150,13 @@ pub fn furnace(
             },
             e => e,
         })?;
-        let walk = match &none.glossy {
-            Glossy::CookTorrance(ct) => {
-                Some(RandomWalk::conductor(ct.microfacet, ct.ks, ct.fresnel)?)
-            }
-            Glossy::RoughDielectric(_) => None,
+        // The random walk where lobe has one, and the kinds of compensation the model has.
+        let (walk, kinds) = match &none.glossy {
+            Glossy::CookTorrance(ct) => (
+                Some(RandomWalk::conductor(ct.microfacet, ct.ks, ct.fresnel)?),
+                &Compensation::ALL[..],
+            ),
+            Glossy::RoughDielectric(_) => (None, crate::models::roughdielectric::COMPENSATIONS),
             _ => {
                 return Err(Error::param(
                     "type",
@@ -172,16 +174,8 @@ pub fn furnace(
                 "the furnace measures the microfacet lobe alone: leave kd out",
             ));
         }
-        // A kind the model does not have is left out; any other error is the user's.
-        let optional = |kind| match at(desc, a, kind) {
-            Ok(m) => Ok(Some(m)),
-            Err(Error::Param { field, message })
-                if field == "multiscatter" && message.contains("not yet") =>
-            {
-                Ok(None)
-            }
-            Err(e) => Err(e),
-        };
+        // A kind the model does not have is left out.
+        let optional = |kind| kinds.contains(&kind).then(|| at(desc, a, kind)).transpose();
         let (kc, tq) = (
             optional(Compensation::KullaConty)?,
             optional(Compensation::Turquin)?,

@@ -260,7 +260,7 @@ impl CookTorrance {
     fn cosine_probability(&self, wo: DVec3) -> f64 {
         match &self.multiscatter {
             Multiscatter::KullaConty(kc) => {
-                kc.cosine_probability(wo, kc.single_albedo(wo, self.ks * self.fresnel.eval(wo.z)))
+                kc.cosine_probability(wo, self.ks * self.fresnel.eval(wo.z))
             }
             _ => 0.0,
         }

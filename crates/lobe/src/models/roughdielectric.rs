@@ -175,6 +175,10 @@ pub(crate) fn mitsuba_microfacet(
     })
 }
 
+/// The kinds of `multiscatter` a rough dielectric has (`kulla-conty` is
+/// not yet built for it: [`RoughDielectric::with_multiscatter`]).
+pub const COMPENSATIONS: &[Compensation] = &[Compensation::None, Compensation::Turquin];
+
 /// A rough dielectric interface of relative index `eta = η_inside /
 /// η_outside`.
 #[derive(Debug, Clone, Copy, PartialEq)]
