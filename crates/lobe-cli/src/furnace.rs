@@ -16,8 +16,8 @@ const DEFAULT_MATERIAL: &str = r#"{"type":"roughconductor","distribution":"ggx"}
 #[command(
     about = "The white furnace: albedo against θo and α, with and without energy compensation, against the random walk",
     long_about = "The directional albedo ∫ f |cos θi| dωi of a microfacet material (cook-torrance, \
-                  roughconductor, or roughdielectric: R + T in importance mode) in a white \
-                  furnace, against θo and α: without compensation \
+                  roughconductor, roughdielectric: R + T in importance mode, or roughplastic: \
+                  the coating and what the base sends back) in a white furnace, against θo and α: without compensation \
                   (multiscatter none, what Mitsuba 3 and pbrt-v4 render), with Kulla and Conty's \
                   and with Turquin's, by quadrature, and Heitz et al.'s random walk on the \
                   microsurface (every bounce, conductors; mean ± standard error of --walks \
@@ -27,7 +27,8 @@ const DEFAULT_MATERIAL: &str = r#"{"type":"roughconductor","distribution":"ggx"}
     after_help = "Examples:\n  \
                   lobe furnace --alpha 0.2,1 --out furnace.png\n  \
                   lobe furnace --material '{\"type\":\"cook-torrance\",\"fresnel\":{\"type\":\"conductor\"}}' --alpha 0.5,1 --theta 0,30,60,80,89 --out gold.png\n  \
-                  lobe furnace --theta 0,45,80 --alpha 0.5,1 --walks 0 --json"
+                  lobe furnace --theta 0,45,80 --alpha 0.5,1 --walks 0 --json\n  \
+                  lobe furnace -m '{\"type\":\"roughplastic\",\"distribution\":\"ggx\",\"diffuse_reflectance\":1}' --theta 0,60,85 --alpha 0.1,0.5,1"
 )]
 pub struct FurnaceArgs {
     /// The material (JSON, @FILE.json or @FILE.toml).

@@ -245,6 +245,32 @@ impl DielectricTurquin {
         DielectricTurquin { table, alpha }
     }
 
+    /// The scaling of an interface of distribution `ndf`, width `alpha`
+    /// (`√(αu αv)`) and relative index `eta` from lobe's built-in tables.
+    /// The error names `multiscatter`: no table of that distribution, or
+    /// `η` (either way round) beyond the tables' `[1/3, 3]`.
+    pub fn builtin(ndf: crate::Ndf, alpha: f64, eta: f64) -> crate::error::Result<Self> {
+        use super::table::{MAX_TABLE_ETA, Surface};
+        let table = super::AlbedoTables::builtin()
+            .get(ndf, Surface::Dielectric)
+            .ok_or_else(|| {
+                crate::Error::param(
+                    "multiscatter",
+                    format!("no built-in table of a {} dielectric", ndf.name()),
+                )
+            })?;
+        if !(1.0 / MAX_TABLE_ETA..=MAX_TABLE_ETA).contains(&eta) {
+            return Err(crate::Error::param(
+                "multiscatter",
+                format!(
+                    "the relative index int_ior/ext_ior is {eta}: the dielectric albedo tables \
+                     span 1/{MAX_TABLE_ETA} to {MAX_TABLE_ETA}"
+                ),
+            ));
+        }
+        Ok(DielectricTurquin::new(table, alpha))
+    }
+
     /// The factor `1/E(μo, α, η)` at `|cos θo| = mu`, `η` the relative
     /// index of the far side over the side of `wo`.
     #[inline]

@@ -3,7 +3,8 @@
 //! with each kind of it, and by Heitz et al.'s random walk (the reference
 //! with every bounce; conductors), per RGB channel (`lobe furnace`). A
 //! rough dielectric's is `R + T` over the whole sphere, in importance mode
-//! (the energy it passes on).
+//! (the energy it passes on); a rough plastic's is the coating's reflection
+//! and what its base sends back through it.
 //!
 //! The albedos of the models are adaptive quadratures of `eval` over half
 //! the hemisphere (the cells are isotropic and `wo` is at `φ = 0`, so
@@ -117,8 +118,8 @@ fn at(desc: &MaterialDesc, alpha: f64, kind: Compensation) -> Result<Material, E
     d.build()
 }
 
-/// The furnace table of `desc` (a `cook-torrance`, `roughconductor` or
-/// `roughdielectric` description; its `alpha`, `roughness` and
+/// The furnace table of `desc` (a `cook-torrance`, `roughconductor`,
+/// `roughdielectric` or `roughplastic` description; its `alpha`, `roughness` and
 /// `multiscatter` are replaced by each cell's, and a dielectric's `mode` by
 /// `importance`). Reports one step per cell to `progress` (after `start`).
 /// The error names the setting or key that is wrong.
@@ -157,12 +158,13 @@ pub fn furnace(
                 &Compensation::ALL[..],
             ),
             Glossy::RoughDielectric(_) => (None, crate::models::roughdielectric::COMPENSATIONS),
+            Glossy::RoughPlastic(_) => (None, crate::models::roughplastic::COMPENSATIONS),
             _ => {
                 return Err(Error::param(
                     "type",
                     format!(
                         "the furnace compares energy compensation of microfacet models \
-                         (cook-torrance, roughconductor, roughdielectric), not {}",
+                         (cook-torrance, roughconductor, roughdielectric, roughplastic), not {}",
                         desc.kind
                     ),
                 ));

@@ -226,19 +226,12 @@ impl RoughDielectric {
         let multiscatter = match kind {
             Compensation::None => DielectricMultiscatter::None,
             Compensation::Turquin => {
-                let table = crate::energy::AlbedoTables::builtin()
-                    .get(self.microfacet.ndf(), crate::energy::table::Surface::Dielectric)
-                    .ok_or_else(|| {
-                        crate::Error::param(
-                            "multiscatter",
-                            format!(
-                                "no built-in table of a {} dielectric",
-                                self.microfacet.ndf().name()
-                            ),
-                        )
-                    })?;
                 let (ax, ay) = self.microfacet.alpha();
-                DielectricMultiscatter::Turquin(DielectricTurquin::new(table, (ax * ay).sqrt()))
+                DielectricMultiscatter::Turquin(DielectricTurquin::builtin(
+                    self.microfacet.ndf(),
+                    (ax * ay).sqrt(),
+                    self.eta,
+                )?)
             }
             Compensation::KullaConty => {
                 return Err(crate::Error::param(

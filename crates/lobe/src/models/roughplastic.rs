@@ -11,6 +11,7 @@
 //! | `ext_ior` | > 0, or a name (`bk7`, `water`, `air`, ...: the list ends `lobe eval --help`) | `air` | index of refraction outside (above the surface); `air` is 1.000277 |
 //! | `nonlinear` | bool | false | account for the base's colour in the light it sends back through the coating (its albedo in the internal-reflection series) |
 //! | `sample_visible` | bool | true | Mitsuba's switch; lobe takes the strategy from each call instead, so only `true` is accepted |
+//! | `multiscatter` | `none`, `kulla-conty`, `turquin` | `none` | energy compensation for the light that bounces between microfacets ([`crate::energy::compensation`]; GGX or Beckmann with a Smith term; not a Mitsuba key, and `none` is Mitsuba's lobe) |
 //!
 //! (This table is [`PARAMS`]; a test checks that they agree.)
 //!
@@ -26,18 +27,30 @@
 //! definitions: 32 × 32 nodes from the denser side, 128 × 128 from the
 //! other, `R_int = 2 Σ R(μⱼ) μⱼ / 64`). Isotropic only (Mitsuba's).
 //!
+//! With `multiscatter = turquin` the coating is the compensated rough
+//! interface of [`super::roughdielectric`]: its reflection and its
+//! transmittance are divided by `E(μ, α, η)`, the single-scattering
+//! interface's `R + T` (lobe's tables), so that what it reflects and what it
+//! lets through add up to 1; `R_int` then follows from the compensated
+//! transmittance by reciprocity, `1 − R_int = 2 ∫ T(μ) μ dμ / η²`
+//! (exact for the piecewise-linear `T`), which is what makes a white base
+//! under a clear coating send back all the light it receives, as a smooth
+//! coating does. It needs `int_ior ≥ ext_ior` (under a rarer coating the
+//! scaled transmittance breaks that reciprocity; refused). `kulla-conty`
+//! is refused (not yet built for dielectrics).
+//!
 //! `uc` chooses the coating with probability `(1 − T) w / ((1 − T) w + T (1 − w))`,
 //! `w = s̄/(s̄ + ρ̄)`; the pdf is that mixture of the coating's density (by
 //! the strategy: `brdf`, `vndf`, `spherical-caps`, `bounded-vndf`) and the
 //! base's `cos θi / π`.
 
 use super::cook_torrance::CookTorrance;
-#[cfg(feature = "desc")]
 use super::keys;
 use super::keys::{EXT_IOR, SPECULAR_REFLECTANCE};
 use super::plastic::{Base, DIFFUSE_REFLECTANCE, NONLINEAR, PLASTIC_INT_IOR};
 use super::roughdielectric::{DISTRIBUTION, MITSUBA_ALPHA, SAMPLE_VISIBLE};
 use super::{Bxdf, ModelInfo, Param};
+use crate::energy::compensation::{Compensation, DielectricMultiscatter, DielectricTurquin};
 use crate::fresnel::fresnel_dielectric;
 use crate::math::Rgb;
 use crate::microfacet::{Microfacet, Shadowing};
@@ -56,6 +69,7 @@ pub const PARAMS: &[Param] = &[
     EXT_IOR,
     NONLINEAR,
     SAMPLE_VISIBLE,
+    keys::MULTISCATTER,
 ];
 
 pub const INFO: ModelInfo = ModelInfo {
@@ -80,12 +94,25 @@ fn from_desc(d: &crate::desc::MaterialDesc) -> crate::error::Result<super::Lobes
         keys::checked_colour(d.specular_reflectance, SPECULAR_REFLECTANCE)?,
         keys::relative_ior(d, PLASTIC_INT_IOR, EXT_IOR)?,
         d.nonlinear.unwrap_or(NONLINEAR.default.flag()),
-    )?;
+    )?
+    .with_multiscatter(keys::multiscatter(d)?)?;
     Ok(super::Lobes::only(super::Glossy::RoughPlastic(lobe)))
 }
 
 /// Number of cosines in the transmittance table (Mitsuba's).
 pub const TABLE_SIZE: usize = 64;
+
+/// The kinds of `multiscatter` a rough plastic has (`kulla-conty` is not
+/// yet built for it: [`RoughPlastic::with_multiscatter`]).
+pub const COMPENSATIONS: &[Compensation] = &[Compensation::None, Compensation::Turquin];
+
+/// What the coating lets through: `T(μⱼ)` at `μⱼ = max(1e-6, j/63)` and
+/// `R_int`.
+#[derive(Debug, Clone, PartialEq)]
+struct Transmission {
+    table: Arc<[f64]>,
+    internal_reflectance: f64,
+}
 
 /// A rough dielectric coating over a Lambertian base.
 #[derive(Debug, Clone, PartialEq)]
@@ -96,10 +123,14 @@ pub struct RoughPlastic {
     /// The coating: Cook-Torrance with the dielectric's Fresnel term and
     /// Smith's separable `G` (Mitsuba's).
     pub coating: CookTorrance,
+    /// Energy compensation of the coating (`multiscatter`); none from
+    /// [`RoughPlastic::new`].
+    pub multiscatter: DielectricMultiscatter,
     base: Base,
-    /// `T(μ)` at `μⱼ = max(1e-6, j/63)`.
-    transmittance: Arc<[f64]>,
-    internal_reflectance: f64,
+    /// The single-scattering coating's (Mitsuba's).
+    single: Transmission,
+    /// What the base sees: `single`, or the compensated coating's.
+    through: Transmission,
 }
 
 impl RoughPlastic {
@@ -127,31 +158,121 @@ impl RoughPlastic {
             Fresnel::Dielectric { eta: Rgb::splat(eta) },
         )?;
         let (table, r_int) = coating_tables(&microfacet, eta);
+        let single = Transmission {
+            table: table.into(),
+            internal_reflectance: r_int,
+        };
         Ok(RoughPlastic {
             diffuse_reflectance: rho,
             eta,
             nonlinear,
             base: Base::new(rho, coating.ks, eta, r_int, nonlinear),
             coating,
-            transmittance: table.into(),
-            internal_reflectance: r_int,
+            multiscatter: DielectricMultiscatter::None,
+            through: single.clone(),
+            single,
         })
     }
 
-    /// `T(cos θ)`, linear between the table's cosines.
+    /// The same plastic with energy compensation `kind` of its coating from
+    /// lobe's built-in tables (see the module documentation): `turquin`;
+    /// `kulla-conty` is refused (not yet built for a dielectric coating).
+    pub fn with_multiscatter(self, kind: Compensation) -> crate::error::Result<Self> {
+        let (multiscatter, through) = match kind {
+            Compensation::None => (DielectricMultiscatter::None, self.single.clone()),
+            Compensation::Turquin if self.eta < 1.0 => {
+                return Err(crate::Error::param(
+                    "multiscatter",
+                    format!(
+                        "turquin needs int_ior ≥ ext_ior (a coating denser than the outside, as a \
+                         plastic's is; here int_ior/ext_ior is {}): under a rarer coating the \
+                         scaled transmittance breaks reciprocity, and a white base would send \
+                         back more light than it receives",
+                        self.eta
+                    ),
+                ));
+            }
+            Compensation::Turquin => {
+                let (alpha, _) = self.coating.microfacet.alpha();
+                let turquin = DielectricTurquin::builtin(self.coating.microfacet.ndf(), alpha, self.eta)?;
+                let n = TABLE_SIZE - 1;
+                let table: Vec<f64> = (0..TABLE_SIZE)
+                    .map(|j| {
+                        let mu = (j as f64 / n as f64).max(1e-6);
+                        (self.single.table[j] * turquin.scale(mu, self.eta)).min(1.0)
+                    })
+                    .collect();
+                // 2 ∫ T(μ) μ dμ of the piecewise-linear T, segment by segment.
+                let mean: f64 = table
+                    .windows(2)
+                    .enumerate()
+                    .map(|(j, t)| {
+                        let (a, b) = (j as f64 / n as f64, (j + 1) as f64 / n as f64);
+                        (b - a) / 6.0 * (t[0] * (2.0 * a + b) + t[1] * (a + 2.0 * b))
+                    })
+                    .sum::<f64>()
+                    * 2.0;
+                let through = Transmission {
+                    table: table.into(),
+                    internal_reflectance: (1.0 - mean / (self.eta * self.eta)).max(0.0),
+                };
+                (DielectricMultiscatter::Turquin(turquin), through)
+            }
+            Compensation::KullaConty => {
+                return Err(crate::Error::param(
+                    "multiscatter",
+                    "kulla-conty is not yet there for roughplastic (its coating is a rough \
+                     dielectric, whose added lobes need tables of both sides); turquin is",
+                ));
+            }
+        };
+        let base = Base::new(
+            self.diffuse_reflectance,
+            self.coating.ks,
+            self.eta,
+            through.internal_reflectance,
+            self.nonlinear,
+        );
+        Ok(RoughPlastic {
+            multiscatter,
+            base,
+            through,
+            ..self
+        })
+    }
+
+    /// The coating's compensation factor at `wo`: `1/E(μo, α, η)` with
+    /// `turquin`, 1 without.
+    #[inline]
+    fn coating_scale(&self, wo: DVec3) -> f64 {
+        match self.multiscatter {
+            DielectricMultiscatter::None => 1.0,
+            DielectricMultiscatter::Turquin(t) => t.scale(wo.z.max(0.0), self.eta),
+        }
+    }
+
+    /// The coating's part of `f` (compensated where asked).
+    #[inline]
+    fn coating_eval(&self, wo: DVec3, wi: DVec3) -> Rgb {
+        self.coating.eval(wo, wi) * self.coating_scale(wo)
+    }
+
+    /// `T(cos θ)`, linear between the table's cosines (the compensated
+    /// coating's with `multiscatter`).
     #[inline]
     #[must_use]
     pub fn transmittance(&self, cos_theta: f64) -> f64 {
         let x = cos_theta.clamp(0.0, 1.0) * (TABLE_SIZE - 1) as f64;
         let i = (x as usize).min(TABLE_SIZE - 2);
-        let t = &self.transmittance;
+        let t = &self.through.table;
         t[i] + (t[i + 1] - t[i]) * (x - i as f64)
     }
 
-    /// `R_int`, the coating's mean reflectance from inside.
+    /// `R_int`, the coating's mean reflectance from inside (the
+    /// compensated coating's with `multiscatter`).
     #[must_use]
     pub fn internal_reflectance(&self) -> f64 {
-        self.internal_reflectance
+        self.through.internal_reflectance
     }
 
     /// Probability of sampling the coating for `wo`.
@@ -246,7 +367,7 @@ impl Bxdf for RoughPlastic {
 
     #[inline]
     fn eval(&self, wo: DVec3, wi: DVec3) -> Rgb {
-        self.coating.eval(wo, wi) + self.base_eval(wo, wi)
+        self.coating_eval(wo, wi) + self.base_eval(wo, wi)
     }
 
     #[inline]
@@ -270,7 +391,7 @@ impl Bxdf for RoughPlastic {
         let (fc, pc) = self.coating.eval_pdf(s, wo, wi);
         let p = self.coating_probability(wo);
         (
-            fc + self.base_eval(wo, wi),
+            fc * self.coating_scale(wo) + self.base_eval(wo, wi),
             p * pc + (1.0 - p) * warp::square_to_cosine_hemisphere_pdf(wi),
         )
     }
