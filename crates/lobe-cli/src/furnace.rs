@@ -20,9 +20,8 @@ const DEFAULT_MATERIAL: &str = r#"{"type":"roughconductor","distribution":"ggx"}
                   the coating and what the base sends back) in a white furnace, against θo and α: without compensation \
                   (multiscatter none, what Mitsuba 3 and pbrt-v4 render), with Kulla and Conty's \
                   and with Turquin's, by quadrature, and Heitz et al.'s random walk on the \
-                  microsurface (every bounce, conductors; mean ± standard error of --walks \
-                  walks). The \
-                  material's alpha and multiscatter are replaced by each cell's. Prints \
+                  microsurface (every bounce, conductors and dielectrics; mean ± standard \
+                  error of --walks walks). The material's alpha and multiscatter are replaced by each cell's. Prints \
                   luminance per α; --json writes every RGB number.",
     after_help = "Examples:\n  \
                   lobe furnace --alpha 0.2,1 --out furnace.png\n  \

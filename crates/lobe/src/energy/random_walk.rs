@@ -1,14 +1,24 @@
-//! The multiple-scattering microfacet reflection of Heitz, Hanika, d'Eon
-//! and Dachsbacher 2016 ("Multiple-Scattering Microfacet BSDFs with the
-//! Smith Model"): a ray walks a random microsurface (Smith's
-//! uncorrelated heights, uniform on `[−1, 1]`, and the slopes of GGX or
-//! Beckmann) and bounces off microfacets until it leaves. The reference
-//! that energy compensation is judged against.
+//! The multiple-scattering microfacet BSDFs of Heitz, Hanika, d'Eon and
+//! Dachsbacher 2016 ("Multiple-Scattering Microfacet BSDFs with the Smith
+//! Model"): a ray walks a random microsurface (Smith's uncorrelated
+//! heights, uniform on `[−1, 1]`, and the slopes of GGX or Beckmann) and
+//! bounces off microfacets until it leaves. The reference that energy
+//! compensation is judged against.
 //!
+//! * A conductor: every bounce reflects, weighted by the facet's
+//!   reflectance (tint times Fresnel).
+//! * A dielectric: at every bounce the facet reflects with probability
+//!   `F` and refracts otherwise, and a refracted ray walks on under the
+//!   interface (the same microsurface seen from the other side: heights and
+//!   normals negated, the relative index inverted) until it leaves above
+//!   (reflected) or below (transmitted). Weights stay 1: the energy that
+//!   importance carries, as lobe's dielectric tables count it (no `η²` at
+//!   a refraction).
 //! * Sampling is exact: [`RandomWalk::sample`] follows one walk from the
-//!   viewer; the direction it leaves in is distributed as `f cos θi`
+//!   viewer; the direction it leaves in is distributed as `f |cos θi|`
 //!   normalized, and its weight is the product of the reflectances of the
-//!   facets it met (1 for a white conductor: the walk loses nothing).
+//!   facets it met (1 for a white conductor and for a dielectric: the walk
+//!   loses nothing).
 //! * Evaluation is estimated: [`RandomWalk::eval_once`] follows one walk
 //!   and adds at every bounce the chance of scattering toward `wi` and
 //!   leaving unshadowed (next-event estimation); its mean is `f(wo, wi)`.
@@ -17,10 +27,9 @@
 //! Its first bounce is the single-scattering lobe with the
 //! height-correlated term `1/(1 + Λo + Λi)`. There is no pdf of a walk, so
 //! the walk is not a lobe of [`crate::Material`]: it cannot be drawn by
-//! another strategy or weighed by MIS. Conductors only (a reflectance per
-//! bounce, tint times Fresnel); walks are cut at [`MAX_BOUNCES`].
+//! another strategy or weighed by MIS. Walks are cut at [`MAX_BOUNCES`].
 
-use crate::fresnel::Fresnel;
+use crate::fresnel::{Fresnel, fresnel_dielectric, refract_about};
 use crate::math::{Rgb, reflect};
 use crate::microfacet::{Microfacet, Ndf};
 use crate::stats::Moments;
@@ -62,13 +71,63 @@ impl RgbEstimate {
     }
 }
 
-/// A random-walk conductor: its microsurface and the reflectance of one
-/// facet, `ks F(cos)`.
+/// What a facet does to light.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Facets {
+    /// Reflects, with reflectance `ks F(cos)`.
+    Conductor { ks: Rgb, fresnel: Fresnel },
+    /// Reflects or refracts; `eta` is the index below the surface over the
+    /// index above it.
+    Dielectric { eta: f64 },
+}
+
+/// A random-walk microsurface: its distribution and what its facets do.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RandomWalk {
     microfacet: Microfacet,
-    ks: Rgb,
-    fresnel: Fresnel,
+    facets: Facets,
+}
+
+/// Where a walk is, in the frame of the side it is on (that side's
+/// surface normal is `+z`: the upper side's frame is the shading frame,
+/// the lower side's is its negation).
+#[derive(Debug, Clone, Copy)]
+struct Ray {
+    /// Direction of travel.
+    w: DVec3,
+    /// Height.
+    h: f64,
+    /// Above the surface.
+    outside: bool,
+}
+
+impl Ray {
+    /// A ray leaving (`w` pointing away from the surface, shading frame)
+    /// reversed: the ray that arrives along `−w` from its side, high above.
+    fn arriving(w: DVec3) -> Ray {
+        let outside = w.z > 0.0;
+        Ray {
+            w: -Ray::side(outside, w),
+            h: START_HEIGHT,
+            outside,
+        }
+    }
+
+    /// A shading-frame vector in the frame of the side `outside` says (and
+    /// back: the map is its own inverse).
+    #[inline]
+    fn side(outside: bool, v: DVec3) -> DVec3 {
+        if outside { v } else { -v }
+    }
+
+    /// Go through the surface at the current point, on along `w_below`
+    /// (this side's frame).
+    #[inline]
+    fn cross(&mut self, w_below: DVec3) {
+        self.w = -w_below;
+        self.h = -self.h;
+        self.outside = !self.outside;
+    }
 }
 
 /// `C1(h)`, the height CDF of the uniform distribution on `[−1, 1]`.
@@ -91,17 +150,47 @@ impl RandomWalk {
         ks: Rgb,
         fresnel: Fresnel,
     ) -> crate::error::Result<Self> {
+        Self::on(microfacet, Facets::Conductor { ks, fresnel })
+    }
+
+    /// The walk on a rough dielectric interface: `microfacet` (GGX or
+    /// Beckmann), `eta` the index below over the index above; the error
+    /// names the field that is wrong.
+    pub fn dielectric(microfacet: Microfacet, eta: f64) -> crate::error::Result<Self> {
+        if !(eta.is_finite() && eta > 0.0) {
+            return Err(crate::Error::param(
+                "int_ior",
+                format!("the relative index must be positive and finite, not {eta}"),
+            ));
+        }
+        Self::on(microfacet, Facets::Dielectric { eta })
+    }
+
+    fn on(microfacet: Microfacet, facets: Facets) -> crate::error::Result<Self> {
         if !matches!(microfacet.ndf(), Ndf::Ggx | Ndf::Beckmann) {
             return Err(crate::Error::param(
                 "distribution",
                 "the random walk needs the slopes of ggx or beckmann",
             ));
         }
-        Ok(RandomWalk {
-            microfacet,
-            ks,
-            fresnel,
-        })
+        Ok(RandomWalk { microfacet, facets })
+    }
+
+    /// Whether light goes through (a dielectric).
+    #[must_use]
+    pub fn transmits(&self) -> bool {
+        matches!(self.facets, Facets::Dielectric { .. })
+    }
+
+    /// The relative index seen from the side `outside` says: the far
+    /// side's over the near side's (1 for a conductor, unused).
+    #[inline]
+    fn eta_from(&self, outside: bool) -> f64 {
+        match self.facets {
+            Facets::Dielectric { eta } if outside => eta,
+            Facets::Dielectric { eta } => 1.0 / eta,
+            Facets::Conductor { .. } => 1.0,
+        }
     }
 
     /// Smith's `Λ` of a direction of travel or view `w` on either side:
@@ -156,52 +245,151 @@ impl RandomWalk {
         }
     }
 
-    /// The reflectance of a facet at cosine `c`.
+    /// The reflectance of a facet at cosine `c` (`c > 0`), from the side
+    /// `outside` says.
     #[inline]
-    fn reflectance(&self, c: f64) -> Rgb {
-        self.ks * self.fresnel.eval(c)
+    fn reflectance(&self, c: f64, outside: bool) -> Rgb {
+        match self.facets {
+            Facets::Conductor { ks, fresnel } => ks * fresnel.eval(c),
+            Facets::Dielectric { .. } => {
+                Rgb::splat(fresnel_dielectric(c, self.eta_from(outside)).r)
+            }
+        }
     }
 
-    /// The phase function of one bounce, seen from `w` (either side),
-    /// toward `wi`: `F D(h) / (4 A(w))`, `A(w) = (1 + Λ(w)) w.z` the
-    /// projected area, `h` the half vector.
+    /// `A(w) = (1 + Λ(w)) w.z`, the microsurface's area projected along
+    /// `w` (either side of the mean surface), per unit area.
     #[inline]
-    fn phase(&self, w: DVec3, wi: DVec3) -> Rgb {
-        let Some(h) = (w + wi).try_normalize() else {
+    fn projected_area(&self, w: DVec3) -> f64 {
+        (1.0 + self.lambda(w)) * w.z
+    }
+
+    /// The phase function of one bounce seen from `v` (the side's frame,
+    /// `v` away from the facet) toward `wi` on the same side (`wi.z > 0`):
+    /// `F D(h) / (4 A(v))`, `h` the half vector.
+    #[inline]
+    fn phase(&self, v: DVec3, wi: DVec3, outside: bool) -> Rgb {
+        let Some(h) = (v + wi).try_normalize() else {
             return Rgb::ZERO;
         };
-        let c = w.dot(h);
-        if h.z <= 0.0 || c <= 0.0 {
+        let c = v.dot(h);
+        let area = self.projected_area(v);
+        if h.z <= 0.0 || c <= 0.0 || area <= 0.0 {
             return Rgb::ZERO;
         }
-        let area = (1.0 + self.lambda(w)) * w.z;
-        if area <= 0.0 {
-            return Rgb::ZERO;
-        }
-        self.reflectance(c) * (self.microfacet.d(h) / (4.0 * area))
+        self.reflectance(c, outside) * (self.microfacet.d(h) / (4.0 * area))
     }
 
-    /// One walk from the viewer at `wo` (upper hemisphere).
+    /// The phase function of a refraction seen from `v` (the side's frame)
+    /// toward `wt` below (`wt.z < 0`): `(1 − F) (v·m) D(m) η² |wt·m| /
+    /// (A(v) (v·m + η wt·m)²)`, `m` the generalized half vector, `η` the
+    /// far side's index over the near side's.
+    #[inline]
+    fn phase_through(&self, v: DVec3, wt: DVec3, outside: bool) -> f64 {
+        let eta = self.eta_from(outside);
+        let Some(m) = (v + wt * eta).try_normalize() else {
+            return 0.0;
+        };
+        let m = if m.z < 0.0 { -m } else { m };
+        let (cv, ct) = (v.dot(m), wt.dot(m));
+        let area = self.projected_area(v);
+        if cv <= 0.0 || ct >= 0.0 || area <= 0.0 {
+            return 0.0;
+        }
+        let f = fresnel_dielectric(cv, eta).r;
+        let denom = cv + eta * ct;
+        (1.0 - f) * cv * self.microfacet.d(m) * eta * eta * (-ct) / (area * denom * denom)
+    }
+
+    /// The ray's next meeting with the microsurface (its height moved
+    /// there); `false` if it leaves.
+    #[inline]
+    fn advance(&self, ray: &mut Ray, u: f64) -> bool {
+        match self.next_height(ray.w, ray.h, u) {
+            Some(h) => {
+                ray.h = h;
+                true
+            }
+            None => false,
+        }
+    }
+
+    /// One bounce where the ray is: a visible normal (`u`), then a
+    /// reflection or (a dielectric's, with probability `1 − F`: `uc`) a
+    /// refraction. Returns the weight of the bounce, `None` where the walk
+    /// is cut (no normal, a degenerate direction).
+    #[inline]
+    fn scatter(&self, ray: &mut Ray, u: DVec2, uc: f64) -> Option<Rgb> {
+        let v = -ray.w;
+        let m = self.sample_visible(v, u)?;
+        let c = v.dot(m);
+        if c.is_nan() || c <= 0.0 {
+            return None;
+        }
+        match self.facets {
+            Facets::Conductor { .. } => {
+                let d = reflect(v, m);
+                if !d.is_finite() {
+                    return None;
+                }
+                ray.w = d;
+                Some(self.reflectance(c, ray.outside))
+            }
+            Facets::Dielectric { .. } => {
+                let eta = self.eta_from(ray.outside);
+                let f = fresnel_dielectric(c, eta).r;
+                if uc < f {
+                    ray.w = reflect(v, m);
+                } else {
+                    // Into the other medium, whichever way it points (a
+                    // steep facet can send it up: it meets the surface again).
+                    ray.cross(refract_about(v, m, eta)?.try_normalize()?);
+                }
+                ray.w.is_finite().then_some(Rgb::ONE)
+            }
+        }
+    }
+
+    /// Next-event estimation from where the ray is toward `wi` (shading
+    /// frame): the phase function toward it times the chance that it
+    /// leaves from there unshadowed, on the side it points to.
+    #[inline]
+    fn toward(&self, ray: &Ray, wi: DVec3) -> Rgb {
+        let v = -ray.w;
+        let w = Ray::side(ray.outside, wi);
+        if w.z > 0.0 {
+            self.phase(v, w, ray.outside) * self.g1_at(w, ray.h)
+        } else if self.transmits() {
+            Rgb::splat(self.phase_through(v, w, ray.outside) * self.g1_at(-w, -ray.h))
+        } else {
+            Rgb::ZERO
+        }
+    }
+
+    /// Random numbers of one bounce: the visible normal's, and (a
+    /// dielectric's) the choice between reflection and refraction.
+    #[inline]
+    fn bounce_numbers(&self, rng: &mut Pcg64) -> (DVec2, f64) {
+        let u = DVec2::new(rng.random::<f64>(), rng.random::<f64>());
+        let uc = if self.transmits() {
+            rng.random::<f64>()
+        } else {
+            0.0
+        };
+        (u, uc)
+    }
+
+    /// One walk from the viewer at `wo` (a conductor's above the surface, a
+    /// dielectric's either side).
     pub fn sample(&self, wo: DVec3, rng: &mut Pcg64) -> WalkSample {
-        let mut wr = -wo;
-        let mut h = START_HEIGHT;
+        let mut ray = Ray::arriving(wo);
         let mut weight = Rgb::ONE;
         let mut bounces = 0;
-        loop {
-            match self.next_height(wr, h, rng.random::<f64>()) {
-                None => break,
-                Some(next) => h = next,
-            }
+        while self.advance(&mut ray, rng.random::<f64>()) {
             bounces += 1;
-            let w = -wr;
-            let u = DVec2::new(rng.random::<f64>(), rng.random::<f64>());
-            let wm = self.sample_visible(w, u);
-            let next = wm.map(|wm| (reflect(w, wm), w.dot(wm)));
-            match next {
-                Some((d, c)) if bounces < MAX_BOUNCES && d.is_finite() && c > 0.0 => {
-                    weight *= self.reflectance(c);
-                    wr = d;
-                }
+            let (u, uc) = self.bounce_numbers(rng);
+            match self.scatter(&mut ray, u, uc) {
+                Some(w) if bounces < MAX_BOUNCES => weight *= w,
                 _ => {
                     return WalkSample {
                         wi: None,
@@ -212,7 +400,7 @@ impl RandomWalk {
             }
         }
         WalkSample {
-            wi: Some(wr),
+            wi: Some(Ray::side(ray.outside, ray.w)),
             weight,
             bounces,
         }
@@ -221,36 +409,27 @@ impl RandomWalk {
     /// One estimate of `f(wo, wi)` (no cosine): a walk from `wo` with
     /// next-event estimation toward `wi` at every bounce.
     pub fn eval_once(&self, wo: DVec3, wi: DVec3, rng: &mut Pcg64) -> Rgb {
-        if wo.z <= 0.0 || wi.z <= 0.0 {
+        if wo.z == 0.0 || wi.z == 0.0 || (!self.transmits() && (wo.z < 0.0 || wi.z < 0.0)) {
             return Rgb::ZERO;
         }
-        let mut wr = -wo;
-        let mut h = START_HEIGHT;
+        let mut ray = Ray::arriving(wo);
         let mut throughput = Rgb::ONE;
         let mut sum = Rgb::ZERO;
         for _ in 0..MAX_BOUNCES {
-            match self.next_height(wr, h, rng.random::<f64>()) {
-                None => break,
-                Some(next) => h = next,
+            if !self.advance(&mut ray, rng.random::<f64>()) {
+                break;
             }
-            let w = -wr;
-            let nee = self.phase(w, wi) * self.g1_at(wi, h);
+            let nee = self.toward(&ray, wi);
             if nee.is_finite() {
                 sum += throughput * nee;
             }
-            let u = DVec2::new(rng.random::<f64>(), rng.random::<f64>());
-            let Some(wm) = self.sample_visible(w, u) else {
-                break;
-            };
-            let c = w.dot(wm);
-            let d = reflect(w, wm);
-            if !(c > 0.0 && d.is_finite()) {
-                break;
+            let (u, uc) = self.bounce_numbers(rng);
+            match self.scatter(&mut ray, u, uc) {
+                Some(w) => throughput *= w,
+                None => break,
             }
-            throughput *= self.reflectance(c);
-            wr = d;
         }
-        sum / wi.z
+        sum / wi.z.abs()
     }
 
     /// The mean of `walks` estimates of `f(wo, wi)` from the stream
@@ -373,7 +552,7 @@ mod tests {
             let first = white.next_height(-o, h, rng.random::<f64>());
             if let Some(next) = first {
                 h = next;
-                m.push(white.phase(o, wi).x * white.g1_at(wi, h) / wi.z);
+                m.push(white.phase(o, wi, true).x * white.g1_at(wi, h) / wi.z);
             } else {
                 m.push(0.0);
             }
@@ -384,5 +563,78 @@ mod tests {
             m.mean(),
             m.std_error()
         );
+    }
+
+    /// A dielectric walk loses nothing: every walk leaves, above or below,
+    /// with weight 1, from either side.
+    #[test]
+    fn a_dielectric_walk_loses_nothing() {
+        for ndf in [Ndf::Ggx, Ndf::Beckmann] {
+            for alpha in [0.1, 0.5, 1.0] {
+                let mf = Microfacet::new(ndf, alpha, alpha).unwrap();
+                let w = RandomWalk::dielectric(mf, 1.5).unwrap();
+                let mut rng = crate::sequence::chunk_rng(5, 0);
+                let mut below = 0;
+                for theta in [0.0, 45.0, 80.0, 89.0, 100.0, 135.0, 180.0] {
+                    for _ in 0..2000 {
+                        let s = w.sample(wo(theta), &mut rng);
+                        let wi = s.wi.expect("a walk is not cut");
+                        assert!((wi.length() - 1.0).abs() < 1e-9, "{wi}");
+                        assert_eq!(s.weight, Rgb::ONE);
+                        below += usize::from(wi.z < 0.0);
+                    }
+                }
+                // Most light goes through glass, from either side.
+                assert!(below > 7000, "{ndf:?} α {alpha}: {below} of 14000 below");
+            }
+        }
+    }
+
+    /// A dielectric walk's estimated eval integrates, over each hemisphere,
+    /// to the share of sampled walks that leave there (reflection and
+    /// transmission, from outside and from inside): the refraction's phase
+    /// function and the shadowing on the far side agree with the sampler.
+    #[test]
+    fn dielectric_eval_integrates_to_the_sampled_split() {
+        let mf = Microfacet::new(Ndf::Ggx, 0.5, 0.5).unwrap();
+        let w = RandomWalk::dielectric(mf, 1.5).unwrap();
+        for theta in [50.0, 140.0] {
+            let o = wo(theta);
+            let mut rng = crate::sequence::chunk_rng(9, 0);
+            let mut up = Moments::new();
+            for _ in 0..200_000 {
+                let s = w.sample(o, &mut rng);
+                up.push(f64::from(u8::from(s.wi.unwrap().z > 0.0)));
+            }
+            let (nmu, nphi, walks) = (96, 96, 16);
+            let rule = crate::stats::quadrature::gauss_legendre(nmu);
+            for side in [1.0, -1.0] {
+                let (mut integral, mut var) = (0.0, 0.0);
+                for (a, &(t, wt)) in rule.iter().enumerate() {
+                    let mu = 0.5 * (t + 1.0);
+                    for p in 0..nphi {
+                        let phi = (p as f64 + 0.5) / nphi as f64 * std::f64::consts::TAU;
+                        let r = (1.0 - mu * mu).sqrt();
+                        let wi = DVec3::new(r * phi.cos(), r * phi.sin(), side * mu);
+                        let stream = usize::from(side < 0.0) * 10_000 + a * nphi + p;
+                        let e = w.eval(o, wi, walks, 4, stream);
+                        let c = 0.5 * wt * mu * std::f64::consts::TAU / nphi as f64;
+                        integral += e.mean.x * c;
+                        var += e.std_error.x * e.std_error.x * c * c;
+                    }
+                }
+                let sampled = if side > 0.0 {
+                    up.mean()
+                } else {
+                    1.0 - up.mean()
+                };
+                let se = (var + up.std_error().powi(2)).sqrt();
+                assert!(
+                    (integral - sampled).abs() < 5.0 * se + 5e-3,
+                    "θo {theta}, {}: quadrature of eval {integral} vs sampled {sampled} (se {se})",
+                    if side > 0.0 { "above" } else { "below" }
+                );
+            }
+        }
     }
 }

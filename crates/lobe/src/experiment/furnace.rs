@@ -1,7 +1,7 @@
 //! The white furnace: the directional albedo `∫ f |cos θi| dωi` of a
 //! microfacet material against `θo` and `α`, without energy compensation,
 //! with each kind of it, and by Heitz et al.'s random walk (the reference
-//! with every bounce; conductors), per RGB channel (`lobe furnace`). A
+//! with every bounce; conductors and dielectrics), per RGB channel (`lobe furnace`). A
 //! rough dielectric's is `R + T` over the whole sphere, in importance mode
 //! (the energy it passes on); a rough plastic's is the coating's reflection
 //! and what its base sends back through it.
@@ -64,7 +64,7 @@ pub struct FurnaceRow {
     pub kulla_conty: Option<Rgb>,
     pub turquin: Option<Rgb>,
     /// The random walk's, with its standard error (`None` without walks,
-    /// or for a dielectric).
+    /// or for a plastic; a dielectric's, `R + T` in importance mode, is 1).
     pub walk: Option<RgbEstimate>,
 }
 
@@ -157,7 +157,10 @@ pub fn furnace(
                 Some(RandomWalk::conductor(ct.microfacet, ct.ks, ct.fresnel)?),
                 &Compensation::ALL[..],
             ),
-            Glossy::RoughDielectric(_) => (None, crate::models::roughdielectric::COMPENSATIONS),
+            Glossy::RoughDielectric(rd) => (
+                Some(RandomWalk::dielectric(rd.microfacet, rd.eta)?),
+                crate::models::roughdielectric::COMPENSATIONS,
+            ),
             Glossy::RoughPlastic(_) => (None, crate::models::roughplastic::COMPENSATIONS),
             _ => {
                 return Err(Error::param(

@@ -251,6 +251,90 @@ fn white_furnace_of_compensated_rough_plastic() {
     );
 }
 
+/// Rough glass against the dielectric random walk: the share of the light
+/// each reflects (the rest is transmitted; both pass on all of it). The
+/// uncompensated lobe's `R` is the single-scattering `R_ss`, Turquin's is
+/// `R_ss / (R_ss + T_ss)`: it splits the light that bounces more than once
+/// as the first bounce does. The walk is the reference.
+#[test]
+fn rough_glass_reflects_like_the_dielectric_walk() {
+    use lobe::stats::quadrature::{Tolerance, integrate_sphere_region};
+    use std::f64::consts::{FRAC_PI_2, PI};
+    let mut rows = Vec::new();
+    let mut stream = 0;
+    for (ndf, ext, int) in [
+        ("ggx", 1.0, 1.5),
+        ("ggx", 1.5, 1.0),
+        ("beckmann", 1.0, 1.5),
+        ("beckmann", 1.5, 1.0),
+    ] {
+        for alpha in [0.2, 0.5, 1.0] {
+            let at = |kind: &str| {
+                Material::load(&format!(
+                    r#"{{"type":"roughdielectric","distribution":"{ndf}","alpha":{alpha},"int_ior":{int},"ext_ior":{ext},"mode":"importance","multiscatter":"{kind}"}}"#
+                ))
+                .unwrap()
+            };
+            let (none, tq) = (at("none"), at("turquin"));
+            let Glossy::RoughDielectric(rd) = &none.glossy else {
+                unreachable!()
+            };
+            let walk = RandomWalk::dielectric(rd.microfacet, rd.eta).unwrap();
+            for theta in [0.0, 45.0, 75.0] {
+                let wo = lobe::frame::wo_from_theta(theta, 0.0);
+                let reflected = |m: &Material| {
+                    let f = |wi: DVec3| m.eval(wo, wi).x * wi.z;
+                    let tol = Tolerance::relative(1e-4).with_initial(32, 32);
+                    2.0 * integrate_sphere_region(f, (0.0, FRAC_PI_2), (0.0, PI), tol).value
+                };
+                let mut rng = lobe::sequence::chunk_rng(21, stream);
+                stream += 1;
+                let n = 100_000;
+                let up = (0..n)
+                    .filter(|_| walk.sample(wo, &mut rng).wi.is_some_and(|w| w.z > 0.0))
+                    .count() as f64
+                    / n as f64;
+                let se = (up * (1.0 - up) / n as f64).sqrt();
+                rows.push((
+                    ndf,
+                    rd.eta,
+                    alpha,
+                    theta,
+                    reflected(&none),
+                    reflected(&tq),
+                    up,
+                    se,
+                ));
+            }
+        }
+    }
+    eprintln!("rough glass, reflected share: ndf η α θo | none turquin | walk ± s.e.");
+    let (mut closer, mut worst) = (0, (0.0f64, String::new()));
+    for &(ndf, eta, alpha, theta, none, tq, walk, se) in &rows {
+        eprintln!(
+            "{ndf:9} {eta:.3} {alpha:.1} {theta:2} | {none:.4} {tq:.4} | {walk:.4} ± {se:.4}"
+        );
+        closer += usize::from((tq - walk).abs() <= (none - walk).abs() + 3.0 * se);
+        if (tq - walk).abs() > worst.0 {
+            worst = (
+                (tq - walk).abs(),
+                format!("{ndf} η {eta:.3} α {alpha} θo {theta}: turquin {tq:.4}, walk {walk:.4}"),
+            );
+        }
+    }
+    eprintln!(
+        "turquin at least as close as none in {closer} of {}; worst |R − R_walk| {:.4} ({})",
+        rows.len(),
+        worst.0,
+        worst.1
+    );
+    // Compensation never moves the split away from the walk's. (How far
+    // it stays is measured, not an aim: from the denser side at α 1 the
+    // walk reflects up to 0.45 where Turquin's split gives 0.09, the light
+    // that total internal reflection keeps inside; docs/energy.md.)
+    assert_eq!(closer, rows.len(), "turquin moved R away from the walk");
+}
+
 /// Gold and copper: the random walk (every bounce, a Fresnel term at each)
 /// against Kulla-Conty's compensated lobe on the height-correlated
 /// single-scattering lobe the walk starts with. Compensation brings every
