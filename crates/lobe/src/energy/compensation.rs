@@ -19,7 +19,7 @@
 //! An anisotropic lobe is compensated with the tables of `α = √(αu αv)`
 //! (the tables are isotropic): approximate, and said where the key is.
 
-use super::table::AlbedoTable;
+use super::table::{AlbedoRow, AlbedoTable};
 use crate::math::{INV_PI, Rgb, luminance};
 use glam::{DVec2, DVec3};
 
@@ -106,8 +106,7 @@ impl Multiscatter {
                 Multiscatter::KullaConty(KullaConty::new(table, alpha, reflectance))
             }
             Compensation::Turquin => Multiscatter::Turquin(Turquin {
-                table,
-                alpha,
+                row: table.row(alpha),
                 f0: reflectance(1.0),
             }),
         }
@@ -117,8 +116,8 @@ impl Multiscatter {
 /// Kulla and Conty's added lobe (see the module documentation).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct KullaConty {
-    table: &'static AlbedoTable,
-    alpha: f64,
+    /// `E(μ)` at the lobe's `α`.
+    row: AlbedoRow,
     /// `F_ms / (π (1 − E_avg))`: the lobe is this times `(1 − E(μo))(1 − E(μi))`.
     scale: Rgb,
     /// The albedo of the added lobe is `ms_albedo (1 − E(μo))`: `F_ms`'s luminance.
@@ -140,8 +139,7 @@ impl KullaConty {
             (Rgb::ZERO, 0.0)
         };
         KullaConty {
-            table,
-            alpha,
+            row: table.row(alpha),
             scale,
             ms_albedo,
         }
@@ -150,7 +148,36 @@ impl KullaConty {
     /// `1 − E(μ)`, at least 0.
     #[inline]
     fn lost(&self, mu: f64) -> f64 {
-        (1.0 - self.table.e(mu, self.alpha)).max(0.0)
+        (1.0 - self.row.e(mu)).max(0.0)
+    }
+
+    /// What the lobe needs of `wo`, looked up once: the probability of
+    /// drawing the added lobe ([`KullaConty::cosine_probability`]) and
+    /// `1 − E(μo)`, given the single-scattering lobe's reflectance at `wo`.
+    #[inline]
+    #[must_use]
+    pub fn at(&self, wo: DVec3, reflectance: Rgb) -> KullaContyAt {
+        let lost = if wo.z > 0.0 { self.lost(wo.z) } else { 0.0 };
+        let e = 1.0 - lost;
+        let ms = self.ms_albedo * lost;
+        let single = e * luminance(reflectance);
+        let q = if ms > 0.0 {
+            (ms / (ms + single.max(0.0))).min(0.9)
+        } else {
+            0.0
+        };
+        KullaContyAt { q, lost_o: lost }
+    }
+
+    /// The added lobe toward `wi` from the `wo` of `at` (as
+    /// [`KullaConty::eval`]).
+    #[inline]
+    #[must_use]
+    pub fn eval_at(&self, at: &KullaContyAt, wi: DVec3) -> Rgb {
+        if wi.z <= 0.0 {
+            return Rgb::ZERO;
+        }
+        self.scale * (at.lost_o * self.lost(wi.z))
     }
 
     /// The added lobe `f_ms(wo, wi)` (no cosine), zero below the horizon.
@@ -177,22 +204,24 @@ impl KullaConty {
     #[inline]
     #[must_use]
     pub fn cosine_probability(&self, wo: DVec3, reflectance: Rgb) -> f64 {
-        let e = self.table.e(wo.z, self.alpha);
-        let ms = self.ms_albedo * (1.0 - e).max(0.0);
-        let single = e * luminance(reflectance);
-        if ms > 0.0 {
-            (ms / (ms + single.max(0.0))).min(0.9)
-        } else {
-            0.0
-        }
+        self.at(wo, reflectance).q
     }
+}
+
+/// Kulla-Conty's lobe at one `wo` ([`KullaConty::at`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct KullaContyAt {
+    /// The probability of drawing the added lobe by cosine sampling.
+    pub q: f64,
+    /// `1 − E(μo)` (0 below the horizon).
+    lost_o: f64,
 }
 
 /// Turquin's scaling (see the module documentation).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Turquin {
-    table: &'static AlbedoTable,
-    alpha: f64,
+    /// `E(μ)` at the lobe's `α`.
+    row: AlbedoRow,
     f0: Rgb,
 }
 
@@ -201,7 +230,7 @@ impl Turquin {
     #[inline]
     #[must_use]
     pub fn scale(&self, wo: DVec3) -> Rgb {
-        let e = self.table.e(wo.z, self.alpha).max(1e-3);
+        let e = self.row.e(wo.z).max(1e-3);
         Rgb::ONE + self.f0 * ((1.0 - e) / e)
     }
 }

@@ -111,6 +111,38 @@ fn locate(t: f64, n: usize) -> (usize, f64) {
     (k, f - k as f64)
 }
 
+/// `E(μ)` of a conductor's table at one `α`, its `α` cell found once: what
+/// a material looks up per sample (the same numbers as
+/// [`AlbedoTable::e`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AlbedoRow {
+    table: &'static AlbedoTable,
+    j: usize,
+    tj: f64,
+}
+
+impl AlbedoRow {
+    /// `E(μ)` at the row's `α`, bilinear between nodes as [`AlbedoTable::e`].
+    #[inline]
+    #[must_use]
+    pub fn e(&self, mu: f64) -> f64 {
+        let t = self.table;
+        let (i, ti) = locate(mu.max(0.0).sqrt(), t.n_mu);
+        let at = |j: usize| {
+            let r = &t.values[j * t.n_mu..];
+            r[i] + (r[i + 1] - r[i]) * ti
+        };
+        let (a, b) = (at(self.j), at(self.j + 1));
+        a + (b - a) * self.tj
+    }
+
+    /// The table's `α` the row is at.
+    #[must_use]
+    pub fn table(&self) -> &'static AlbedoTable {
+        self.table
+    }
+}
+
 /// `E(μ, α)` (and `η`) of one normal distribution and surface, with the
 /// standard error of each node.
 #[derive(Debug, Clone, PartialEq)]
@@ -198,6 +230,14 @@ impl AlbedoTable {
             std_errors,
             averages,
         })
+    }
+
+    /// The row of a conductor's table at `alpha` (clamped to the table),
+    /// for many lookups at one `α`.
+    #[must_use]
+    pub fn row(&'static self, alpha: f64) -> AlbedoRow {
+        let (j, tj) = locate((alpha.max(0.0) / MAX_TABLE_ALPHA).sqrt(), self.n_alpha);
+        AlbedoRow { table: self, j, tj }
     }
 
     /// `E(μ, α)` of a conductor's table, bilinear between nodes (`μ`, `α`

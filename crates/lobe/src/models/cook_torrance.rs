@@ -32,7 +32,7 @@
 //! The sampling densities use Smith's `G1` whatever `G` term `eval` uses.
 
 use super::{Bxdf, ModelInfo, Param, Range, Value};
-use crate::energy::compensation::{self, Compensation, Multiscatter};
+use crate::energy::compensation::{self, Compensation, KullaConty, KullaContyAt, Multiscatter};
 use crate::math::{INV_PI, Rgb, luminance, reflect};
 use crate::sample::{LobeSample, Scattering};
 use crate::microfacet::{MAX_ALPHA, MIN_ALPHA, Microfacet, Ndf, Shadowing};
@@ -259,11 +259,56 @@ impl CookTorrance {
     #[inline]
     fn cosine_probability(&self, wo: DVec3) -> f64 {
         match &self.multiscatter {
-            Multiscatter::KullaConty(kc) => {
-                kc.cosine_probability(wo, self.ks * self.fresnel.eval(wo.z))
-            }
+            Multiscatter::KullaConty(kc) => self.kulla_conty_at(kc, wo).q,
             _ => 0.0,
         }
+    }
+
+    /// Kulla-Conty's lobe at `wo` (one table lookup).
+    #[inline]
+    fn kulla_conty_at(&self, kc: &KullaConty, wo: DVec3) -> KullaContyAt {
+        kc.at(wo, self.ks * self.fresnel.eval(wo.z))
+    }
+
+    /// Kulla-Conty's `sample_eval`: the single-scattering lobe's own
+    /// `sample_eval` where the microfacet sampler draws (its `D`, `Λ(wo)`
+    /// and half vector shared), its `eval_pdf` where the cosine draws, the
+    /// added lobe and the mixture density from one lookup of `E(μo)`.
+    #[inline]
+    fn kulla_conty_sample_eval(
+        &self,
+        kc: &KullaConty,
+        sampler: MicrofacetSampler,
+        wo: DVec3,
+        u: DVec2,
+    ) -> Option<LobeSample> {
+        let at = self.kulla_conty_at(kc, wo);
+        let drawn = |u| {
+            self.single_sample_eval(sampler, wo, u)
+                .map(|s| (s.wi, s.f, s.pdf))
+        };
+        let (wi, f, p) = if at.q > 0.0 {
+            match compensation::choose(u, at.q) {
+                Ok(u) => {
+                    let wi = crate::warp::square_to_cosine_hemisphere(u);
+                    if wi.z <= 0.0 {
+                        return None;
+                    }
+                    let (f, p) = self.single_eval_pdf(sampler, wo, wi);
+                    (wi, f, p)
+                }
+                Err(u) => drawn(u)?,
+            }
+        } else {
+            drawn(u)?
+        };
+        let pdf = Self::mixed_pdf(p, at.q, wi);
+        (pdf > 0.0).then_some(LobeSample {
+            wi,
+            f: f + kc.eval_at(&at, wi),
+            pdf,
+            scattering: Scattering::GlossyReflection,
+        })
     }
 
     /// The single-scattering lobe's `f` with the compensation added or
@@ -508,20 +553,17 @@ impl Bxdf for CookTorrance {
         &self,
         sampler: MicrofacetSampler,
         wo: DVec3,
-        uc: f64,
+        _uc: f64,
         u: DVec2,
     ) -> Option<LobeSample> {
-        if self.multiscatter == Multiscatter::None {
-            return self.single_sample_eval(sampler, wo, u);
+        match &self.multiscatter {
+            Multiscatter::None => self.single_sample_eval(sampler, wo, u),
+            Multiscatter::KullaConty(kc) => self.kulla_conty_sample_eval(kc, sampler, wo, u),
+            Multiscatter::Turquin(t) => self.single_sample_eval(sampler, wo, u).map(|s| LobeSample {
+                f: s.f * t.scale(wo),
+                ..s
+            }),
         }
-        let wi = self.sample(sampler, wo, uc, u)?;
-        let (f, pdf) = self.eval_pdf(sampler, wo, wi);
-        (pdf > 0.0).then_some(LobeSample {
-            wi,
-            f,
-            pdf,
-            scattering: Scattering::GlossyReflection,
-        })
     }
 
     #[inline]
@@ -538,10 +580,13 @@ impl Bxdf for CookTorrance {
     #[inline]
     fn eval_pdf(&self, sampler: MicrofacetSampler, wo: DVec3, wi: DVec3) -> (Rgb, f64) {
         let (f, p) = self.single_eval_pdf(sampler, wo, wi);
-        (
-            self.compensated(f, wo, wi),
-            Self::mixed_pdf(p, self.cosine_probability(wo), wi),
-        )
+        match &self.multiscatter {
+            Multiscatter::KullaConty(kc) => {
+                let at = self.kulla_conty_at(kc, wo);
+                (f + kc.eval_at(&at, wi), Self::mixed_pdf(p, at.q, wi))
+            }
+            _ => (self.compensated(f, wo, wi), p),
+        }
     }
 
     fn albedo_hint(&self, wo: DVec3) -> f64 {
