@@ -62,6 +62,7 @@ __all__ = [
     "SampleResult",
     "load_dict",
     "estimate",
+    "furnace",
     "render",
     "set_threads",
     "get_threads",
@@ -200,6 +201,41 @@ def estimate(
         str(sequence), int(seed), int(replicas), mis_bsdf, ms,
     )
     return _json.loads(text)
+
+
+def furnace(
+    material: Material | Mapping[str, Any],
+    theta: Sequence[float] | None = None,
+    alpha: Sequence[float] | None = None,
+    walks: int = 100_000,
+    seed: int = 1,
+) -> dict[str, Any]:
+    """The white furnace of a microfacet material (``cook-torrance``,
+    ``roughconductor``, ``roughdielectric``: R + T in importance mode, or
+    ``roughplastic``): its directional albedo ∫ f |cos θi| dωi under light 1
+    from every direction, per RGB channel, for each ``theta`` (degrees, θo;
+    default 0 to 85 by 5, and 89) and ``alpha`` (default 0.05 to 1), without
+    energy compensation (``"none"``, Mitsuba's lobe), with each kind the
+    model has (``"kulla-conty"``, ``"turquin"``; None where it has not), and
+    by Heitz et al.'s random walk on the microsurface (``"walk"`` and
+    ``"walk_std_error"``, the mean of ``walks`` walks per cell; None with
+    ``walks=0`` or for a plastic). The material's ``alpha`` and
+    ``multiscatter`` are replaced by each cell's. What ``lobe furnace
+    --json`` prints, as Python objects (the same library call); the numbers
+    do not depend on the thread count.
+
+    >>> import lobe
+    >>> t = lobe.furnace({"type": "roughconductor", "distribution": "ggx"}, theta=[0], alpha=[1.0], walks=0)
+    >>> row = t["rows"][0]
+    >>> round(row["none"][0], 3), round(row["turquin"][0], 2)
+    (0.307, 1.0)
+    """
+    m = _material(material)
+    for name, v in (("walks", walks), ("seed", seed)):
+        if int(v) < 0:
+            raise ValueError(f"{name} {v}: must be >= 0")
+    grid = lambda xs: None if xs is None else [float(x) for x in xs]  # noqa: E731
+    return _json.loads(_lobe._furnace_json(m, grid(theta), grid(alpha), int(walks), int(seed)))
 
 
 def render(

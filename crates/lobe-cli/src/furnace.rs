@@ -72,23 +72,7 @@ pub fn run(args: &FurnaceArgs) -> Result<()> {
     let f = furnace(&desc, &s, &bar).with_context(|| origin.clone())?;
     bar.finish();
     if args.json {
-        let rgb = |c: lobe::Rgb| serde_json::json!([c.x, c.y, c.z]);
-        let rows: Vec<_> = f
-            .rows
-            .iter()
-            .map(|r| {
-                serde_json::json!({
-                    "theta": r.theta, "alpha": r.alpha,
-                    "none": rgb(r.none), "kulla-conty": r.kulla_conty.map(rgb), "turquin": r.turquin.map(rgb),
-                    "walk": r.walk.map(|w| rgb(w.mean)),
-                    "walk_std_error": r.walk.map(|w| rgb(w.std_error)),
-                })
-            })
-            .collect();
-        println!(
-            "{}",
-            serde_json::json!({"model": f.model, "walks": s.walks, "rows": rows})
-        );
+        println!("{}", f.to_json());
     } else {
         let mut out = String::new();
         let mut last = f64::NAN;

@@ -799,6 +799,31 @@ fn _estimate_json(
         .map_err(value_error)
 }
 
+/// The white furnace table as JSON text (`lobe furnace --json`).
+#[pyfunction]
+#[pyo3(signature = (material, thetas, alphas, walks, seed))]
+fn _furnace_json(
+    py: Python<'_>,
+    material: &PyMaterial,
+    thetas: Option<Vec<f64>>,
+    alphas: Option<Vec<f64>>,
+    walks: u64,
+    seed: u64,
+) -> PyResult<String> {
+    use lobe::experiment::furnace::{FurnaceSettings, furnace};
+    let desc = lobe::MaterialDesc::from_json(&material.desc)
+        .map_err(|e| value_error(without_position(&e.to_string())))?;
+    let standard = FurnaceSettings::standard();
+    let s = FurnaceSettings {
+        thetas: thetas.unwrap_or(standard.thetas),
+        alphas: alphas.unwrap_or(standard.alphas),
+        walks,
+        seed,
+    };
+    py.detach(|| furnace(&desc, &s, &()).map(|f| f.to_json()))
+        .map_err(|e| value_error(e.to_string()))
+}
+
 /// Render a scene (TOML text as if read from `path`) to an (H, W, 3)
 /// float32 linear image.
 /// Run `work` with the GIL released, on a thread of its own, while this
@@ -990,6 +1015,7 @@ fn _lobe(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(cache_info, m)?)?;
     m.add_function(wrap_pyfunction!(clear_cache, m)?)?;
     m.add_function(wrap_pyfunction!(_estimate_json, m)?)?;
+    m.add_function(wrap_pyfunction!(_furnace_json, m)?)?;
     m.add_function(wrap_pyfunction!(_render, m)?)?;
     m.add_function(wrap_pyfunction!(_json_to_toml, m)?)?;
     m.add_function(wrap_pyfunction!(_chi2_uniforms, m)?)?;

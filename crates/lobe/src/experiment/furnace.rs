@@ -85,7 +85,35 @@ impl FurnaceRow {
 pub struct Furnace {
     /// The material's `type`.
     pub model: String,
+    /// Walks per cell of the random walk (0: none).
+    pub walks: u64,
     pub rows: Vec<FurnaceRow>,
+}
+
+#[cfg(feature = "desc")]
+impl Furnace {
+    /// The table as JSON text (`lobe furnace --json`, `lobe.furnace`):
+    /// `model`, `walks` and `rows`, each with `theta`, `alpha`, and RGB
+    /// triples `none`, `kulla-conty`, `turquin`, `walk`, `walk_std_error`
+    /// (`null` where the model has no such kind or no walk ran).
+    #[must_use]
+    pub fn to_json(&self) -> String {
+        use serde_json::json;
+        let rgb = |c: Rgb| json!([c.x, c.y, c.z]);
+        let rows: Vec<_> = self
+            .rows
+            .iter()
+            .map(|r| {
+                json!({
+                    "theta": r.theta, "alpha": r.alpha,
+                    "none": rgb(r.none), "kulla-conty": r.kulla_conty.map(rgb), "turquin": r.turquin.map(rgb),
+                    "walk": r.walk.map(|w| rgb(w.mean)),
+                    "walk_std_error": r.walk.map(|w| rgb(w.std_error)),
+                })
+            })
+            .collect();
+        json!({"model": self.model, "walks": self.walks, "rows": rows}).to_string()
+    }
 }
 
 /// `∫ f |cos θi| dωi` at `wo` (`φ = 0`) of an isotropic material, per
@@ -209,6 +237,7 @@ pub fn furnace(
     });
     Ok(Furnace {
         model: desc.kind.clone(),
+        walks: s.walks,
         rows,
     })
 }
