@@ -63,6 +63,8 @@ __all__ = [
     "load_dict",
     "estimate",
     "furnace",
+    "fit",
+    "sweep",
     "render",
     "set_threads",
     "get_threads",
@@ -236,6 +238,55 @@ def furnace(
             raise ValueError(f"{name} {v}: must be >= 0")
     grid = lambda xs: None if xs is None else [float(x) for x in xs]  # noqa: E731
     return _json.loads(_lobe._furnace_json(m, grid(theta), grid(alpha), int(walks), int(seed)))
+
+
+def fit(
+    material: Material | Mapping[str, Any],
+    distribution: str = "ggx",
+    fresnel: str = "schlick",
+    anisotropic: bool = False,
+) -> dict[str, Any]:
+    """Fit Cook-Torrance (``distribution`` ``"ggx"`` or ``"beckmann"``,
+    ``fresnel`` ``"schlick"`` or ``"conductor"``, one ``alpha`` or, with
+    ``anisotropic``, ``alpha_u`` and ``alpha_v``, and a diffuse ``kd``) to a
+    material, typically a measured one (``{"type": "measured", "path":
+    ...}``), by the cosine-weighted log-space L2 error over its table: what
+    ``lobe fit --json`` prints, as Python objects (the same library call):
+    ``material`` (the fitted description, for ``load_dict``), ``error``,
+    ``pairs``, ``evaluations``.
+
+    >>> import lobe
+    >>> r = lobe.fit({"type": "cook-torrance", "distribution": "ggx", "alpha": 0.3})
+    >>> round(r["material"]["alpha"], 2), r["error"] < 1e-6
+    (0.3, True)
+    """
+    m = _material(material)
+    return _json.loads(_lobe._fit_json(m, str(distribution), str(fresnel), bool(anisotropic)))
+
+
+def sweep(
+    task: str,
+    grid: Mapping[str, Sequence[Any]] | Sequence[Mapping[str, Any]],
+    *,
+    out: str | os.PathLike[str] | None = None,
+    workers: int | None = None,
+    scheduler: Any = None,
+    quiet: bool = False,
+    flush_seconds: float = 2.0,
+) -> Any:
+    """Run a grid of lobe's calls on Dask and return a pandas DataFrame:
+    :func:`lobe.sweeps.sweep` (its documentation says everything; it needs
+    ``pip install 'lobe[dask]'``).
+
+    >>> import lobe
+    >>> callable(lobe.sweep)
+    True
+    """
+    from . import sweeps
+
+    return sweeps.sweep(
+        task, grid, out=out, workers=workers, scheduler=scheduler, quiet=quiet, flush_seconds=flush_seconds
+    )
 
 
 def render(

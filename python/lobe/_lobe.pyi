@@ -15,7 +15,7 @@ _F32 = npt.NDArray[np.float32]
 _Floats = npt.NDArray[np.floating[Any]]
 
 __all__ = [
-    "BLOCK", "Material", "SampleResult", "_chi2_test", "_chi2_uniforms", "_estimate_json", "_furnace_json", "_json_to_toml",
+    "BLOCK", "Material", "SampleResult", "_chi2_test", "_chi2_uniforms", "_estimate_json", "_fit_json", "_furnace_json", "_json_to_toml",
     "_load_json", "_render", "cache_info", "clear_cache", "get_threads", "set_cache_limit", "set_threads", "sidak",
     "simd_level", "__version__",
 ]
@@ -116,6 +116,7 @@ def _estimate_json(
     strategies: list[str], samples: int, sequence: str, seed: int, replicas: int,
     mis_bsdf: Optional[str], mis_samples: Tuple[int, int],
 ) -> str: ...
+def _fit_json(material: Material, distribution: str, fresnel: str, anisotropic: bool) -> str: ...
 def _furnace_json(
     material: Material, thetas: Optional[list[float]], alphas: Optional[list[float]], walks: int, seed: int,
 ) -> str: ...

@@ -78,13 +78,7 @@ pub fn run(args: &FitArgs) -> Result<()> {
     let fit = fit?;
     let seconds = t0.elapsed().as_secs_f64();
     if args.json {
-        println!(
-            r#"{{"material":{},"error":{:e},"pairs":{},"evaluations":{},"seconds":{seconds:.3}}}"#,
-            fit.to_json(),
-            fit.error,
-            fit.pairs,
-            fit.evaluations
-        );
+        println!("{}", fit.report_json(Some(seconds)));
     } else {
         println!("{}", fit.to_json());
         println!(

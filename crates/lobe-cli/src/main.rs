@@ -22,6 +22,7 @@ mod furnace;
 mod plot;
 mod render;
 mod report;
+mod sweep;
 mod tabulate;
 mod tabulate_energy;
 
@@ -61,6 +62,7 @@ enum Command {
     TabulateEnergy(tabulate_energy::TabulateEnergyArgs),
     Fit(fit::FitArgs),
     Furnace(furnace::FurnaceArgs),
+    Sweep(sweep::SweepArgs),
 }
 
 fn main() -> ExitCode {
@@ -82,6 +84,7 @@ fn main() -> ExitCode {
         Command::TabulateEnergy(args) => tabulate_energy::run(&args),
         Command::Fit(args) => fit::run(&args),
         Command::Furnace(args) => furnace::run(&args),
+        Command::Sweep(args) => sweep::run(&args),
     });
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -799,6 +799,40 @@ fn _estimate_json(
         .map_err(value_error)
 }
 
+/// Cook-Torrance fitted to a material, as JSON text (`lobe fit --json`
+/// without the time): `material`, `error`, `pairs`, `evaluations`.
+#[pyfunction]
+#[pyo3(signature = (material, distribution, fresnel, anisotropic))]
+fn _fit_json(
+    py: Python<'_>,
+    material: &PyMaterial,
+    distribution: &str,
+    fresnel: &str,
+    anisotropic: bool,
+) -> PyResult<String> {
+    let distribution = match distribution {
+        "ggx" => lobe::Ndf::Ggx,
+        "beckmann" => lobe::Ndf::Beckmann,
+        other => {
+            return Err(value_error(format!(
+                "distribution {other:?}: expected ggx or beckmann"
+            )));
+        }
+    };
+    let settings = lobe::fit::FitSettings {
+        distribution,
+        fresnel: fresnel
+            .parse()
+            .map_err(|e: lobe::Error| value_error(e.to_string()))?,
+        anisotropic,
+    };
+    let m = material.m.clone();
+    let fit = py
+        .detach(|| lobe::fit::fit(&m, settings))
+        .map_err(|e| value_error(e.to_string()))?;
+    Ok(fit.report_json(None))
+}
+
 /// The white furnace table as JSON text (`lobe furnace --json`).
 #[pyfunction]
 #[pyo3(signature = (material, thetas, alphas, walks, seed))]
@@ -1016,6 +1050,7 @@ fn _lobe(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(clear_cache, m)?)?;
     m.add_function(wrap_pyfunction!(_estimate_json, m)?)?;
     m.add_function(wrap_pyfunction!(_furnace_json, m)?)?;
+    m.add_function(wrap_pyfunction!(_fit_json, m)?)?;
     m.add_function(wrap_pyfunction!(_render, m)?)?;
     m.add_function(wrap_pyfunction!(_json_to_toml, m)?)?;
     m.add_function(wrap_pyfunction!(_chi2_uniforms, m)?)?;

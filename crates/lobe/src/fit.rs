@@ -131,6 +131,21 @@ impl Fit {
         (self.alpha_u * self.alpha_v).sqrt()
     }
 
+    /// The fit as `lobe fit --json` prints it: `material` (as
+    /// [`Fit::to_json`]), `error`, `pairs`, `evaluations`, and `seconds`
+    /// where given.
+    #[must_use]
+    pub fn report_json(&self, seconds: Option<f64>) -> String {
+        let seconds = seconds.map_or(String::new(), |s| format!(r#","seconds":{s:.3}"#));
+        format!(
+            r#"{{"material":{},"error":{:e},"pairs":{},"evaluations":{}{seconds}}}"#,
+            self.to_json(),
+            self.error,
+            self.pairs,
+            self.evaluations
+        )
+    }
+
     /// The material as `--material` accepts it (JSON).
     #[must_use]
     pub fn to_json(&self) -> String {
