@@ -264,31 +264,6 @@ def fit(
     return _json.loads(_lobe._fit_json(m, str(distribution), str(fresnel), bool(anisotropic)))
 
 
-def sweep(
-    task: str,
-    grid: Mapping[str, Sequence[Any]] | Sequence[Mapping[str, Any]],
-    *,
-    out: str | os.PathLike[str] | None = None,
-    workers: int | None = None,
-    scheduler: Any = None,
-    quiet: bool = False,
-    flush_seconds: float = 2.0,
-) -> Any:
-    """Run a grid of lobe's calls on Dask and return a pandas DataFrame:
-    :func:`lobe.sweeps.sweep` (its documentation says everything; it needs
-    ``pip install 'lobe[dask]'``).
-
-    >>> import lobe
-    >>> callable(lobe.sweep)
-    True
-    """
-    from . import sweeps
-
-    return sweeps.sweep(
-        task, grid, out=out, workers=workers, scheduler=scheduler, quiet=quiet, flush_seconds=flush_seconds
-    )
-
-
 def render(
     scene: str | os.PathLike[str] | Mapping[str, Any],
     spp: int | None = None,
@@ -336,3 +311,5 @@ def render(
 
 
 from . import chi2  # noqa: E402
+from . import sweeps  # noqa: E402  (imports Dask only when a sweep runs)
+from .sweeps import sweep  # noqa: E402
