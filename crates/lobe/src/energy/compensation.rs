@@ -239,6 +239,7 @@ impl Turquin {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum DielectricMultiscatter {
     None,
+    KullaConty(DielectricKullaConty),
     Turquin(DielectricTurquin),
 }
 
@@ -248,6 +249,7 @@ impl DielectricMultiscatter {
     pub fn kind(&self) -> Compensation {
         match self {
             DielectricMultiscatter::None => Compensation::None,
+            DielectricMultiscatter::KullaConty(_) => Compensation::KullaConty,
             DielectricMultiscatter::Turquin(_) => Compensation::Turquin,
         }
     }
@@ -306,6 +308,156 @@ impl DielectricTurquin {
     #[must_use]
     pub fn scale(&self, mu: f64, eta: f64) -> f64 {
         1.0 / self.table.e_eta(mu, self.alpha, eta).max(MIN_DIELECTRIC_E)
+    }
+}
+
+/// Kulla and Conty's lobes for a rough dielectric interface: the light
+/// the single-scattering lobe loses from side `s`, `1 − E_s(μo)`, is given
+/// back as an added reflection on that side and an added transmission to
+/// the other, both of Kelemen's separable shape:
+///
+/// * reflection: `ρ_s (1 − E_s(μo))(1 − E_s(μi)) / (π A_s)`,
+/// * transmission: `τ_s (1 − E_s(μo))(1 − E_s'(μi)) / (π A_s')`,
+///
+/// `E_s(μ) = E(μ, α, η_s)` the interface's single-scattering `R + T` seen
+/// from side `s` (lobe's tables, importance mode), `A_s = 1 − E_avg,s`,
+/// `ρ_s + τ_s = 1` so that a clear interface passes on everything from
+/// either side. The split follows the average Fresnel transmittance of each
+/// side, `T_out = 1 − F_avg(η)` and `T_in = T_out / η²` (the exact relation
+/// between the two sides' averages), weighed by the other side's loss:
+/// `τ_out = T_out A_in / (A_out + A_in)`, `τ_in = T_in A_out / (A_out + A_in)`.
+/// Then `τ_out A_out = η² τ_in A_in`, which is what the generalized
+/// reciprocity `f(wo, wi)/η_i² = f(wi, wo)/η_o²` of an importance-mode
+/// transmission asks of the added lobes. Light bouncing inside the denser
+/// medium mostly reflects back (`τ_in` is small), as total internal
+/// reflection makes it. Values here are importance mode and untinted; the
+/// model scales transmission for radiance and applies its tints.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DielectricKullaConty {
+    table: &'static AlbedoTable,
+    alpha: f64,
+    /// `η = η_inside / η_outside`.
+    eta: f64,
+    /// `A_out`, `A_in`.
+    lost_avg: [f64; 2],
+    /// `τ_out`, `τ_in`.
+    tau: [f64; 2],
+}
+
+/// Below this `A_out + A_in` the interface loses nothing worth giving
+/// back (index-matched, or α near zero) and the added lobes are zero.
+pub const MIN_DIELECTRIC_LOSS: f64 = 1e-9;
+
+impl DielectricKullaConty {
+    /// The lobes of an interface of distribution `ndf`, width `alpha`
+    /// (`√(αu αv)`) and relative index `eta` (inside over outside) from
+    /// lobe's built-in tables; the error names `multiscatter` (as
+    /// [`DielectricTurquin::builtin`]).
+    pub fn builtin(ndf: crate::Ndf, alpha: f64, eta: f64) -> crate::error::Result<Self> {
+        let table = DielectricTurquin::builtin(ndf, alpha, eta)?.table;
+        let lost = |e: f64| (1.0 - table.e_avg_eta(alpha, e)).clamp(0.0, 1.0);
+        let lost_avg = [lost(eta), lost(1.0 / eta)];
+        let t_out = 1.0 - crate::fresnel::diffuse_reflectance(eta);
+        let t_in = t_out / (eta * eta);
+        let sum = lost_avg[0] + lost_avg[1];
+        let tau = if sum > MIN_DIELECTRIC_LOSS {
+            [t_out * lost_avg[1] / sum, t_in * lost_avg[0] / sum]
+        } else {
+            [0.0, 0.0]
+        };
+        Ok(DielectricKullaConty {
+            table,
+            alpha,
+            eta,
+            lost_avg,
+            tau,
+        })
+    }
+
+    /// Side index: 0 above the surface, 1 below.
+    #[inline]
+    fn side(w: DVec3) -> usize {
+        usize::from(w.z < 0.0)
+    }
+
+    /// `1 − E_s(|cos θ|)` of direction `w` seen from its own side.
+    #[inline]
+    fn lost(&self, w: DVec3) -> f64 {
+        let eta = if w.z >= 0.0 { self.eta } else { 1.0 / self.eta };
+        (1.0 - self.table.e_eta(w.z.abs(), self.alpha, eta)).clamp(0.0, 1.0)
+    }
+
+    /// The share of the added light from `wo`'s side that is transmitted.
+    #[must_use]
+    pub fn tau(&self, wo: DVec3) -> f64 {
+        self.tau[Self::side(wo)]
+    }
+
+    /// The added lobes' albedo at `wo`: `1 − E_s(μo)` (0 where the
+    /// interface loses nothing).
+    #[inline]
+    #[must_use]
+    pub fn albedo(&self, wo: DVec3) -> f64 {
+        if self.tau == [0.0, 0.0] {
+            return 0.0;
+        }
+        self.lost(wo)
+    }
+
+    /// The added lobe toward `wi` (importance mode, untinted, no cosine):
+    /// the reflection if `wi` is on `wo`'s side, the transmission if not.
+    #[inline]
+    #[must_use]
+    pub fn eval(&self, wo: DVec3, wi: DVec3) -> f64 {
+        if wo.z == 0.0 || wi.z == 0.0 || self.tau == [0.0, 0.0] {
+            return 0.0;
+        }
+        let (so, si) = (Self::side(wo), Self::side(wi));
+        let share = if so == si {
+            1.0 - self.tau[so]
+        } else {
+            self.tau[so]
+        };
+        let norm = self.lost_avg[si];
+        if norm <= 0.0 {
+            // That side loses nothing: its 1 − E(μi) is zero too.
+            return 0.0;
+        }
+        share * self.lost(wo) * self.lost(wi) * INV_PI / norm
+    }
+
+    /// The density of drawing `wi` by the added lobes' own sampler from
+    /// `wo`: reflection with probability `1 − τ`, transmission with `τ`,
+    /// each cosine-distributed on its hemisphere.
+    #[inline]
+    #[must_use]
+    pub fn pdf(&self, wo: DVec3, wi: DVec3) -> f64 {
+        let t = self.tau(wo);
+        let share = if Self::side(wo) == Self::side(wi) {
+            1.0 - t
+        } else {
+            t
+        };
+        share * wi.z.abs() * INV_PI
+    }
+
+    /// Draw from the added lobes: `uc` chooses transmission (`uc < τ`) or
+    /// reflection, `u` the cosine-distributed direction on that side.
+    #[inline]
+    #[must_use]
+    pub fn sample(&self, wo: DVec3, uc: f64, u: DVec2) -> Option<DVec3> {
+        let w = crate::warp::square_to_cosine_hemisphere(u);
+        if w.z <= 0.0 {
+            return None;
+        }
+        let up = wo.z > 0.0;
+        let through = uc < self.tau(wo);
+        // On wo's side unless transmitted.
+        Some(if up != through {
+            w
+        } else {
+            DVec3::new(w.x, w.y, -w.z)
+        })
     }
 }
 

@@ -45,7 +45,9 @@ use super::dielectric::{check_eta, refraction_scale};
 use super::keys;
 use super::keys::{EXT_IOR, INT_IOR, MODE, SPECULAR_REFLECTANCE, SPECULAR_TRANSMITTANCE};
 use super::{Bxdf, ModelInfo, Param, Range, Value};
-use crate::energy::compensation::{Compensation, DielectricMultiscatter, DielectricTurquin};
+use crate::energy::compensation::{
+    self, Compensation, DielectricKullaConty, DielectricMultiscatter, DielectricTurquin,
+};
 use crate::fresnel::{fresnel_dielectric, refract_about};
 use crate::math::Rgb;
 use crate::microfacet::{Microfacet, Ndf};
@@ -175,9 +177,8 @@ pub(crate) fn mitsuba_microfacet(
     })
 }
 
-/// The kinds of `multiscatter` a rough dielectric has (`kulla-conty` is
-/// not yet built for it: [`RoughDielectric::with_multiscatter`]).
-pub const COMPENSATIONS: &[Compensation] = &[Compensation::None, Compensation::Turquin];
+/// The kinds of `multiscatter` a rough dielectric has: all.
+pub const COMPENSATIONS: &[Compensation] = &Compensation::ALL;
 
 /// A rough dielectric interface of relative index `eta = η_inside /
 /// η_outside`.
@@ -220,8 +221,8 @@ impl RoughDielectric {
 
     /// The same interface with energy compensation `kind` from lobe's
     /// built-in tables: `turquin` divides the lobe by its `R + T`;
-    /// `kulla-conty` is refused (not yet: its added lobes need a table of
-    /// each side's reflection and transmission).
+    /// `kulla-conty` adds a reflection and a transmission lobe on each side
+    /// ([`DielectricKullaConty`]).
     pub fn with_multiscatter(self, kind: Compensation) -> crate::error::Result<Self> {
         let multiscatter = match kind {
             Compensation::None => DielectricMultiscatter::None,
@@ -234,11 +235,12 @@ impl RoughDielectric {
                 )?)
             }
             Compensation::KullaConty => {
-                return Err(crate::Error::param(
-                    "multiscatter",
-                    "kulla-conty is not yet there for roughdielectric (its added reflection and \
-                     transmission lobes need tables of both sides); turquin is",
-                ));
+                let (ax, ay) = self.microfacet.alpha();
+                DielectricMultiscatter::KullaConty(DielectricKullaConty::builtin(
+                    self.microfacet.ndf(),
+                    (ax * ay).sqrt(),
+                    self.eta,
+                )?)
             }
         };
         Ok(RoughDielectric {
@@ -308,12 +310,57 @@ impl RoughDielectric {
         }
     }
 
-    /// `(f, pdf)` at `wi` by `sampler`, or `None` where both are zero.
+    /// `(f, pdf)` at `wi` by `sampler`, or `None` where both are zero:
+    /// the single-scattering lobe's, with Kulla-Conty's lobes added and
+    /// their mixture density where they are on.
     #[inline]
     fn eval_pdf_at(&self, sampler: RoughSampler, wo: DVec3, wi: DVec3) -> Option<(Rgb, f64)> {
         if self.index_matched() {
             return None;
         }
+        let DielectricMultiscatter::KullaConty(kc) = &self.multiscatter else {
+            return self.single_eval_pdf_at(sampler, wo, wi);
+        };
+        let (f, p) = self
+            .single_eval_pdf_at(sampler, wo, wi)
+            .unwrap_or((Rgb::ZERO, 0.0));
+        let q = Self::added_probability(kc, wo);
+        let f = f + self.added_eval(kc, wo, wi);
+        let pdf = (1.0 - q) * p + q * kc.pdf(wo, wi);
+        let ok = |x: f64| x.is_finite() && x >= 0.0;
+        (ok(pdf) && f.to_array().into_iter().all(ok) && (pdf > 0.0 || f != Rgb::ZERO))
+            .then_some((f, pdf))
+    }
+
+    /// The probability of drawing Kulla-Conty's added lobes at `wo`: their
+    /// share of a clear interface's energy, `1 − E(μo)`, at most 0.9.
+    #[inline]
+    fn added_probability(kc: &DielectricKullaConty, wo: DVec3) -> f64 {
+        kc.albedo(wo).min(0.9)
+    }
+
+    /// Kulla-Conty's added lobes toward `wi`, tinted, and a transmission
+    /// scaled for radiance as the single-scattering one is.
+    #[inline]
+    fn added_eval(&self, kc: &DielectricKullaConty, wo: DVec3, wi: DVec3) -> Rgb {
+        let v = kc.eval(wo, wi);
+        if wo.z * wi.z > 0.0 {
+            self.specular_reflectance * v
+        } else {
+            let eta = self.eta_beyond(wo);
+            let v = if self.mode == TransportMode::Importance {
+                v
+            } else {
+                v / (eta * eta)
+            };
+            self.specular_transmittance * v
+        }
+    }
+
+    /// The single-scattering lobe's `(f, pdf)` (Turquin's scaling applied),
+    /// or `None` where both are zero.
+    #[inline]
+    fn single_eval_pdf_at(&self, sampler: RoughSampler, wo: DVec3, wi: DVec3) -> Option<(Rgb, f64)> {
         let (m, reflect) = self.half_vector(wo, wi)?;
         let mf = &self.microfacet;
         let (cos_om, cos_im) = (wo.dot(m), wi.dot(m));
@@ -338,8 +385,8 @@ impl RoughDielectric {
             (self.specular_transmittance * f, pdf)
         };
         let f = match &self.multiscatter {
-            DielectricMultiscatter::None => f,
             DielectricMultiscatter::Turquin(t) => f * t.scale(wo.z.abs(), self.eta_beyond(wo)),
+            DielectricMultiscatter::None | DielectricMultiscatter::KullaConty(_) => f,
         };
         let ok = |x: f64| x.is_finite() && x >= 0.0;
         if !(ok(pdf) && f.to_array().into_iter().all(ok)) {
@@ -409,6 +456,17 @@ impl Bxdf for RoughDielectric {
         if self.index_matched() {
             return Some(-wo);
         }
+        // Kulla-Conty: u.x first chooses the added lobes (probability q),
+        // whose own choice of side takes uc.
+        let u = match &self.multiscatter {
+            DielectricMultiscatter::KullaConty(kc) => {
+                match compensation::choose(u, Self::added_probability(kc, wo)) {
+                    Ok(u) => return kc.sample(wo, uc, u),
+                    Err(u) => u,
+                }
+            }
+            _ => u,
+        };
         let m = self.sample_m(sampler, wo, u)?;
         let cos_om = wo.dot(m);
         // `brdf` draws normals that `wo` may see from behind.

@@ -35,9 +35,12 @@
 //! transmittance by reciprocity, `1 − R_int = 2 ∫ T(μ) μ dμ / η²`
 //! (exact for the piecewise-linear `T`), which is what makes a white base
 //! under a clear coating send back all the light it receives, as a smooth
-//! coating does. It needs `int_ior ≥ ext_ior` (under a rarer coating the
-//! scaled transmittance breaks that reciprocity; refused). `kulla-conty`
-//! is refused (not yet built for dielectrics).
+//! coating does. With `kulla-conty` the coating gets the compensated
+//! interface's added reflection (on its side of the surface,
+//! [`crate::energy::compensation::DielectricKullaConty`]) and `T` its
+//! added transmission, `τ_out (1 − E(μ))`; `R_int` follows as above. Both
+//! need `int_ior ≥ ext_ior` (under a rarer coating the compensated
+//! transmittance breaks that reciprocity; refused).
 //!
 //! `uc` chooses the coating with probability `(1 − T) w / ((1 − T) w + T (1 − w))`,
 //! `w = s̄/(s̄ + ρ̄)`; the pdf is that mixture of the coating's density (by
@@ -50,7 +53,9 @@ use super::keys::{EXT_IOR, SPECULAR_REFLECTANCE};
 use super::plastic::{Base, DIFFUSE_REFLECTANCE, NONLINEAR, PLASTIC_INT_IOR};
 use super::roughdielectric::{DISTRIBUTION, MITSUBA_ALPHA, SAMPLE_VISIBLE};
 use super::{Bxdf, ModelInfo, Param};
-use crate::energy::compensation::{Compensation, DielectricMultiscatter, DielectricTurquin};
+use crate::energy::compensation::{
+    Compensation, DielectricKullaConty, DielectricMultiscatter, DielectricTurquin,
+};
 use crate::fresnel::fresnel_dielectric;
 use crate::math::Rgb;
 use crate::microfacet::{Microfacet, Shadowing};
@@ -102,9 +107,8 @@ fn from_desc(d: &crate::desc::MaterialDesc) -> crate::error::Result<super::Lobes
 /// Number of cosines in the transmittance table (Mitsuba's).
 pub const TABLE_SIZE: usize = 64;
 
-/// The kinds of `multiscatter` a rough plastic has (`kulla-conty` is not
-/// yet built for it: [`RoughPlastic::with_multiscatter`]).
-pub const COMPENSATIONS: &[Compensation] = &[Compensation::None, Compensation::Turquin];
+/// The kinds of `multiscatter` a rough plastic has: all.
+pub const COMPENSATIONS: &[Compensation] = &Compensation::ALL;
 
 /// What the coating lets through: `T(μⱼ)` at `μⱼ = max(1e-6, j/63)` and
 /// `R_int`.
@@ -175,19 +179,18 @@ impl RoughPlastic {
     }
 
     /// The same plastic with energy compensation `kind` of its coating from
-    /// lobe's built-in tables (see the module documentation): `turquin`;
-    /// `kulla-conty` is refused (not yet built for a dielectric coating).
+    /// lobe's built-in tables (see the module documentation).
     pub fn with_multiscatter(self, kind: Compensation) -> crate::error::Result<Self> {
         let (multiscatter, through) = match kind {
             Compensation::None => (DielectricMultiscatter::None, self.single.clone()),
-            Compensation::Turquin if self.eta < 1.0 => {
+            _ if self.eta < 1.0 => {
                 return Err(crate::Error::param(
                     "multiscatter",
                     format!(
-                        "turquin needs int_ior ≥ ext_ior (a coating denser than the outside, as a \
+                        "{kind} needs int_ior ≥ ext_ior (a coating denser than the outside, as a \
                          plastic's is; here int_ior/ext_ior is {}): under a rarer coating the \
-                         scaled transmittance breaks reciprocity, and a white base would send \
-                         back more light than it receives",
+                         compensated transmittance breaks reciprocity, and a white base would \
+                         send back more light than it receives",
                         self.eta
                     ),
                 ));
@@ -195,35 +198,20 @@ impl RoughPlastic {
             Compensation::Turquin => {
                 let (alpha, _) = self.coating.microfacet.alpha();
                 let turquin = DielectricTurquin::builtin(self.coating.microfacet.ndf(), alpha, self.eta)?;
-                let n = TABLE_SIZE - 1;
-                let table: Vec<f64> = (0..TABLE_SIZE)
-                    .map(|j| {
-                        let mu = (j as f64 / n as f64).max(1e-6);
-                        (self.single.table[j] * turquin.scale(mu, self.eta)).min(1.0)
-                    })
-                    .collect();
-                // 2 ∫ T(μ) μ dμ of the piecewise-linear T, segment by segment.
-                let mean: f64 = table
-                    .windows(2)
-                    .enumerate()
-                    .map(|(j, t)| {
-                        let (a, b) = (j as f64 / n as f64, (j + 1) as f64 / n as f64);
-                        (b - a) / 6.0 * (t[0] * (2.0 * a + b) + t[1] * (a + 2.0 * b))
-                    })
-                    .sum::<f64>()
-                    * 2.0;
-                let through = Transmission {
-                    table: table.into(),
-                    internal_reflectance: (1.0 - mean / (self.eta * self.eta)).max(0.0),
-                };
-                (DielectricMultiscatter::Turquin(turquin), through)
+                let table = self.compensated_transmittance(|mu, t| {
+                    t * turquin.scale(mu, self.eta)
+                });
+                (DielectricMultiscatter::Turquin(turquin), table)
             }
             Compensation::KullaConty => {
-                return Err(crate::Error::param(
-                    "multiscatter",
-                    "kulla-conty is not yet there for roughplastic (its coating is a rough \
-                     dielectric, whose added lobes need tables of both sides); turquin is",
-                ));
+                let (alpha, _) = self.coating.microfacet.alpha();
+                let kc = DielectricKullaConty::builtin(self.coating.microfacet.ndf(), alpha, self.eta)?;
+                // The added transmission into the base: τ_out (1 − E(μ)).
+                let table = self.compensated_transmittance(|mu, t| {
+                    let w = DVec3::new((1.0 - mu * mu).max(0.0).sqrt(), 0.0, mu);
+                    t + kc.tau(w) * kc.albedo(w)
+                });
+                (DielectricMultiscatter::KullaConty(kc), table)
             }
         };
         let base = Base::new(
@@ -241,20 +229,57 @@ impl RoughPlastic {
         })
     }
 
+    /// The compensated coating's transmittance table, `through(μⱼ, T(μⱼ))`
+    /// at each cosine (at most 1), and `R_int` from it by reciprocity:
+    /// `1 − R_int = 2 ∫ T(μ) μ dμ / η²`, exact for the piecewise-linear `T`.
+    fn compensated_transmittance(&self, through: impl Fn(f64, f64) -> f64) -> Transmission {
+        let n = TABLE_SIZE - 1;
+        let table: Vec<f64> = (0..TABLE_SIZE)
+            .map(|j| {
+                let mu = (j as f64 / n as f64).max(1e-6);
+                through(mu, self.single.table[j]).min(1.0)
+            })
+            .collect();
+        // 2 ∫ T(μ) μ dμ of the piecewise-linear T, segment by segment.
+        let mean: f64 = table
+            .windows(2)
+            .enumerate()
+            .map(|(j, t)| {
+                let (a, b) = (j as f64 / n as f64, (j + 1) as f64 / n as f64);
+                (b - a) / 6.0 * (t[0] * (2.0 * a + b) + t[1] * (a + 2.0 * b))
+            })
+            .sum::<f64>()
+            * 2.0;
+        Transmission {
+            table: table.into(),
+            internal_reflectance: (1.0 - mean / (self.eta * self.eta)).max(0.0),
+        }
+    }
+
     /// The coating's compensation factor at `wo`: `1/E(μo, α, η)` with
-    /// `turquin`, 1 without.
+    /// `turquin`, 1 otherwise.
     #[inline]
     fn coating_scale(&self, wo: DVec3) -> f64 {
         match self.multiscatter {
-            DielectricMultiscatter::None => 1.0,
             DielectricMultiscatter::Turquin(t) => t.scale(wo.z.max(0.0), self.eta),
+            DielectricMultiscatter::None | DielectricMultiscatter::KullaConty(_) => 1.0,
         }
     }
 
     /// The coating's part of `f` (compensated where asked).
     #[inline]
     fn coating_eval(&self, wo: DVec3, wi: DVec3) -> Rgb {
-        self.coating.eval(wo, wi) * self.coating_scale(wo)
+        self.compensated(self.coating.eval(wo, wi), wo, wi)
+    }
+
+    /// The single-scattering coating's `f` compensated: scaled (Turquin)
+    /// or with Kulla-Conty's added reflection (tinted as the coating).
+    #[inline]
+    fn compensated(&self, f: Rgb, wo: DVec3, wi: DVec3) -> Rgb {
+        match &self.multiscatter {
+            DielectricMultiscatter::KullaConty(kc) => f + self.coating.ks * kc.eval(wo, wi),
+            _ => f * self.coating_scale(wo),
+        }
     }
 
     /// `T(cos θ)`, linear between the table's cosines (the compensated
@@ -391,7 +416,7 @@ impl Bxdf for RoughPlastic {
         let (fc, pc) = self.coating.eval_pdf(s, wo, wi);
         let p = self.coating_probability(wo);
         (
-            fc * self.coating_scale(wo) + self.base_eval(wo, wi),
+            self.compensated(fc, wo, wi) + self.base_eval(wo, wi),
             p * pc + (1.0 - p) * warp::square_to_cosine_hemisphere_pdf(wi),
         )
     }
