@@ -119,10 +119,23 @@ impl Furnace {
 /// `∫ f |cos θi| dωi` at `wo` (`φ = 0`) of an isotropic material, per
 /// channel: twice the integral over `φ ∈ [0, π]`, over the lower
 /// hemisphere too where it transmits.
+///
+/// The quadrature is adaptive but deterministic: it chooses its nodes from
+/// the values it has seen. So if the three channels were equal at every
+/// node the red channel's integral visited, the green and blue integrals
+/// would visit the same nodes and give the same bits; they are then not
+/// computed again (a grey material costs one integral, not three).
 fn albedo(m: &Material, wo: DVec3) -> Rgb {
     let below = m.reach().transmits;
+    let grey = std::cell::Cell::new(true);
     let channel = |c: usize| {
-        let f = |wi: DVec3| m.eval(wo, wi)[c] * wi.z.abs();
+        let f = |wi: DVec3| {
+            let v = m.eval(wo, wi);
+            if c == 0 && (v.x.to_bits() != v.y.to_bits() || v.x.to_bits() != v.z.to_bits()) {
+                grey.set(false);
+            }
+            v[c] * wi.z.abs()
+        };
         let tol = Tolerance::relative(TOLERANCE).with_initial(32, 32);
         let mut sum = integrate_sphere_region(f, (0.0, FRAC_PI_2), (0.0, PI), tol).value;
         if below {
@@ -130,7 +143,12 @@ fn albedo(m: &Material, wo: DVec3) -> Rgb {
         }
         2.0 * sum
     };
-    Rgb::new(channel(0), channel(1), channel(2))
+    let red = channel(0);
+    if grey.get() {
+        Rgb::splat(red)
+    } else {
+        Rgb::new(red, channel(1), channel(2))
+    }
 }
 
 /// `desc` at width `alpha` (isotropic) with compensation `kind` (in
