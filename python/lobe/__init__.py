@@ -217,8 +217,8 @@ def furnace(
     ``roughplastic``): its directional albedo ∫ f |cos θi| dωi under light 1
     from every direction, per RGB channel, for each ``theta`` (degrees, θo;
     default 0 to 85 by 5, and 89) and ``alpha`` (default 0.05 to 1), without
-    energy compensation (``"none"``, Mitsuba's lobe), with each kind the
-    model has (``"kulla-conty"``, ``"turquin"``; None where it has not), and
+    energy compensation (``"none"``, Mitsuba's lobe), with each kind
+    (``"kulla-conty"``, ``"turquin"``), and
     by Heitz et al.'s random walk on the microsurface (``"walk"`` and
     ``"walk_std_error"``, the mean of ``walks`` walks per cell; None with
     ``walks=0`` or for a plastic). The material's ``alpha`` and

@@ -88,10 +88,7 @@ pub fn run(args: &FurnaceArgs) -> Result<()> {
             let walk = r.walk.map_or("—".to_string(), |w| {
                 format!("{:.4} ± {:.4}", luminance(w.mean), luminance(w.std_error))
             });
-            let lum = |kind| {
-                r.albedo(kind)
-                    .map_or("—".to_string(), |c| format!("{:.4}", luminance(c)))
-            };
+            let lum = |kind| format!("{:.4}", luminance(r.albedo(kind)));
             let _ = writeln!(
                 out,
                 "{:>6} {:>9} {:>12} {:>9} {:>18}",

@@ -35,11 +35,7 @@ pub fn furnace_plot(path: &Path, title: &str, f: &Furnace) -> Result<()> {
         .iter()
         .flat_map(|r| {
             let w = r.walk.map_or(0.0, |w| luminance(w.mean));
-            [
-                r.kulla_conty.map_or(0.0, luminance),
-                r.turquin.map_or(0.0, luminance),
-                w,
-            ]
+            [luminance(r.kulla_conty), luminance(r.turquin), w]
         })
         .fold(1.0f64, f64::max)
         * 1.05;
@@ -93,9 +89,7 @@ pub fn furnace_plot(path: &Path, title: &str, f: &Furnace) -> Result<()> {
             for (kind, colour, width) in CURVES {
                 chart
                     .draw_series(LineSeries::new(
-                        cells
-                            .iter()
-                            .filter_map(|r| r.albedo(kind).map(|c| (r.theta, luminance(c)))),
+                        cells.iter().map(|r| (r.theta, luminance(r.albedo(kind)))),
                         colour.stroke_width(width),
                     ))
                     .map_err(|x| e(&x))?;

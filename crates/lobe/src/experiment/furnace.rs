@@ -59,21 +59,21 @@ pub struct FurnaceRow {
     pub theta: f64,
     pub alpha: f64,
     /// The albedo without compensation, with Kulla-Conty's, with
-    /// Turquin's (`None` where the model does not have that kind).
+    /// Turquin's.
     pub none: Rgb,
-    pub kulla_conty: Option<Rgb>,
-    pub turquin: Option<Rgb>,
+    pub kulla_conty: Rgb,
+    pub turquin: Rgb,
     /// The random walk's, with its standard error (`None` without walks,
     /// or for a plastic; a dielectric's, `R + T` in importance mode, is 1).
     pub walk: Option<RgbEstimate>,
 }
 
 impl FurnaceRow {
-    /// The albedo of compensation `kind`, where the model has it.
+    /// The albedo of compensation `kind`.
     #[must_use]
-    pub fn albedo(&self, kind: Compensation) -> Option<Rgb> {
+    pub fn albedo(&self, kind: Compensation) -> Rgb {
         match kind {
-            Compensation::None => Some(self.none),
+            Compensation::None => self.none,
             Compensation::KullaConty => self.kulla_conty,
             Compensation::Turquin => self.turquin,
         }
@@ -95,7 +95,7 @@ impl Furnace {
     /// The table as JSON text (`lobe furnace --json`, `lobe.furnace`):
     /// `model`, `walks` and `rows`, each with `theta`, `alpha`, and RGB
     /// triples `none`, `kulla-conty`, `turquin`, `walk`, `walk_std_error`
-    /// (`null` where the model has no such kind or no walk ran).
+    /// (the walk's `null` where none ran).
     #[must_use]
     pub fn to_json(&self) -> String {
         use serde_json::json;
@@ -106,7 +106,7 @@ impl Furnace {
             .map(|r| {
                 json!({
                     "theta": r.theta, "alpha": r.alpha,
-                    "none": rgb(r.none), "kulla-conty": r.kulla_conty.map(rgb), "turquin": r.turquin.map(rgb),
+                    "none": rgb(r.none), "kulla-conty": rgb(r.kulla_conty), "turquin": rgb(r.turquin),
                     "walk": r.walk.map(|w| rgb(w.mean)),
                     "walk_std_error": r.walk.map(|w| rgb(w.std_error)),
                 })
@@ -197,17 +197,13 @@ pub fn furnace(
             },
             e => e,
         })?;
-        // The random walk where lobe has one, and the kinds of compensation the model has.
-        let (walk, kinds) = match &none.glossy {
-            Glossy::CookTorrance(ct) => (
-                Some(RandomWalk::conductor(ct.microfacet, ct.ks, ct.fresnel)?),
-                &Compensation::ALL[..],
-            ),
-            Glossy::RoughDielectric(rd) => (
-                Some(RandomWalk::dielectric(rd.microfacet, rd.eta)?),
-                crate::models::roughdielectric::COMPENSATIONS,
-            ),
-            Glossy::RoughPlastic(_) => (None, crate::models::roughplastic::COMPENSATIONS),
+        // The random walk where lobe has one.
+        let walk = match &none.glossy {
+            Glossy::CookTorrance(ct) => {
+                Some(RandomWalk::conductor(ct.microfacet, ct.ks, ct.fresnel)?)
+            }
+            Glossy::RoughDielectric(rd) => Some(RandomWalk::dielectric(rd.microfacet, rd.eta)?),
+            Glossy::RoughPlastic(_) => None,
             _ => {
                 return Err(Error::param(
                     "type",
@@ -225,11 +221,9 @@ pub fn furnace(
                 "the furnace measures the microfacet lobe alone: leave kd out",
             ));
         }
-        // A kind the model does not have is left out.
-        let optional = |kind| kinds.contains(&kind).then(|| at(desc, a, kind)).transpose();
         let (kc, tq) = (
-            optional(Compensation::KullaConty)?,
-            optional(Compensation::Turquin)?,
+            at(desc, a, Compensation::KullaConty)?,
+            at(desc, a, Compensation::Turquin)?,
         );
         cells.push((a, none, kc, tq, walk));
     }
@@ -243,8 +237,8 @@ pub fn furnace(
             theta,
             alpha: *a,
             none: albedo(none, wo),
-            kulla_conty: kc.as_ref().map(|m| albedo(m, wo)),
-            turquin: tq.as_ref().map(|m| albedo(m, wo)),
+            kulla_conty: albedo(kc, wo),
+            turquin: albedo(tq, wo),
             walk: walk
                 .as_ref()
                 .filter(|_| s.walks > 0)

@@ -177,9 +177,6 @@ pub(crate) fn mitsuba_microfacet(
     })
 }
 
-/// The kinds of `multiscatter` a rough dielectric has: all.
-pub const COMPENSATIONS: &[Compensation] = &Compensation::ALL;
-
 /// A rough dielectric interface of relative index `eta = η_inside /
 /// η_outside`.
 #[derive(Debug, Clone, Copy, PartialEq)]

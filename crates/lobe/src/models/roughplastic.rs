@@ -107,9 +107,6 @@ fn from_desc(d: &crate::desc::MaterialDesc) -> crate::error::Result<super::Lobes
 /// Number of cosines in the transmittance table (Mitsuba's).
 pub const TABLE_SIZE: usize = 64;
 
-/// The kinds of `multiscatter` a rough plastic has: all.
-pub const COMPENSATIONS: &[Compensation] = &Compensation::ALL;
-
 /// What the coating lets through: `T(μⱼ)` at `μⱼ = max(1e-6, j/63)` and
 /// `R_int`.
 #[derive(Debug, Clone, PartialEq)]

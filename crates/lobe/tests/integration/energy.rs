@@ -148,10 +148,7 @@ fn white_furnace_of_compensated_conductors() {
         let f = furnace(&desc(json), &s, &()).unwrap();
         for r in &f.rows {
             darkest = darkest.min(r.none.x);
-            for (kind, a) in [
-                ("kulla-conty", r.kulla_conty.unwrap()),
-                ("turquin", r.turquin.unwrap()),
-            ] {
+            for (kind, a) in [("kulla-conty", r.kulla_conty), ("turquin", r.turquin)] {
                 let err = (a.x - 1.0).abs();
                 if err > worst.0 {
                     worst = (
@@ -194,10 +191,7 @@ fn white_furnace_of_compensated_rough_glass() {
     ] {
         let f = furnace(&desc(json), &s, &()).unwrap();
         for r in &f.rows {
-            for (kind, t) in [
-                ("kulla-conty", r.kulla_conty.unwrap().x),
-                ("turquin", r.turquin.unwrap().x),
-            ] {
+            for (kind, t) in [("kulla-conty", r.kulla_conty.x), ("turquin", r.turquin.x)] {
                 if (t - 1.0).abs() > worst.0 {
                     worst = (
                         (t - 1.0).abs(),
@@ -244,10 +238,7 @@ fn white_furnace_of_compensated_rough_plastic() {
         for r in &f.rows {
             assert!(r.walk.is_none(), "{json}");
             darkest = darkest.min(r.none.x);
-            for (kind, t) in [
-                ("kulla-conty", r.kulla_conty.unwrap()),
-                ("turquin", r.turquin.unwrap()),
-            ] {
+            for (kind, t) in [("kulla-conty", r.kulla_conty), ("turquin", r.turquin)] {
                 let err = (t - lobe::Rgb::ONE).abs().max_element();
                 if err > worst.0 {
                     worst = (
@@ -438,7 +429,7 @@ fn coloured_conductors_gain_saturation_like_the_random_walk() {
                 mean: w,
                 std_error: se,
             } = r.walk.unwrap();
-            let (none, kc) = (r.none, r.kulla_conty.unwrap());
+            let (none, kc) = (r.none, r.kulla_conty);
             let at = format!("{metal} α {} θo {}", r.alpha, r.theta);
             for c in 0..3 {
                 assert!(
