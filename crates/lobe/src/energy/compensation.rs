@@ -151,9 +151,11 @@ impl KullaConty {
         (1.0 - self.row.e(mu)).max(0.0)
     }
 
-    /// What the lobe needs of `wo`, looked up once: the probability of
-    /// drawing the added lobe ([`KullaConty::cosine_probability`]) and
-    /// `1 − E(μo)`, given the single-scattering lobe's reflectance at `wo`.
+    /// What the lobe needs of `wo`, looked up once, given the
+    /// single-scattering lobe's reflectance there (tint times Fresnel): the
+    /// probability of drawing the added lobe by cosine sampling (its share
+    /// of the albedo, `ms_albedo (1 − E(μo))` against `E(μo)` times the
+    /// luminance of `reflectance`, at most 0.9) and `1 − E(μo)`.
     #[inline]
     #[must_use]
     pub fn at(&self, wo: DVec3, reflectance: Rgb) -> KullaContyAt {
@@ -194,17 +196,6 @@ impl KullaConty {
     #[must_use]
     pub fn albedo(&self, wo: DVec3) -> f64 {
         self.ms_albedo * self.lost(wo.z)
-    }
-
-    /// The probability of drawing the added lobe by cosine sampling at
-    /// `wo`, given the single-scattering lobe's reflectance there (tint
-    /// times Fresnel): the added lobe's share of the albedo, its
-    /// `ms_albedo (1 − E(μo))` against `E(μo)` times the luminance of
-    /// `reflectance`, at most 0.9. One table lookup.
-    #[inline]
-    #[must_use]
-    pub fn cosine_probability(&self, wo: DVec3, reflectance: Rgb) -> f64 {
-        self.at(wo, reflectance).q
     }
 }
 
@@ -270,6 +261,31 @@ pub struct DielectricTurquin {
 /// The smallest `E` a dielectric's scaling divides by.
 pub const MIN_DIELECTRIC_E: f64 = 0.01;
 
+/// lobe's built-in dielectric table of `ndf` for an interface of relative
+/// index `eta`. The error names `multiscatter`: no table of that
+/// distribution, or `η` (either way round) beyond the tables' `[1/3, 3]`.
+pub fn dielectric_table(ndf: crate::Ndf, eta: f64) -> crate::error::Result<&'static AlbedoTable> {
+    use super::table::{MAX_TABLE_ETA, Surface};
+    let table = super::AlbedoTables::builtin()
+        .get(ndf, Surface::Dielectric)
+        .ok_or_else(|| {
+            crate::Error::param(
+                "multiscatter",
+                format!("no built-in table of a {} dielectric", ndf.name()),
+            )
+        })?;
+    if !(1.0 / MAX_TABLE_ETA..=MAX_TABLE_ETA).contains(&eta) {
+        return Err(crate::Error::param(
+            "multiscatter",
+            format!(
+                "the relative index int_ior/ext_ior is {eta}: the dielectric albedo tables \
+                 span 1/{MAX_TABLE_ETA} to {MAX_TABLE_ETA}"
+            ),
+        ));
+    }
+    Ok(table)
+}
+
 impl DielectricTurquin {
     #[must_use]
     pub fn new(table: &'static AlbedoTable, alpha: f64) -> Self {
@@ -277,29 +293,10 @@ impl DielectricTurquin {
     }
 
     /// The scaling of an interface of distribution `ndf`, width `alpha`
-    /// (`√(αu αv)`) and relative index `eta` from lobe's built-in tables.
-    /// The error names `multiscatter`: no table of that distribution, or
-    /// `η` (either way round) beyond the tables' `[1/3, 3]`.
+    /// (`√(αu αv)`) and relative index `eta` from lobe's built-in tables
+    /// (the error as [`dielectric_table`]'s).
     pub fn builtin(ndf: crate::Ndf, alpha: f64, eta: f64) -> crate::error::Result<Self> {
-        use super::table::{MAX_TABLE_ETA, Surface};
-        let table = super::AlbedoTables::builtin()
-            .get(ndf, Surface::Dielectric)
-            .ok_or_else(|| {
-                crate::Error::param(
-                    "multiscatter",
-                    format!("no built-in table of a {} dielectric", ndf.name()),
-                )
-            })?;
-        if !(1.0 / MAX_TABLE_ETA..=MAX_TABLE_ETA).contains(&eta) {
-            return Err(crate::Error::param(
-                "multiscatter",
-                format!(
-                    "the relative index int_ior/ext_ior is {eta}: the dielectric albedo tables \
-                     span 1/{MAX_TABLE_ETA} to {MAX_TABLE_ETA}"
-                ),
-            ));
-        }
-        Ok(DielectricTurquin::new(table, alpha))
+        Ok(DielectricTurquin::new(dielectric_table(ndf, eta)?, alpha))
     }
 
     /// The factor `1/E(μo, α, η)` at `|cos θo| = mu`, `η` the relative
@@ -351,10 +348,9 @@ pub const MIN_DIELECTRIC_LOSS: f64 = 1e-9;
 impl DielectricKullaConty {
     /// The lobes of an interface of distribution `ndf`, width `alpha`
     /// (`√(αu αv)`) and relative index `eta` (inside over outside) from
-    /// lobe's built-in tables; the error names `multiscatter` (as
-    /// [`DielectricTurquin::builtin`]).
+    /// lobe's built-in tables (the error as [`dielectric_table`]'s).
     pub fn builtin(ndf: crate::Ndf, alpha: f64, eta: f64) -> crate::error::Result<Self> {
-        let table = DielectricTurquin::builtin(ndf, alpha, eta)?.table;
+        let table = dielectric_table(ndf, eta)?;
         let lost = |e: f64| (1.0 - table.e_avg_eta(alpha, e)).clamp(0.0, 1.0);
         let lost_avg = [lost(eta), lost(1.0 / eta)];
         let t_out = 1.0 - crate::fresnel::diffuse_reflectance(eta);

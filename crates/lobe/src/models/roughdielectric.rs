@@ -221,24 +221,16 @@ impl RoughDielectric {
     /// `kulla-conty` adds a reflection and a transmission lobe on each side
     /// ([`DielectricKullaConty`]).
     pub fn with_multiscatter(self, kind: Compensation) -> crate::error::Result<Self> {
+        let (ax, ay) = self.microfacet.alpha();
+        let (ndf, alpha) = (self.microfacet.ndf(), (ax * ay).sqrt());
         let multiscatter = match kind {
             Compensation::None => DielectricMultiscatter::None,
             Compensation::Turquin => {
-                let (ax, ay) = self.microfacet.alpha();
-                DielectricMultiscatter::Turquin(DielectricTurquin::builtin(
-                    self.microfacet.ndf(),
-                    (ax * ay).sqrt(),
-                    self.eta,
-                )?)
+                DielectricMultiscatter::Turquin(DielectricTurquin::builtin(ndf, alpha, self.eta)?)
             }
-            Compensation::KullaConty => {
-                let (ax, ay) = self.microfacet.alpha();
-                DielectricMultiscatter::KullaConty(DielectricKullaConty::builtin(
-                    self.microfacet.ndf(),
-                    (ax * ay).sqrt(),
-                    self.eta,
-                )?)
-            }
+            Compensation::KullaConty => DielectricMultiscatter::KullaConty(
+                DielectricKullaConty::builtin(ndf, alpha, self.eta)?,
+            ),
         };
         Ok(RoughDielectric {
             multiscatter,

@@ -178,6 +178,8 @@ impl RoughPlastic {
     /// The same plastic with energy compensation `kind` of its coating from
     /// lobe's built-in tables (see the module documentation).
     pub fn with_multiscatter(self, kind: Compensation) -> crate::error::Result<Self> {
+        // Isotropic (checked in `new`).
+        let (ndf, (alpha, _)) = (self.coating.microfacet.ndf(), self.coating.microfacet.alpha());
         let (multiscatter, through) = match kind {
             Compensation::None => (DielectricMultiscatter::None, self.single.clone()),
             _ if self.eta < 1.0 => {
@@ -193,16 +195,14 @@ impl RoughPlastic {
                 ));
             }
             Compensation::Turquin => {
-                let (alpha, _) = self.coating.microfacet.alpha();
-                let turquin = DielectricTurquin::builtin(self.coating.microfacet.ndf(), alpha, self.eta)?;
+                let turquin = DielectricTurquin::builtin(ndf, alpha, self.eta)?;
                 let table = self.compensated_transmittance(|mu, t| {
                     t * turquin.scale(mu, self.eta)
                 });
                 (DielectricMultiscatter::Turquin(turquin), table)
             }
             Compensation::KullaConty => {
-                let (alpha, _) = self.coating.microfacet.alpha();
-                let kc = DielectricKullaConty::builtin(self.coating.microfacet.ndf(), alpha, self.eta)?;
+                let kc = DielectricKullaConty::builtin(ndf, alpha, self.eta)?;
                 // The added transmission into the base: τ_out (1 − E(μ)).
                 let table = self.compensated_transmittance(|mu, t| {
                     let w = DVec3::new((1.0 - mu * mu).max(0.0).sqrt(), 0.0, mu);
@@ -253,29 +253,21 @@ impl RoughPlastic {
         }
     }
 
-    /// The coating's compensation factor at `wo`: `1/E(μo, α, η)` with
-    /// `turquin`, 1 otherwise.
-    #[inline]
-    fn coating_scale(&self, wo: DVec3) -> f64 {
-        match self.multiscatter {
-            DielectricMultiscatter::Turquin(t) => t.scale(wo.z.max(0.0), self.eta),
-            DielectricMultiscatter::None | DielectricMultiscatter::KullaConty(_) => 1.0,
-        }
-    }
-
     /// The coating's part of `f` (compensated where asked).
     #[inline]
     fn coating_eval(&self, wo: DVec3, wi: DVec3) -> Rgb {
         self.compensated(self.coating.eval(wo, wi), wo, wi)
     }
 
-    /// The single-scattering coating's `f` compensated: scaled (Turquin)
-    /// or with Kulla-Conty's added reflection (tinted as the coating).
+    /// The single-scattering coating's `f` compensated: scaled by
+    /// `1/E(μo, α, η)` (Turquin) or with Kulla-Conty's added reflection
+    /// (tinted as the coating); `f` itself without compensation.
     #[inline]
     fn compensated(&self, f: Rgb, wo: DVec3, wi: DVec3) -> Rgb {
         match &self.multiscatter {
+            DielectricMultiscatter::None => f,
+            DielectricMultiscatter::Turquin(t) => f * t.scale(wo.z.max(0.0), self.eta),
             DielectricMultiscatter::KullaConty(kc) => f + self.coating.ks * kc.eval(wo, wi),
-            _ => f * self.coating_scale(wo),
         }
     }
 
