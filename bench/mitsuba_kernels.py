@@ -74,6 +74,7 @@ if "DRJIT_LIBLLVM_PATH" not in os.environ and os.path.exists(_LLVM):
     os.environ["DRJIT_LIBLLVM_PATH"] = _LLVM
 
 import numpy as np  # noqa: E402
+from machine import cpu_model  # noqa: E402  (bench/machine.py, beside this script)
 
 try:
     import drjit as dr  # noqa: E402
@@ -111,17 +112,6 @@ CASES = {
     ),
 }
 DEFAULT_CASES = "ggx-vndf,ggx-brdf,beckmann-vndf"
-
-
-def cpu_model():
-    try:
-        with open("/proc/cpuinfo") as f:
-            for line in f:
-                if line.startswith("model name"):
-                    return line.split(":", 1)[1].strip()
-    except OSError:
-        pass
-    return "unknown"
 
 
 class Inputs:

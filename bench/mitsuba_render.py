@@ -98,6 +98,7 @@ if "DRJIT_LIBLLVM_PATH" not in os.environ and os.path.exists(_LLVM):
     os.environ["DRJIT_LIBLLVM_PATH"] = _LLVM
 
 import numpy as np  # noqa: E402
+from machine import cpu_model  # noqa: E402  (bench/machine.py, beside this script)
 
 try:
     import drjit as dr  # noqa: E402
@@ -549,10 +550,7 @@ def main():
     if os.path.exists(args.lobe):
         lobe_ver = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT,
                                   capture_output=True, text=True).stdout.strip() or "?"
-    try:
-        cpu = next(l.split(":", 1)[1].strip() for l in open("/proc/cpuinfo") if l.startswith("model name"))
-    except (OSError, StopIteration):
-        cpu = "unknown"
+    cpu = cpu_model()
     load = " ".join(open("/proc/loadavg").read().split()[:3]) if os.path.exists("/proc/loadavg") else "?"
     print(f"Scene bench/two_spheres.toml, {cam.get('width')}x{cam.get('height')}, {int(mask.sum())} sphere "
           f"pixels; CPU {cpu}, {args.threads} threads; Mitsuba {mi.__version__} llvm_ad_rgb `direct` "

@@ -7,25 +7,14 @@ cluster (BENCHMARKS.md "Sweeps on Dask"). Needs pip install '.[dask]'.
 
 import argparse
 import os
-import platform
 import sys
 import time
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "examples"))
 
 import lobe  # noqa: E402
+from machine import cpu_model  # noqa: E402  (bench/machine.py, beside this script)
 from sweep_lecture import grid  # noqa: E402
-
-
-def cpu():
-    try:
-        with open("/proc/cpuinfo") as f:
-            for line in f:
-                if line.startswith("model name"):
-                    return line.split(":", 1)[1].strip()
-    except OSError:
-        pass
-    return platform.processor()
 
 
 def main():
@@ -34,7 +23,7 @@ def main():
     ap.add_argument("--repeat", type=int, default=2)
     a = ap.parse_args()
     tasks = grid(a.samples)
-    print(f"{cpu()}, {os.cpu_count()} cores; {len(tasks)} estimates of {a.samples} samples; lobe {lobe.__version__}")
+    print(f"{cpu_model()}, {os.cpu_count()} cores; {len(tasks)} estimates of {a.samples} samples; lobe {lobe.__version__}")
     times = {}
     for w in (1, 2) * a.repeat:
         t0 = time.perf_counter()
