@@ -186,6 +186,15 @@ def tasks(task: str, grid: Mapping[str, Sequence[Any]] | Sequence[Mapping[str, A
     return out
 
 
+def _params_row(task: str, params: Mapping[str, Any]) -> dict[str, Any]:
+    """The start of a task's row: its key and its parameters as columns
+    (each as given, a dict or list as canonical JSON)."""
+    row: dict[str, Any] = {"task_key": _key(task, params)}
+    for k, v in params.items():
+        row[k] = _canonical(v) if isinstance(v, (Mapping, list, tuple)) else v
+    return row
+
+
 def run_task(task: str, params: Mapping[str, Any]) -> dict[str, Any]:
     """Run one task where this process is (a Dask worker, or here): its row,
     the parameters (each as given, a dict as canonical JSON) and the
@@ -195,9 +204,7 @@ def run_task(task: str, params: Mapping[str, Any]) -> dict[str, Any]:
     # One thread per task: the parallelism is the sweep's, across workers.
     lobe.set_threads(1)
     fn, _, _ = TASKS[task]
-    row: dict[str, Any] = {"task_key": _key(task, params)}
-    for k, v in params.items():
-        row[k] = _canonical(v) if isinstance(v, (Mapping, list, tuple)) else v
+    row = _params_row(task, params)
     t0 = time.perf_counter()
     try:
         row.update(fn(params, task_seed(task, params)))
@@ -405,20 +412,18 @@ def sweep(
         try:
             from distributed import as_completed
 
-            futures = [client.submit(run_task, task, p, key=f"lobe-{task}-{k}", pure=False) for k, p in pending]
+            params = {f"lobe-{task}-{k}": p for k, p in pending}
+            futures = [client.submit(run_task, task, p, key=key, pure=False) for key, p in params.items()]
             for fut in as_completed(futures):
                 try:
                     row = fut.result()
                 except Exception as e:  # noqa: BLE001 - a task that killed its workers
-                    i = futures.index(fut)
-                    k, p = pending[i]
-                    row = {"task_key": k, **{n: (_canonical(v) if isinstance(v, (Mapping, list, tuple)) else v) for n, v in p.items()}}
+                    row = _params_row(task, params[fut.key])
                     row["error"] = f"{type(e).__name__}: {e}"
                     row["wall_s"] = None
                 rows[row["task_key"]] = row
                 writer.add(row)
                 progress.advance(row)
-            writer.flush()
         finally:
             writer.flush()
             close()
@@ -435,7 +440,7 @@ def sweep(
         frames.append(pd.DataFrame(list(rows.values())))
     df = pd.concat(frames, ignore_index=True) if len(frames) > 1 else frames[0]
     order = {k: i for i, k in enumerate(keys)}
-    df = df.iloc[sorted(range(len(df)), key=lambda i: order[df["task_key"].iloc[i]])].reset_index(drop=True)
+    df = df.iloc[df["task_key"].map(order).argsort(kind="stable")].reset_index(drop=True)
     df.attrs["computed"] = len(pending)
     df.attrs["failed"] = failed
     return df
