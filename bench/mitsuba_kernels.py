@@ -26,8 +26,8 @@ What one figure is:
 * Inputs: N = 2^22 lanes (by default) of precomputed wo (lobe's wo, Mitsuba's
   `si.wi`) uniform over the upper hemisphere (uniform cos θ, uniform azimuth:
   the same distribution as `lobe bench`, from numpy's PCG64 instead of
-  rand_pcg), sample2 = (u1, u2) uniform, sample1 = 0.5 (lobe's uc; the plugin
-  ignores it).
+  rand_pcg), sample2 = (u1, u2) uniform, sample1 uniform (lobe's uc: the lobe choice
+  of plastics and dielectrics; roughconductor ignores it).
 * `msps`: `bsdf.sample` + `bsdf.eval` + `bsdf.pdf` at the sampled direction,
   the three channels of weight and f plus pdf summed per lane and reduced with
   `dr.sum`, `dr.eval` + `dr.sync_thread()`: one fused kernel plus the
@@ -113,6 +113,58 @@ CASES = {
 }
 DEFAULT_CASES = "ggx-vndf,ggx-brdf,beckmann-vndf"
 
+# Mitsuba 3 plugins whose names and parameters lobe's material descriptions
+# share (`lobe bench --all` uses them wherever Mitsuba has the model).
+MITSUBA_PLUGINS = {"diffuse", "roughconductor", "roughdielectric", "roughplastic", "conductor",
+                   "dielectric", "thindielectric", "plastic", "twosided"}
+
+
+def mitsuba_dict(material, strategy):
+    """The Mitsuba BSDF dict doing the work of lobe's `material` (JSON text)
+    sampled by `strategy`, or None where Mitsuba has no such model or
+    sampler: the same dict (lobe reads Mitsuba's names and defaults), with
+    `sample_visible` from the strategy (vndf: true, brdf: false) for the
+    rough plugins; the diffuse plugins sample the cosine (lobe's `cosine`
+    and `brdf`), the smooth ones their delta (lobe's `brdf`, their only
+    strategy). lobe-only keys (`multiscatter`) have no Mitsuba equivalent."""
+    d = json.loads(material)
+    t = d.get("type")
+    if t not in MITSUBA_PLUGINS or "multiscatter" in json.dumps(d):
+        return None
+    inner = d.get("material", {}) if t == "twosided" else d
+    it = inner.get("type") if isinstance(inner, dict) else None
+    if t == "twosided" and it not in MITSUBA_PLUGINS:
+        return None
+    kind = it if t == "twosided" else t
+    if kind in ("roughconductor", "roughdielectric", "roughplastic"):
+        if strategy not in ("vndf", "brdf"):
+            return None
+        inner["sample_visible"] = strategy == "vndf"
+    elif kind == "diffuse":
+        if strategy not in ("cosine", "brdf"):
+            return None
+    elif strategy != "brdf":
+        return None
+    return d
+
+
+def cases_from(path):
+    """(name, (strategy, lobe material, Mitsuba dict)) for each distinct
+    (material, strategy) of a `lobe bench --all --json` file that Mitsuba
+    can run."""
+    with open(path) as f:
+        rows = json.load(f)["results"]
+    out, seen = [], set()
+    for r in rows:
+        k = (r["material"], r["strategy"])
+        if k in seen:
+            continue
+        seen.add(k)
+        d = mitsuba_dict(*k)
+        if d is not None:
+            out.append((f"{r['case']} {r['strategy']}", (r["strategy"], r["material"], d)))
+    return out
+
 
 class Inputs:
     """Precomputed inputs (numpy, f32), the distribution of `lobe bench`."""
@@ -128,6 +180,8 @@ class Inputs:
         # 24 random bits each: uniform f32 in [0, 1), as lobe bench draws them.
         self.u1 = rng.integers(0, 1 << 24, n, dtype=np.int64)
         self.u2 = (rng.integers(0, 1 << 24, n) / float(1 << 24)).astype(np.float32)
+        # sample1 (lobe's uc): which lobe a plastic or a dielectric samples.
+        self.uc = (rng.integers(0, 1 << 24, n) / float(1 << 24)).astype(np.float32)
 
     def fresh(self, run):
         """New Dr.Jit arrays (evaluated, outside any timing); u1 shifted by a
@@ -138,15 +192,17 @@ class Inputs:
         si = dr.zeros(mi.SurfaceInteraction3f)
         si.wi = mi.Vector3f(mi.Float(self.wo[0]), mi.Float(self.wo[1]), mi.Float(self.wo[2]))
         s2 = mi.Point2f(mi.Float(u1), mi.Float(self.u2))
-        dr.eval(si.wi, s2)
+        s1 = mi.Float(self.uc)
+        dr.eval(si.wi, s2, s1)
         dr.sync_thread()
-        return si, s2
+        return si, (s1, s2)
 
 
-def kernel(bsdf, mode, si, s2):
+def kernel(bsdf, mode, si, samples):
     """Trace one run; returns the reduced sum (not yet evaluated)."""
+    s1, s2 = samples
     ctx = mi.BSDFContext()
-    bs, w = bsdf.sample(ctx, si, 0.5, s2)
+    bs, w = bsdf.sample(ctx, si, s1, s2)
     if mode == "sample":
         s = w.x + w.y + w.z + bs.pdf + bs.wo.x + bs.wo.y + bs.wo.z
     else:
@@ -199,10 +255,17 @@ def simd_name(lanes):
 def run(args):
     mi.set_variant(VARIANT)
     dr.set_flag(dr.JitFlag.KernelHistory, True)
-    names = [c.strip() for c in args.cases.split(",") if c.strip()]
-    for c in names:
-        if c not in CASES:
-            sys.exit(f"mitsuba_kernels.py: --cases: unknown case {c!r} (known: {', '.join(CASES)})")
+    if args.cases_from:
+        try:
+            chosen = cases_from(args.cases_from)
+        except (OSError, KeyError, ValueError) as e:
+            sys.exit(f"mitsuba_kernels.py: --cases-from {args.cases_from}: {e}")
+    else:
+        names = [c.strip() for c in args.cases.split(",") if c.strip()]
+        for c in names:
+            if c not in CASES:
+                sys.exit(f"mitsuba_kernels.py: --cases: unknown case {c!r} (known: {', '.join(CASES)})")
+        chosen = [(c, CASES[c]) for c in names]
     try:
         threads = [int(t) for t in args.threads.split(",")]
     except ValueError:
@@ -211,14 +274,13 @@ def run(args):
         sys.exit("mitsuba_kernels.py: --threads, --samples, --reps and --warmup must be >= 1")
     inputs = Inputs(args.samples, args.seed)
     n = args.samples
-    msps = lambda t: n / t / 1e6  # noqa: E731
+    msps = lambda t: n / t / 1e6 if t > 0 else None  # noqa: E731
     out = []
     info = {"cache_misses": 0}
     for t in threads:
         dr.set_thread_count(t)
         results = []
-        for c in names:
-            strategy, lobe_material, d = CASES[c]
+        for c, (strategy, lobe_material, d) in chosen:
             bsdf = mi.load_dict(d)
             full, full_k = time_mode(bsdf, "sep", inputs, args.warmup, args.reps, info)
             ep, _ = time_mode(bsdf, "eval_pdf", inputs, args.warmup, args.reps, info)
@@ -255,11 +317,12 @@ def run(args):
     o = out[0]
     print(f"Mitsuba {o['mitsuba']} {VARIANT}, Dr.Jit {o['drjit']}; cpu {o['cpu']}; simd {o['simd']}")
     print(f"{n} samples, median of {args.reps} warm runs; M samples/s")
-    print(f"{'case':<15} {'threads':>7} {'s+eval+pdf':>11} {'s+eval_pdf':>11} {'sample':>9} {'kernel':>9}")
+    print(f"{'case':<40} {'threads':>7} {'s+eval+pdf':>11} {'s+eval_pdf':>11} {'sample':>9} {'kernel':>9}")
     for o in out:
         for r in o["results"]:
-            print(f"{r['case']:<15} {o['threads']:>7} {r['msps']:>11.1f} {r['eval_pdf_msps']:>11.1f} "
-                  f"{r['sample_msps']:>9.1f} {r['kernel_msps']:>9.1f}")
+            k = "—" if r["kernel_msps"] is None else f"{r['kernel_msps']:.1f}"
+            print(f"{r['case']:<40} {o['threads']:>7} {r['msps']:>11.1f} {r['eval_pdf_msps']:>11.1f} "
+                  f"{r['sample_msps']:>9.1f} {k:>9}")
 
 
 def main():
@@ -272,6 +335,9 @@ def main():
     p.add_argument("--warmup", type=int, default=2, help="untimed runs first (default 2)")
     p.add_argument("--cases", default=DEFAULT_CASES,
                    help=f"comma-separated, from {', '.join(CASES)} (default {DEFAULT_CASES})")
+    p.add_argument("--cases-from", metavar="FILE",
+                   help="instead of --cases: every (material, strategy) of a `lobe bench --all --json` "
+                        "output that Mitsuba has (see mitsuba_dict)")
     p.add_argument("--seed", type=int, default=0x6C6F6265, help="numpy seed of the inputs")
     p.add_argument("--json", action="store_true", help="print JSON (the shape of `lobe bench --json`)")
     run(p.parse_args())

@@ -118,15 +118,21 @@ def main():
     p.add_argument("--build", action="store_true", help="run cargo build --release first")
     p.add_argument("--mitsuba-python", default=default_mitsuba_python(),
                    help="Python with mitsuba + numpy (default $MITSUBA_PYTHON or /work/venv-mitsuba)")
-    p.add_argument("--rounds", type=int, default=3, help="alternating rounds (default 3)")
+    p.add_argument("--rounds", type=int, help="alternating rounds (default 3; with --all, 1)")
     p.add_argument("--threads", default="1,2", help="comma-separated thread counts (default 1,2)")
     p.add_argument("--samples", "-n", type=int, default=1 << 22, help="samples per run (default 2^22)")
     p.add_argument("--reps", type=int, default=10, help="warm runs per figure, median (default 10)")
     p.add_argument("--json-out", help="also write every raw JSON result to this file")
+    p.add_argument("--all", action="store_true",
+                   help="the whole table: `lobe bench --all` (every model x strategy x SIMD level x "
+                        "thread count) beside mitsuba_kernels.py on every case Mitsuba has, "
+                        "alternating per round (default 1 round)")
     p.add_argument("--shadowing", choices=["smith-correlated", "smith-separable"],
                    help="lobe's Smith term (default: lobe's default, smith-correlated); "
                         "smith-separable is the term Mitsuba's roughconductor evaluates")
     args = p.parse_args()
+    if args.rounds is None:
+        args.rounds = 1 if args.all else 3
     try:
         threads = [int(t) for t in args.threads.split(",")]
     except ValueError:
@@ -147,6 +153,8 @@ def main():
     if "DRJIT_LIBLLVM_PATH" not in env and os.path.exists(llvm):
         env["DRJIT_LIBLLVM_PATH"] = llvm
     common = ["--samples", str(args.samples), "--reps", str(args.reps)]
+    if args.all:
+        return run_all(args, threads, env)
     mitsuba_cmd = [args.mitsuba_python, os.path.join(HERE, "mitsuba_kernels.py"), "--json"] + common
 
     # (key, threads) -> {"lobe": [...], "lobe_sample": [...], ...}
@@ -254,6 +262,98 @@ def main():
             print(f"\n* {label(k[0]) if k[1] else k[0]} {k[1]}: {n}")
             shown.add(n)
     print("\nratio = lobe / the faster of Mitsuba's two ways; — = not measured (see the notes).")
+
+
+def run_all(args, threads, env):
+    """--all: rounds of `lobe bench --all --json` and mitsuba_kernels.py
+    --cases-from (its output), alternating; the median per cell; one
+    Markdown table: lobe's f64 path and every SIMD level, Mitsuba's faster
+    way of sample + eval + pdf, and lobe's best level over Mitsuba."""
+    import tempfile
+    lobe_runs, mi_runs = [], []
+    tlist = ",".join(str(t) for t in threads)
+    # lobe --all's own reps: the f64 path is slow; 3 is its default.
+    lobe_cmd = [args.lobe, "bench", "--all", "--json", "--threads", tlist,
+                "--samples", str(args.samples)]
+    with tempfile.TemporaryDirectory() as tmp:
+        for rnd in range(args.rounds):
+            def lobe_side():
+                print(f"round {rnd + 1}/{args.rounds}: lobe bench --all", file=sys.stderr)
+                out, err = run_json(lobe_cmd, side="lobe", threads=max(threads))
+                if out is None:
+                    die(f"lobe bench --all failed: {err}")
+                lobe_runs.append(out)
+                with open(os.path.join(tmp, "cases.json"), "w") as f:
+                    json.dump(out, f)
+
+            def mitsuba_side():
+                path = os.path.join(tmp, "cases.json")
+                if not os.path.exists(path):
+                    lobe_side()
+                print(f"round {rnd + 1}/{args.rounds}: mitsuba_kernels.py", file=sys.stderr)
+                cmd = [args.mitsuba_python, os.path.join(HERE, "mitsuba_kernels.py"), "--json",
+                       "--cases-from", path, "--threads", tlist,
+                       "--samples", str(args.samples), "--reps", str(args.reps)]
+                out, err = run_json(cmd, env=env, side="mitsuba", threads=max(threads))
+                if out is None:
+                    die(f"mitsuba_kernels.py failed: {err}")
+                mi_runs.append(out if isinstance(out, list) else [out])
+
+            for f in ((lobe_side, mitsuba_side) if rnd % 2 == 0 else (mitsuba_side, lobe_side)):
+                f()
+    if args.json_out:
+        with open(args.json_out, "w") as f:
+            json.dump({"lobe": lobe_runs, "mitsuba": mi_runs}, f, indent=2)
+    med = lambda v: statistics.median(v) if v else None  # noqa: E731
+    levels = lobe_runs[0]["levels"]
+    cells = {}  # (case, strategy, threads) -> {column: [values]}
+    order = []
+    for run in lobe_runs:
+        for r in run["results"]:
+            k = (r["case"], r["strategy"], r["threads"])
+            if k not in cells:
+                order.append(k)
+                cells[k] = {"material": r["material"]}
+            cells[k].setdefault("f64", []).append(r["f64"]["msps"])
+            for lv in levels:
+                if "msps" in r[lv]:
+                    cells[k].setdefault(lv, []).append(r[lv]["msps"])
+    by_material = {}
+    for run in mi_runs:
+        for o in run:
+            for r in o["results"]:
+                best = max(x for x in (r["msps"], r["eval_pdf_msps"]) if x is not None)
+                by_material.setdefault((r["material"], r["strategy"], o["threads"]), []).append(best)
+    mt = mi_runs[0][0] if mi_runs and mi_runs[0] else {}
+    lo = lobe_runs[0]
+    commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT,
+                            capture_output=True, text=True).stdout.strip() or "?"
+    try:
+        load = " ".join(open("/proc/loadavg").read().split()[:3])
+    except OSError:
+        load = "?"
+    heads = {"scalar": "f32 portable", "avx2": "AVX2", "avx512": "AVX-512"}
+    print(f"CPU: {lo['cpu']}; lobe levels {', '.join(levels)}; Mitsuba {mt.get('mitsuba', '?')} "
+          f"{mt.get('variant', '?')} (Dr.Jit {mt.get('drjit', '?')}, {mt.get('simd', '?')}).  ")
+    print(f"lobe commit {commit}; {datetime.datetime.now(datetime.timezone.utc):%Y-%m-%d %H:%M} UTC; "
+          f"load average at the end {load}; {args.samples} inputs ({lo['scalar_samples']} for lobe's "
+          f"f64 path), lobe median of {lo['reps']} reps, Mitsuba median of {args.reps} warm runs, "
+          f"median of {args.rounds} alternating round(s); sample + eval + pdf per sample, "
+          f"M samples/s · ns per sample (wall).\n")
+    cols = ["f64 path"] + [heads.get(lv, lv) for lv in levels] + ["Mitsuba 3", "lobe best / Mitsuba"]
+    print("| model | strategy | threads | " + " | ".join(cols) + " |")
+    print("|---|---|---:|" + "---:|" * len(cols))
+    fmt = lambda x: "—" if x is None else f"{x:.1f} · {1e3 / x:.1f} ns"  # noqa: E731
+    for k in order:
+        c = cells[k]
+        row = [med(c.get("f64"))] + [med(c.get(lv)) for lv in levels]
+        mi_ = med(by_material.get((c["material"], k[1], k[2])))
+        best = max((x for x in row[1:] if x is not None), default=None)
+        ratio = "—" if best is None or mi_ is None else f"{best / mi_:.2f}×"
+        print(f"| {k[0]} | {k[1]} | {k[2]} | " + " | ".join(fmt(x) for x in row + [mi_])
+              + f" | {ratio} |")
+    print("\n— = not measured: no batch kernel at that level (lobe's f64 path serves it), or no "
+          "Mitsuba plugin or sampler for the case (bench/mitsuba_kernels.py, mitsuba_dict).")
 
 
 if __name__ == "__main__":

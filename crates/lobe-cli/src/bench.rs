@@ -58,22 +58,29 @@ pub struct BenchArgs {
     /// has; without --material, for GGX alpha 0.2)
     #[arg(long)]
     pub strategy: Option<String>,
-    /// Worker threads, each on its own part of the inputs
-    #[arg(long, default_value_t = 1)]
-    pub threads: usize,
+    /// Worker threads, each on its own part of the inputs; a comma-separated
+    /// list times each count (default 1; with --all, 1 and every CPU)
+    #[arg(long, value_delimiter = ',')]
+    pub threads: Option<Vec<usize>>,
     /// Precomputed inputs (at least 2^22 for a figure worth quoting)
     #[arg(long, short = 'n', default_value_t = 1 << 22)]
     pub samples: usize,
-    /// Timed repetitions; the median is reported
-    #[arg(long, default_value_t = 7)]
-    pub reps: usize,
+    /// Timed repetitions; the median is reported (default 7; with --all, 3)
+    #[arg(long)]
+    pub reps: Option<usize>,
+    /// The whole table: every model (one material each, with Mitsuba 3's
+    /// plugin names where it has them) × every strategy × every SIMD level
+    /// this CPU runs, beside the scalar f64 path, × thread counts, in M
+    /// samples/s and ns per sample (BENCHMARKS.md)
+    #[arg(long, conflicts_with_all = ["material", "strategy"])]
+    pub all: bool,
     /// Print JSON instead of a table
     #[arg(long)]
     pub json: bool,
 }
 
 /// Precomputed inputs in structure-of-arrays layout.
-struct Inputs {
+pub(crate) struct Inputs {
     wo: [Vec<f32>; 3],
     u1: Vec<f32>,
     u2: Vec<f32>,
@@ -81,7 +88,7 @@ struct Inputs {
 }
 
 impl Inputs {
-    fn new(n: usize) -> Self {
+    pub(crate) fn new(n: usize) -> Self {
         let mut rng = rand_pcg::Pcg64::seed_from_u64(0x6c6f_6265_6265_6e63);
         let mut v = Inputs {
             wo: [vec![], vec![], vec![]],
@@ -124,7 +131,7 @@ impl Inputs {
 }
 
 #[derive(Clone, Copy, PartialEq, Eq, Debug)]
-enum Mode {
+pub(crate) enum Mode {
     /// Batch sample, then batch eval_pdf at the sampled directions.
     SampleEvalPdf,
     /// Batch sample alone.
@@ -135,12 +142,13 @@ enum Mode {
 
 /// What one timing runs: the mode, the material and strategy, the inputs.
 #[derive(Clone, Copy)]
-struct Job<'a> {
-    mode: Mode,
-    m: &'a Material,
-    strategy: BsdfStrategy,
-    b: &'a BatchSampler,
-    inputs: &'a Inputs,
+pub(crate) struct Job<'a> {
+    pub mode: Mode,
+    pub m: &'a Material,
+    pub strategy: BsdfStrategy,
+    /// The batch kernel (`None` for the scalar path's jobs).
+    pub b: Option<&'a BatchSampler>,
+    pub inputs: &'a Inputs,
 }
 
 /// One thread's work on `range`; returns a sum of the results so that
@@ -177,6 +185,7 @@ fn work(
         }
         return total;
     }
+    let b = b.expect("a batch job has its kernel");
     let mut start = range.start;
     while start < range.end {
         let end = (start + BLOCK).min(range.end);
@@ -236,7 +245,7 @@ fn sum_f32(v: &[f32]) -> f32 {
 
 /// The median wall time of `reps` timed runs (after one warm-up run) of
 /// `threads` workers, each on its part of the inputs.
-fn time(job: Job<'_>, threads: usize, reps: usize) -> Duration {
+pub(crate) fn time(job: Job<'_>, threads: usize, reps: usize) -> Duration {
     let inputs = job.inputs;
     let n = inputs.len();
     let chunk = n.div_ceil(threads);
@@ -270,17 +279,25 @@ fn time(job: Job<'_>, threads: usize, reps: usize) -> Duration {
     times[times.len() / 2]
 }
 
-/// The CPU model from /proc/cpuinfo.
-fn cpu_model() -> String {
-    std::fs::read_to_string("/proc/cpuinfo")
-        .ok()
-        .and_then(|s| {
-            s.lines()
-                .find(|l| l.starts_with("model name"))
-                .and_then(|l| l.split_once(':'))
-                .map(|(_, v)| v.trim().to_string())
-        })
-        .unwrap_or_else(|| "unknown".into())
+/// The CPU from /proc/cpuinfo: its model name and, where the file gives
+/// them, family and model numbers (a virtual machine's name may be only
+/// "AMD EPYC" for several generations: family 25 model 1 is Zen 3, model
+/// 17 Zen 4).
+pub(crate) fn cpu_model() -> String {
+    let Ok(info) = std::fs::read_to_string("/proc/cpuinfo") else {
+        return "unknown".into();
+    };
+    let field = |key: &str| {
+        info.lines()
+            .find(|l| l.split(':').next().is_some_and(|k| k.trim() == key))
+            .and_then(|l| l.split_once(':'))
+            .map(|(_, v)| v.trim().to_string())
+    };
+    let name = field("model name").unwrap_or_else(|| "unknown".into());
+    match (field("cpu family"), field("model")) {
+        (Some(f), Some(m)) => format!("{name} (family {f}, model {m})"),
+        _ => name,
+    }
 }
 
 fn parse_strategies(list: &str) -> Result<Vec<BsdfStrategy>> {
@@ -291,11 +308,23 @@ fn parse_strategies(list: &str) -> Result<Vec<BsdfStrategy>> {
 }
 
 pub fn run(args: &BenchArgs) -> Result<()> {
-    if args.threads == 0 {
-        bail!("--threads must be at least 1");
+    let threads = match &args.threads {
+        Some(list) => list.clone(),
+        None if args.all => {
+            let cpus = std::thread::available_parallelism().map_or(1, usize::from);
+            if cpus > 1 { vec![1, cpus] } else { vec![1] }
+        }
+        None => vec![1],
+    };
+    if threads.is_empty() || threads.contains(&0) {
+        bail!("--threads: every count must be at least 1");
     }
-    if args.samples == 0 || args.reps == 0 {
+    let reps = args.reps.unwrap_or(if args.all { 3 } else { 7 });
+    if args.samples == 0 || reps == 0 {
         bail!("--samples and --reps must be at least 1");
+    }
+    if args.all {
+        return crate::bench_all::run(args.samples, &threads, reps, args.json);
     }
     // (material text, material, strategy) rows.
     let mut rows: Vec<(String, Material, BsdfStrategy)> = Vec::new();
@@ -343,61 +372,78 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     }
     let inputs = Inputs::new(args.samples);
     let msps = |d: Duration| args.samples as f64 / d.as_secs_f64() / 1e6;
-    let mut results = Vec::new();
-    // Progress: three timings per row (on a terminal a bar; otherwise a
-    // line every few seconds).
-    let bar = crate::common::progress(3 * rows.len() as u64, "timing", false);
-    for ((text, m, s), b) in rows.iter().zip(&samplers) {
-        bar.set_message(format!("timing {s}"));
-        let job = |mode| Job {
-            mode,
-            m,
-            strategy: *s,
-            b,
-            inputs: &inputs,
-        };
-        let full = time(job(Mode::SampleEvalPdf), args.threads, args.reps);
-        let sample = time(job(Mode::Sample), args.threads, args.reps);
-        bar.inc(2);
-        let scalar = time(job(Mode::Scalar), args.threads, args.reps);
-        bar.inc(1);
-        results.push((text.as_str(), *s, msps(full), msps(sample), msps(scalar)));
-    }
-    bar.finish_and_clear();
     let level = level.map_or("none", |l| l.name());
     let cpu = cpu_model();
+    // Progress: three timings per row and thread count (on a terminal a
+    // bar; otherwise a line every few seconds).
+    let bar = crate::common::progress((3 * rows.len() * threads.len()) as u64, "timing", false);
+    let mut tables = Vec::new();
+    for &t in &threads {
+        let mut results = Vec::new();
+        for ((text, m, s), b) in rows.iter().zip(&samplers) {
+            bar.set_message(format!("timing {s}, {t} threads"));
+            let job = |mode| Job {
+                mode,
+                m,
+                strategy: *s,
+                b: Some(b),
+                inputs: &inputs,
+            };
+            let full = time(job(Mode::SampleEvalPdf), t, reps);
+            let sample = time(job(Mode::Sample), t, reps);
+            bar.inc(2);
+            let scalar = time(job(Mode::Scalar), t, reps);
+            bar.inc(1);
+            results.push((text.as_str(), *s, msps(full), msps(sample), msps(scalar)));
+        }
+        tables.push((t, results));
+    }
+    bar.finish_and_clear();
     if args.json {
-        let v = serde_json::json!({
-            "simd": level,
-            "cpu": cpu,
-            "threads": args.threads,
-            "samples": args.samples,
-            "reps": args.reps,
-            "block": BLOCK,
-            "results": results.iter().map(|&(text, s, x, y, z)| serde_json::json!({
-                "material": text,
-                "strategy": s.name(),
-                "msps": x,
-                "sample_msps": y,
-                "scalar_msps": z,
-            })).collect::<Vec<_>>(),
-        });
+        let objects: Vec<serde_json::Value> = tables
+            .iter()
+            .map(|(t, results)| {
+                serde_json::json!({
+                    "simd": level,
+                    "cpu": cpu,
+                    "threads": t,
+                    "samples": args.samples,
+                    "reps": reps,
+                    "block": BLOCK,
+                    "results": results.iter().map(|&(text, s, x, y, z)| serde_json::json!({
+                        "material": text,
+                        "strategy": s.name(),
+                        "msps": x,
+                        "sample_msps": y,
+                        "scalar_msps": z,
+                    })).collect::<Vec<_>>(),
+                })
+            })
+            .collect();
+        // One thread count: one object (the shape bench/side_by_side.py
+        // reads); several: a list of them.
+        let v = match <[_; 1]>::try_from(objects) {
+            Ok([one]) => one,
+            Err(all) => serde_json::Value::Array(all),
+        };
         println!("{}", serde_json::to_string_pretty(&v)?);
     } else {
-        println!(
-            "cpu {cpu}; simd {level}; {} threads; {} samples, median of {} reps; M samples/s",
-            args.threads, args.samples, args.reps
-        );
-        println!(
-            "{:<58} {:<15} {:>16} {:>8} {:>17} {:>8}",
-            "material", "strategy", "sample+eval+pdf", "sample", "scalar f64 s+e+p", "speedup"
-        );
-        for (text, s, x, y, z) in results {
+        for (t, results) in tables {
             println!(
-                "{text:<58} {:<15} {x:>16.1} {y:>8.1} {z:>17.1} {:>7.1}x",
-                s.name(),
-                x / z
+                "cpu {cpu}; simd {level}; {t} threads; {} samples, median of {reps} reps; M samples/s",
+                args.samples
             );
+            println!(
+                "{:<58} {:<15} {:>16} {:>8} {:>17} {:>8}",
+                "material", "strategy", "sample+eval+pdf", "sample", "scalar f64 s+e+p", "speedup"
+            );
+            for (text, s, x, y, z) in results {
+                println!(
+                    "{text:<58} {:<15} {x:>16.1} {y:>8.1} {z:>17.1} {:>7.1}x",
+                    s.name(),
+                    x / z
+                );
+            }
         }
     }
     Ok(())

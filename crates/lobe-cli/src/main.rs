@@ -6,6 +6,7 @@
 
 mod alloc;
 mod bench;
+mod bench_all;
 mod common;
 mod compare;
 mod compare_figure;

@@ -22,7 +22,7 @@ use super::super::lanes::Lanes;
 use super::super::math::sincos_turns;
 use super::{
     BOUNDED, CtParams, Eval, GGX, INV_PI, Sampled, Shadow, V3, VNDF, dot, eval_at, eval_h, finish,
-    glossy_probability, plus_diffuse, reflect_or_diffuse, select3, stretched_len, with_weight,
+    mixture_pdf, plus_diffuse, reflect_or_diffuse, select3, stretched_len, with_weight,
 };
 
 /// The visible normal of the caps (`STRAT = CAPS`) or of the bounded VNDF.
@@ -123,7 +123,7 @@ fn eval_h_caps<L: Lanes, const STRAT: u8>(
     if STRAT != BOUNDED {
         return eval_h::<L, GGX, VNDF>(l, p, wo, wi, h, hh, oh, ih);
     }
-    if p.kd_lum == 0.0 && p.kd_pi == [0.0; 3] {
+    if !p.has_diffuse() {
         return eval_at_caps::<L, STRAT>(l, p, wo, wi, h, hh, oh, ih);
     }
     let zero = l.splat(0.0);
@@ -132,8 +132,8 @@ fn eval_h_caps<L: Lanes, const STRAT: u8>(
     let fg = select3(l, e.ok, e.f, zero);
     let pg = l.select(e.ok, e.pdf, zero);
     let pd = wi[2] * l.splat(INV_PI);
-    let pdf = l.mul_add(glossy_probability(l, p, wo), pg - pd, pd);
-    with_weight(above, plus_diffuse(l, fg, p.kd_pi, above), pdf, wi[2])
+    let pdf = mixture_pdf(l, p, wo, pg, pd);
+    with_weight(above, plus_diffuse(l, p, fg, wo, wi, above), pdf, wi[2])
 }
 
 /// One vector of samples (`STRAT`: [`CAPS`] or [`BOUNDED`]).

@@ -118,6 +118,90 @@ pub(crate) struct CtParams {
     /// Whether `uc` chooses between the glossy and the diffuse lobe (both
     /// present, strategy vndf or brdf).
     pub two_lobes: bool,
+    /// Rough plastic's base in place of the Lambertian term (`kd_pi` and
+    /// `kd_lum` are then 0).
+    pub base: Option<PlasticBaseP>,
+    /// Turquin's energy compensation of the glossy lobe.
+    pub turquin: Option<TurquinP>,
+}
+
+/// Nodes of the tables below (rough plastic's transmittance, Mitsuba's
+/// 64; the energy tables' cosines, lobe's 64).
+pub(crate) const TABLE_NODES: usize = 64;
+
+/// Rough plastic's base (`models::roughplastic`): `f_d = scale T(μo)
+/// T(μi)`, `T` linear in `μ` between [`TABLE_NODES`] evenly spaced nodes;
+/// the coating is chosen with probability `(1 − T(μo)) w / ((1 − T(μo)) w
+/// + T(μo)(1 − w))`, 0 where both are 0.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct PlasticBaseP {
+    pub scale: [f32; 3],
+    pub w: f32,
+    pub t: [f32; TABLE_NODES],
+}
+
+/// Turquin's scaling of a glossy lobe (`energy::compensation::Turquin`):
+/// `f` and `weight` times `1 + F0 (1 − E)/E`, `E = max(E(μo), e_min)`
+/// linear in `√μo` between [`TABLE_NODES`] evenly spaced nodes (the energy
+/// table's row at the lobe's `α`); the pdf is the single-scattering one.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct TurquinP {
+    pub f0: [f32; 3],
+    pub e: [f32; TABLE_NODES],
+    /// The least `E` divided by (1e-3 for a conductor's table, 0.01 for a
+    /// dielectric's).
+    pub e_min: f32,
+}
+
+impl CtParams {
+    /// Whether the material has a diffuse term beside the glossy lobe (a
+    /// Lambertian `kd` or rough plastic's base).
+    #[inline(always)]
+    pub(crate) fn has_diffuse(&self) -> bool {
+        self.kd_lum != 0.0 || self.kd_pi != [0.0; 3] || self.base.is_some()
+    }
+}
+
+/// `table` at `x ∈ [0, 1]` (clamped), linear between its evenly spaced
+/// nodes, as the scalar path's tables interpolate.
+#[inline(always)]
+pub(crate) fn lerp_table<L: Lanes>(l: L, table: &[f32; TABLE_NODES], x: L::F) -> L::F {
+    let top = (TABLE_NODES - 1) as f32;
+    let x = l.min(l.max(x, l.splat(0.0)), l.splat(1.0)) * l.splat(top);
+    let i = l.min(l.floor(x), l.splat(top - 1.0));
+    let a = l.gather(table, i);
+    let b = l.gather(table, i + l.splat(1.0));
+    l.mul_add(b - a, x - i, a)
+}
+
+/// Rough plastic's `T(μ)`.
+#[inline(always)]
+fn plastic_t<L: Lanes>(l: L, b: &PlasticBaseP, mu: L::F) -> L::F {
+    lerp_table(l, &b.t, mu)
+}
+
+/// The glossy lobe's [`Eval`] with Turquin's scaling where the material
+/// has it (`f` and `weight`; the pdf is unchanged).
+#[inline(always)]
+fn turquin_scaled<L: Lanes>(l: L, p: &CtParams, wo: V3<L>, e: Eval<L>) -> Eval<L> {
+    let Some(t) = &p.turquin else { return e };
+    let one = l.splat(1.0);
+    let ev = l.max(
+        lerp_table(l, &t.e, l.sqrt(l.max(wo[2], l.splat(0.0)))),
+        l.splat(t.e_min),
+    );
+    let r = (one - ev) / ev;
+    let k = [
+        l.mul_add(l.splat(t.f0[0]), r, one),
+        l.mul_add(l.splat(t.f0[1]), r, one),
+        l.mul_add(l.splat(t.f0[2]), r, one),
+    ];
+    Eval {
+        ok: e.ok,
+        f: [e.f[0] * k[0], e.f[1] * k[1], e.f[2] * k[2]],
+        pdf: e.pdf,
+        weight: [e.weight[0] * k[0], e.weight[1] * k[1], e.weight[2] * k[2]],
+    }
 }
 
 /// Cells of the guess table along `cos θ` and along the normal-incidence
@@ -322,7 +406,7 @@ fn eval_h<L: Lanes, const NDF: u8, const STRAT: u8>(
     oh: L::F,
     ih: L::F,
 ) -> Eval<L> {
-    if p.has_glossy && p.kd_lum == 0.0 && p.kd_pi == [0.0; 3] {
+    if p.has_glossy && !p.has_diffuse() {
         return eval_at::<L, NDF, STRAT>(l, p, wo, wi, h, hh, oh, ih, None);
     }
     // A diffuse term: f = glossy + kd/π; for vndf and brdf the pdf is the
@@ -341,23 +425,46 @@ fn eval_h<L: Lanes, const NDF: u8, const STRAT: u8>(
         UNIFORM => l.splat(INV_TWO_PI),
         COSINE => pd,
         _ if !p.has_glossy => pd,
-        _ => {
-            let pr = glossy_probability(l, p, wo);
-            l.mul_add(pr, pg - pd, pd)
-        }
+        _ => mixture_pdf(l, p, wo, pg, pd),
     };
-    with_weight(above, plus_diffuse(l, fg, p.kd_pi, above), pdf, wi[2])
+    with_weight(above, plus_diffuse(l, p, fg, wo, wi, above), pdf, wi[2])
 }
 
-/// The glossy `fg` plus the diffuse `kd/π` where `above` (both directions
-/// above the horizon), as `Material::eval` adds them; no cosine.
+/// `P p_g + (1 − P) p_d` at `wo`, the two lobes' mixture density, with
+/// `1 − P` computed on its own ([`lobe_choice`]). (Not `p_d + P (p_g −
+/// p_d)`: where `P` rounds to 1, as under a plastic's coating that lets
+/// almost nothing through, that cancels a tiny `p_g`, and `1 − P` from `P`
+/// is mostly rounding.)
 #[inline(always)]
-pub(super) fn plus_diffuse<L: Lanes>(l: L, fg: V3<L>, kd_pi: [f32; 3], above: L::M) -> V3<L> {
+pub(super) fn mixture_pdf<L: Lanes>(l: L, p: &CtParams, wo: V3<L>, pg: L::F, pd: L::F) -> L::F {
+    let (pr, q) = lobe_choice(l, p, wo, true);
+    l.mul_add(pr, pg, q * pd)
+}
+
+/// The glossy `fg` plus the diffuse term where `above` (both directions
+/// above the horizon), as `Material::eval` adds them; no cosine: `kd/π`,
+/// or rough plastic's `scale T(μo) T(μi)`.
+#[inline(always)]
+pub(super) fn plus_diffuse<L: Lanes>(
+    l: L,
+    p: &CtParams,
+    fg: V3<L>,
+    wo: V3<L>,
+    wi: V3<L>,
+    above: L::M,
+) -> V3<L> {
     let zero = l.splat(0.0);
+    let d = match &p.base {
+        None => p.kd_pi.map(|c| l.splat(c)),
+        Some(b) => {
+            let tt = plastic_t(l, b, wo[2]) * plastic_t(l, b, wi[2]);
+            b.scale.map(|c| l.splat(c) * tt)
+        }
+    };
     [
-        fg[0] + l.select(above, l.splat(kd_pi[0]), zero),
-        fg[1] + l.select(above, l.splat(kd_pi[1]), zero),
-        fg[2] + l.select(above, l.splat(kd_pi[2]), zero),
+        fg[0] + l.select(above, d[0], zero),
+        fg[1] + l.select(above, d[1], zero),
+        fg[2] + l.select(above, d[2], zero),
     ]
 }
 
@@ -376,18 +483,42 @@ pub(super) fn with_weight<L: Lanes>(ok: L::M, f: V3<L>, pdf: L::F, cos_i: L::F) 
 
 /// The probability of choosing the glossy lobe, as
 /// `Material::glossy_probability`: `g/(g + d)`, `g = luminance(ks F(cos θo))`,
-/// `d = luminance(kd)`; 1/2 where both are 0.
+/// `d = luminance(kd)`; 1/2 where both are 0. Rough plastic's as
+/// `RoughPlastic::coating_probability`.
 #[inline(always)]
 fn glossy_probability<L: Lanes>(l: L, p: &CtParams, wo: V3<L>) -> L::F {
-    let c = l.min(l.max(wo[2], l.splat(0.0)), l.splat(1.0));
-    let ksf = ks_fresnel(l, &p.fresnel, c);
-    let g = l.mul_add(
-        l.splat(0.2126),
-        ksf[0],
-        l.mul_add(l.splat(0.7152), ksf[1], l.splat(0.0722) * ksf[2]),
-    );
-    let s = g + l.splat(p.kd_lum);
-    l.select(l.gt(s, l.splat(0.0)), g / s, l.splat(0.5))
+    lobe_choice(l, p, wo, false).0
+}
+
+/// `(P, 1 − P)` of [`glossy_probability`], `1 − P` computed as `d/(g + d)`
+/// (with `want_q`; else 0): accurate where `P` is within rounding of 1.
+#[inline(always)]
+fn lobe_choice<L: Lanes>(l: L, p: &CtParams, wo: V3<L>, want_q: bool) -> (L::F, L::F) {
+    let zero = l.splat(0.0);
+    let (g, d, none) = if let Some(b) = &p.base {
+        let t = plastic_t(l, b, wo[2]);
+        let ps = (l.splat(1.0) - t) * l.splat(b.w);
+        let pd = t * l.splat(1.0 - b.w);
+        (ps, pd, (zero, l.splat(1.0)))
+    } else {
+        let c = l.min(l.max(wo[2], zero), l.splat(1.0));
+        let ksf = ks_fresnel(l, &p.fresnel, c);
+        let g = l.mul_add(
+            l.splat(0.2126),
+            ksf[0],
+            l.mul_add(l.splat(0.7152), ksf[1], l.splat(0.0722) * ksf[2]),
+        );
+        (g, l.splat(p.kd_lum), (l.splat(0.5), l.splat(0.5)))
+    };
+    let s = g + d;
+    let some = l.gt(s, zero);
+    let pr = l.select(some, g / s, none.0);
+    let q = if want_q {
+        l.select(some, d / s, none.1)
+    } else {
+        zero
+    };
+    (pr, q)
 }
 
 /// `f`, `pdf`, `weight` given a half vector `h` of any length (`hh = |h|²`,
@@ -400,6 +531,24 @@ fn glossy_probability<L: Lanes>(l: L, p: &CtParams, wo: V3<L>) -> L::F {
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
 fn eval_at<L: Lanes, const NDF: u8, const STRAT: u8>(
+    l: L,
+    p: &CtParams,
+    wo: V3<L>,
+    wi: V3<L>,
+    h: V3<L>,
+    hh: L::F,
+    oh: L::F,
+    ih: L::F,
+    lam1o_pre: Option<L::F>,
+) -> Eval<L> {
+    let e = eval_single::<L, NDF, STRAT>(l, p, wo, wi, h, hh, oh, ih, lam1o_pre);
+    turquin_scaled(l, p, wo, e)
+}
+
+/// [`eval_at`] of the single-scattering lobe.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn eval_single<L: Lanes, const NDF: u8, const STRAT: u8>(
     l: L,
     p: &CtParams,
     wo: V3<L>,

@@ -65,9 +65,25 @@
 //! rough dielectric: GGX vndf only (Beckmann, the other strategies and an
 //! index-matched interface take the scalar path).
 //!
+//! **Rough plastic** (`roughplastic`, GGX or Beckmann, every strategy it
+//! has) runs in the Cook-Torrance kernel: its coating is a Cook-Torrance
+//! lobe (dielectric Fresnel, separable Smith), its base takes the place of
+//! the Lambertian term (`scale T(μo) T(μi)`, `T` read from the material's
+//! 64-cosine transmittance table, linear between nodes as the scalar path
+//! reads it) and the coating's probability is the scalar path's
+//! `(1 − T) w / ((1 − T) w + T (1 − w))`. **Turquin's energy compensation**
+//! (`multiscatter = "turquin"`) of Cook-Torrance lobes and of rough
+//! plastic's coating scales the lobe's `f` and weight by `1 + F0 (1 −
+//! E)/E` (`1/E(μo, α, η)` for the coating), `E` read from the energy
+//! table's 64 cosines at the lobe's `α`; the pdf is the single-scattering
+//! lobe's. Both are tested against the scalar path like the rest (the
+//! grid's `roughplastic` and `turquin` groups, chi-square included).
+//!
 //! Refused with [`BatchError::Unsupported`], the scalar path serving them:
-//! not yet batched: glass, mirrors, plastic and two-sided materials (issue
-//! 42's models but rough glass; their kernels are issue 44's work).
+//! the smooth models (`conductor`, `dielectric`, `thindielectric`,
+//! `plastic`: delta lobes), two-sided materials, Kulla-Conty compensation
+//! (its added lobe and mixture sampling), and rough glass other than GGX
+//! by visible normals. `lobe bench --all` lists them with the reason.
 //!
 //! Beckmann's visible slopes are drawn as the scalar path draws them (Heitz
 //! and d'Eon 2014: the slope CDF inverted by Newton's method inside a
@@ -261,6 +277,7 @@ mod tests;
 
 pub use buffers::{DirPairs, EvalPdfBuffers, SampleBuffers, SampleInputs};
 
+use crate::energy::Multiscatter;
 use crate::models::{CookTorrance, Glossy};
 use crate::{BsdfStrategy, Fresnel, Material, Ndf, Rgb, Shadowing};
 use dispatch::{Backend, Kernel};
@@ -818,13 +835,7 @@ fn kernel_for(m: &Material, strategy: BsdfStrategy) -> Result<Kernel, BatchError
     let kd_pi = c3(kd * crate::math::INV_PI);
     let kd_lum = crate::math::luminance(kd) as f32;
     let lobe = match &m.glossy {
-        Glossy::CookTorrance(lobe) if lobe.multiscatter != crate::energy::Multiscatter::None => {
-            return unsupported(format!(
-                "not yet batched: energy compensation (multiscatter {})",
-                lobe.multiscatter.kind()
-            ));
-        }
-        Glossy::CookTorrance(lobe) => *lobe,
+        Glossy::CookTorrance(lobe) => lobe,
         Glossy::None => {
             // A Lambertian material: cosine-weighted (uniform for uniform).
             let strat = if strategy == BsdfStrategy::Uniform {
@@ -878,35 +889,91 @@ fn kernel_for(m: &Material, strategy: BsdfStrategy) -> Result<Kernel, BatchError
             ));
         }
         Glossy::RoughDielectric(rd) => return dielectric_kernel(rd, strategy),
+        Glossy::RoughPlastic(rp) => return rough_plastic_kernel(m, rp, strategy),
         #[allow(unreachable_patterns)]
         _ => {
             return unsupported(format!(
-                "model `{}`: not yet batched: glass, mirrors, plastic and two-sided materials",
+                "model `{}`: not yet batched: smooth glass, mirrors and plastic (delta lobes), \
+                 two-sided materials",
                 m.model_name()
             ));
         }
     };
-    // Compensated lobes were refused above.
-    let CookTorrance {
-        ks,
-        microfacet,
-        shadowing,
-        fresnel,
-        multiscatter: _,
-    } = lobe;
-    let ndf = match microfacet.ndf() {
+    let turquin = match &lobe.multiscatter {
+        Multiscatter::None => None,
+        Multiscatter::Turquin(t) => {
+            let row = t.row();
+            if row.table().n_mu != kernel::TABLE_NODES {
+                return unsupported(format!(
+                    "energy table of {} cosines (the kernels read {})",
+                    row.table().n_mu,
+                    kernel::TABLE_NODES
+                ));
+            }
+            Some(kernel::TurquinP {
+                f0: c3(t.f0()),
+                e: table_nodes(|x| row.e(x * x)),
+                e_min: 1e-3,
+            })
+        }
+        Multiscatter::KullaConty(_) => {
+            return unsupported(
+                "not yet batched: Kulla-Conty energy compensation (its added lobe and the \
+                 mixture sampling it)"
+                    .into(),
+            );
+        }
+    };
+    let p = CtParams {
+        kd_pi,
+        kd_lum,
+        two_lobes: m.chooses_lobe(strategy),
+        turquin,
+        ..cook_torrance_params(lobe, strategy)
+    };
+    Ok(Kernel::CookTorrance {
+        ndf: ndf_code(lobe.microfacet.ndf()),
+        strat: strat_code(strategy),
+        p,
+    })
+}
+
+/// `f(x)` at [`kernel::TABLE_NODES`] evenly spaced `x ∈ [0, 1]`, in f32.
+fn table_nodes(f: impl Fn(f64) -> f64) -> [f32; kernel::TABLE_NODES] {
+    let top = (kernel::TABLE_NODES - 1) as f64;
+    std::array::from_fn(|j| f(j as f64 / top) as f32)
+}
+
+fn ndf_code(ndf: Ndf) -> u8 {
+    match ndf {
         Ndf::Ggx => kernel::GGX,
         Ndf::Beckmann => kernel::BECKMANN,
         Ndf::BlinnPhong => kernel::BLINN_PHONG,
-    };
-    let strat = match strategy {
+    }
+}
+
+fn strat_code(strategy: BsdfStrategy) -> u8 {
+    match strategy {
         BsdfStrategy::Vndf => kernel::VNDF,
         BsdfStrategy::Brdf => kernel::BRDF,
         BsdfStrategy::Uniform => kernel::UNIFORM,
         BsdfStrategy::Cosine => kernel::COSINE,
         BsdfStrategy::SphericalCaps => kernel::CAPS,
         BsdfStrategy::BoundedVndf => kernel::BOUNDED,
-    };
+    }
+}
+
+/// A single-scattering Cook-Torrance lobe's kernel parameters: no diffuse
+/// term, no lobe choice, no compensation (callers set what differs).
+fn cook_torrance_params(lobe: &CookTorrance, strategy: BsdfStrategy) -> CtParams {
+    let c3 = |c: Rgb| [c.x as f32, c.y as f32, c.z as f32];
+    let CookTorrance {
+        ks,
+        microfacet,
+        shadowing,
+        fresnel,
+        multiscatter: _,
+    } = *lobe;
     let (ax, ay) = microfacet.alpha();
     let fresnel = match fresnel {
         Fresnel::None => FresnelP::Schlick {
@@ -932,27 +999,69 @@ fn kernel_for(m: &Material, strategy: BsdfStrategy) -> Result<Kernel, BatchError
         Shadowing::SmithSeparable => Shadow::Separable,
         Shadowing::VCavity => Shadow::VCavity,
     };
-    Ok(Kernel::CookTorrance {
-        ndf,
-        strat,
-        p: CtParams {
-            ax: ax as f32,
-            ay: ay as f32,
-            inv_ax: (1.0 / ax) as f32,
-            inv_ay: (1.0 / ay) as f32,
-            inv_pi_axay: (crate::math::INV_PI / (ax * ay)) as f32,
-            fresnel,
-            shadow,
-            guess: if ndf == kernel::BECKMANN && strat == kernel::VNDF {
-                kernel::beckmann_guess_table()
-            } else {
-                &[]
-            },
-            has_glossy: true,
-            kd_pi,
-            kd_lum,
-            two_lobes: m.chooses_lobe(strategy),
+    CtParams {
+        fresnel,
+        shadow,
+        guess: if microfacet.ndf() == Ndf::Beckmann && strategy == BsdfStrategy::Vndf {
+            kernel::beckmann_guess_table()
+        } else {
+            &[]
         },
+        ..microfacets_only(ax, ay)
+    }
+}
+
+/// Rough plastic (`models::roughplastic`): its coating as a Cook-Torrance
+/// lobe (dielectric Fresnel, separable Smith) with the base in place of
+/// the Lambertian term; Turquin's compensated coating scales the coating
+/// by `1/E(μo, α, η)` (its transmittance table already compensated).
+fn rough_plastic_kernel(
+    m: &Material,
+    rp: &crate::models::RoughPlastic,
+    strategy: BsdfStrategy,
+) -> Result<Kernel, BatchError> {
+    use crate::energy::DielectricMultiscatter;
+    let unsupported = |reason: String| Err(BatchError::Unsupported { reason });
+    let turquin = match &rp.multiscatter {
+        DielectricMultiscatter::None => None,
+        DielectricMultiscatter::Turquin(t) => {
+            if t.mu_nodes() != kernel::TABLE_NODES {
+                return unsupported(format!(
+                    "energy table of {} cosines (the kernels read {})",
+                    t.mu_nodes(),
+                    kernel::TABLE_NODES
+                ));
+            }
+            Some(kernel::TurquinP {
+                f0: [1.0; 3],
+                e: table_nodes(|x| t.albedo(x * x, rp.eta)),
+                e_min: crate::energy::compensation::MIN_DIELECTRIC_E as f32,
+            })
+        }
+        DielectricMultiscatter::KullaConty(_) => {
+            return unsupported(
+                "not yet batched: Kulla-Conty energy compensation (its added lobe and the \
+                 mixture sampling it)"
+                    .into(),
+            );
+        }
+    };
+    let c3 = |c: Rgb| [c.x as f32, c.y as f32, c.z as f32];
+    let base = rp.base();
+    let p = CtParams {
+        two_lobes: m.chooses_lobe(strategy),
+        base: Some(kernel::PlasticBaseP {
+            scale: c3(base.scale),
+            w: base.specular_weight as f32,
+            t: table_nodes(|x| rp.transmittance(x)),
+        }),
+        turquin,
+        ..cook_torrance_params(&rp.coating, strategy)
+    };
+    Ok(Kernel::CookTorrance {
+        ndf: ndf_code(rp.coating.microfacet.ndf()),
+        strat: strat_code(strategy),
+        p,
     })
 }
 
@@ -976,6 +1085,8 @@ fn microfacets_only(ax: f64, ay: f64) -> CtParams {
         kd_pi: [0.0; 3],
         kd_lum: 0.0,
         two_lobes: false,
+        base: None,
+        turquin: None,
     }
 }
 

@@ -34,6 +34,62 @@ fn ct(ndf: Ndf, ax: f64, ay: f64, sh: Shadowing, fr: Fresnel, ks: Rgb) -> Materi
     Material::with_diffuse(Rgb::ZERO, Glossy::CookTorrance(lobe)).unwrap()
 }
 
+/// Rough plastics of `ndf` (alpha, index, nonlinear, colours, Turquin's
+/// compensation: `models::roughplastic`), and Cook-Torrance lobes with
+/// Turquin's compensation (both Smith terms, three Fresnel terms, with and
+/// without a diffuse term).
+fn compensated_and_plastic(ndf: Ndf) -> (Vec<Material>, Vec<Material>) {
+    use crate::energy::compensation::Compensation;
+    use crate::models::RoughPlastic;
+    let mut plastic = Vec::new();
+    for (i, (a, eta, nonlinear, turquin)) in [
+        (0.05, 1.49, false, false),
+        (0.3, 1.2, true, false),
+        (0.8, 2.5, false, false),
+        (0.2, 1.0 / 1.3, false, false),
+        (0.3, 1.49, false, true),
+        (0.6, 1.8, true, true),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let mf = Microfacet::new(ndf, a, a).unwrap();
+        let rho = [Rgb::new(0.8, 0.3, 0.1), Rgb::ONE, Rgb::splat(0.5)][i % 3];
+        let spec = if i == 2 {
+            Rgb::new(0.9, 1.0, 0.8)
+        } else {
+            Rgb::ONE
+        };
+        let mut rp = RoughPlastic::new(mf, rho, spec, eta, nonlinear).unwrap();
+        if turquin {
+            rp = rp.with_multiscatter(Compensation::Turquin).unwrap();
+        }
+        plastic.push(Material::with_diffuse(Rgb::ZERO, Glossy::RoughPlastic(rp)).unwrap());
+    }
+    let mut turquin = Vec::new();
+    for (i, sh) in [Shadowing::SmithCorrelated, Shadowing::SmithSeparable]
+        .into_iter()
+        .enumerate()
+    {
+        for (j, fr) in fresnels().into_iter().skip(1).enumerate() {
+            let a = [0.1, 0.5, 1.0][j];
+            let ay = if i == 1 && j == 2 { 0.4 } else { a };
+            let mf = Microfacet::new(ndf, a, ay).unwrap();
+            let lobe = CookTorrance::new(Rgb::new(0.9, 1.0, 0.7), mf, sh, fr)
+                .unwrap()
+                .with_multiscatter(Compensation::Turquin)
+                .unwrap();
+            let kd = if j == 1 {
+                Rgb::new(0.3, 0.2, 0.1)
+            } else {
+                Rgb::ZERO
+            };
+            turquin.push(Material::with_diffuse(kd, Glossy::CookTorrance(lobe)).unwrap());
+        }
+    }
+    (plastic, turquin)
+}
+
 /// The batched (distribution, strategy) pairs of Cook-Torrance.
 fn batched() -> Vec<(Ndf, BsdfStrategy)> {
     let mut v = Vec::new();
@@ -180,6 +236,15 @@ fn groups(rng: &mut impl Rng, random: usize) -> Vec<(String, Vec<Material>, Bsdf
         BsdfStrategy::Brdf,
     ] {
         v.push(("lambert".to_string(), lambert.clone(), s));
+    }
+    // Rough plastic and Turquin's compensation: every strategy each has.
+    for ndf in [Ndf::Ggx, Ndf::Beckmann] {
+        let (plastic, turquin) = compensated_and_plastic(ndf);
+        for (name, mats) in [("roughplastic", plastic), ("turquin", turquin)] {
+            for s in mats[0].strategies() {
+                v.push((format!("{name} {}", ndf.name()), mats.clone(), s));
+            }
+        }
     }
     v
 }
@@ -594,6 +659,19 @@ fn grid_chi2_batch_pdf() {
             mats.push((format!("{name} kd={}", kd.x), m, BsdfStrategy::Brdf));
         }
     }
+    // Rough plastic and Turquin's compensation, one material of each per
+    // distribution and strategy (the pdf is the uncompensated lobe's for
+    // Turquin: sampled the same way, tested for the scaled weight's sake).
+    for ndf in [Ndf::Ggx, Ndf::Beckmann] {
+        let (plastic, turquin) = compensated_and_plastic(ndf);
+        for (name, m) in [("roughplastic", &plastic[4]), ("turquin", &turquin[1])] {
+            for s in m.strategies() {
+                if !matches!(s, BsdfStrategy::Uniform | BsdfStrategy::Cosine) {
+                    mats.push((format!("{name} {}", ndf.name()), m.clone(), s));
+                }
+            }
+        }
+    }
     // The cases added after the first step at 60° and 89° only (test cost).
     let alpha = sidak(0.01, mats.len() * views.len());
     let _ = alphas;
@@ -603,7 +681,9 @@ fn grid_chi2_batch_pdf() {
             let later_case = name.starts_with("phong")
                 || name.starts_with("blinn-phong n")
                 || matches!(s, BsdfStrategy::SphericalCaps | BsdfStrategy::BoundedVndf)
-                || name.starts_with("blinn-phong α");
+                || name.starts_with("blinn-phong α")
+                || name.starts_with("roughplastic")
+                || name.starts_with("turquin");
             for &theta in &views[if later_case { 1 } else { 0 }..] {
                 let wo = crate::frame::wo_from_theta(theta, 0.3f64.to_degrees());
                 let wo32 = [wo.x as f32, wo.y as f32, wo.z as f32];
@@ -754,13 +834,21 @@ fn grid_every_supported_combination_builds() {
             BlinnPhong::new(Rgb::splat(0.5), 20.0, normalized).unwrap(),
         ));
     }
+    for ndf in [Ndf::Ggx, Ndf::Beckmann] {
+        let (plastic, turquin) = compensated_and_plastic(ndf);
+        glossies.extend(plastic.into_iter().chain(turquin).map(|m| m.glossy));
+    }
     let _ = Lambert::new(Rgb::ONE);
     // What the batch path does not have yet (the module doc says so).
     // Only the measured model (not in this walk: it needs a data file).
     let not_yet = |m: &Material, _s: BsdfStrategy| {
         !matches!(
             m.glossy,
-            Glossy::CookTorrance(_) | Glossy::None | Glossy::Phong(_) | Glossy::BlinnPhong(_)
+            Glossy::CookTorrance(_)
+                | Glossy::None
+                | Glossy::Phong(_)
+                | Glossy::BlinnPhong(_)
+                | Glossy::RoughPlastic(_)
         )
     };
     let mut wrong = Vec::new();

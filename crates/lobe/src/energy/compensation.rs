@@ -217,6 +217,19 @@ pub struct Turquin {
 }
 
 impl Turquin {
+    /// `E(μ)` at the lobe's `α` (what the batch kernels tabulate).
+    #[must_use]
+    pub fn row(&self) -> AlbedoRow {
+        self.row
+    }
+
+    /// `F0`, the lobe's reflectance at normal incidence (tint times
+    /// Fresnel).
+    #[must_use]
+    pub fn f0(&self) -> Rgb {
+        self.f0
+    }
+
     /// The factor `1 + F0 (1 − E(μo)) / E(μo)` of the lobe at `wo`.
     #[inline]
     #[must_use]
@@ -297,6 +310,20 @@ impl DielectricTurquin {
     /// (the error as [`dielectric_table`]'s).
     pub fn builtin(ndf: crate::Ndf, alpha: f64, eta: f64) -> crate::error::Result<Self> {
         Ok(DielectricTurquin::new(dielectric_table(ndf, eta)?, alpha))
+    }
+
+    /// Cosine nodes of its table.
+    #[must_use]
+    pub fn mu_nodes(&self) -> usize {
+        self.table.n_mu
+    }
+
+    /// `E(μ, α, η)`, what [`DielectricTurquin::scale`] divides by (at
+    /// least [`MIN_DIELECTRIC_E`]).
+    #[inline]
+    #[must_use]
+    pub fn albedo(&self, mu: f64, eta: f64) -> f64 {
+        self.table.e_eta(mu, self.alpha, eta)
     }
 
     /// The factor `1/E(μo, α, η)` at `|cos θo| = mu`, `η` the relative

@@ -282,6 +282,13 @@ impl RoughPlastic {
         t[i] + (t[i + 1] - t[i]) * (x - i as f64)
     }
 
+    /// The base under the coating: the scale of its `f` and the coating's
+    /// weight in the lobe choice.
+    #[must_use]
+    pub fn base(&self) -> &Base {
+        &self.base
+    }
+
     /// `R_int`, the coating's mean reflectance from inside (the
     /// compensated coating's with `multiscatter`).
     #[must_use]
