@@ -79,6 +79,7 @@ def run_json(cmd, env=None, side=None, threads=1):
     cpu = (r1.ru_utime - r0.ru_utime) + (r1.ru_stime - r0.ru_stime)
     if side and wall > 0:
         SHARE[side].append(cpu / (wall * threads))
+    run_json.last_stderr = p.stderr
     if p.returncode != 0:
         lines = [x for x in p.stderr.strip().splitlines() if x.strip()]
         return None, (" ".join(lines[-3:]) if lines else f"exit {p.returncode}")
@@ -285,6 +286,9 @@ def run_all(args, threads, env):
                 lobe_runs.append(out)
                 with open(os.path.join(tmp, "cases.json"), "w") as f:
                     json.dump(out, f)
+                if args.json_out:  # kept as it comes: a later failure loses nothing
+                    with open(args.json_out, "w") as f:
+                        json.dump({"lobe": lobe_runs, "mitsuba": mi_runs}, f, indent=2)
 
             def mitsuba_side():
                 path = os.path.join(tmp, "cases.json")
@@ -297,6 +301,7 @@ def run_all(args, threads, env):
                 out, err = run_json(cmd, env=env, side="mitsuba", threads=max(threads))
                 if out is None:
                     die(f"mitsuba_kernels.py failed: {err}")
+                sys.stderr.write(run_json.last_stderr)
                 mi_runs.append(out if isinstance(out, list) else [out])
 
             for f in ((lobe_side, mitsuba_side) if rnd % 2 == 0 else (mitsuba_side, lobe_side)):
@@ -319,10 +324,14 @@ def run_all(args, threads, env):
                 if "msps" in r[lv]:
                     cells[k].setdefault(lv, []).append(r[lv]["msps"])
     by_material = {}
+    notes = set()
     for run in mi_runs:
         for o in run:
             for r in o["results"]:
                 best = max(x for x in (r["msps"], r["eval_pdf_msps"]) if x is not None)
+                if r.get("not_finite"):
+                    notes.add(f"{r['case']}: the sum of Mitsuba's outputs is not finite "
+                              f"({', '.join(r['not_finite'])}), timed all the same")
                 by_material.setdefault((r["material"], r["strategy"], o["threads"]), []).append(best)
     mt = mi_runs[0][0] if mi_runs and mi_runs[0] else {}
     lo = lobe_runs[0]
@@ -352,6 +361,8 @@ def run_all(args, threads, env):
         ratio = "—" if best is None or mi_ is None else f"{best / mi_:.2f}×"
         print(f"| {k[0]} | {k[1]} | {k[2]} | " + " | ".join(fmt(x) for x in row + [mi_])
               + f" | {ratio} |")
+    for n in sorted(notes):
+        print(f"\n* {n}")
     print("\n— = not measured: no batch kernel at that level (lobe's f64 path serves it), or no "
           "Mitsuba plugin or sampler for the case (bench/mitsuba_kernels.py, mitsuba_dict).")
 

@@ -1,6 +1,8 @@
 """Throughput of lobe's Python bindings against `lobe bench`, same machine,
 same run: sample + eval_pdf at the sampled directions (what `lobe bench`
-calls msps) for GGX alpha = 0.2 by vndf at N = 2^22, one thread.
+calls msps) for GGX alpha = 0.2 by vndf at N = 2^22, one thread; `sample`
+alone against `lobe bench`'s sample_msps; and two Python threads calling
+sample + eval_pdf at once against the same calls one after the other.
 
     cargo build --release -p lobe-cli
     python python/bench_python.py [--lobe target/release/lobe] [--threads 1] [--reps 7]
@@ -84,10 +86,47 @@ def main() -> None:
         ).stdout
         return json.loads(out)
 
+    def sample_only() -> float:
+        t0 = time.perf_counter()
+        s = m.sample(wo, u, strategy=a.strategy)
+        dt = time.perf_counter() - t0
+        assert s.valid.any()
+        return dt
+
+    # Two Python threads, each on its own copy of the inputs, calling
+    # sample + eval_pdf at once; against the same two calls in a row.
+    wo2, u2 = wo.copy(order="F"), u.copy(order="F")
+
+    def pair(w, uu):
+        s = m.sample(w, uu, strategy=a.strategy)
+        m.eval_pdf(w, s.wi, strategy=a.strategy)
+
+    def serial() -> float:
+        t0 = time.perf_counter()
+        pair(wo, u)
+        pair(wo2, u2)
+        return time.perf_counter() - t0
+
+    def concurrent() -> float:
+        import threading
+        ts = [threading.Thread(target=pair, args=x) for x in ((wo, u), (wo2, u2))]
+        t0 = time.perf_counter()
+        for t in ts:
+            t.start()
+        for t in ts:
+            t.join()
+        return time.perf_counter() - t0
+
+    def median_time(call) -> float:
+        call()
+        times = sorted(call() for _ in range(a.reps))
+        return times[len(times) // 2]
+
     # Interleaved: Python, lobe bench, Python, so that a change of load shows.
-    p1, q1 = python_msps(), python_msps(reused)
+    p1, q1, s1 = python_msps(), python_msps(reused), python_msps(sample_only)
     b = bench_msps()
-    p2, q2 = python_msps(), python_msps(reused)
+    p2, q2, s2 = python_msps(), python_msps(reused), python_msps(sample_only)
+    t_serial, t_conc = median_time(serial), median_time(concurrent)
     r = b["results"][0]
     py, pq = max(p1, p2), max(q1, q2)
     print(json.dumps({
@@ -96,6 +135,10 @@ def main() -> None:
         "python_msps": [p1, p2], "python_out_msps": [q1, q2],
         "lobe_bench_msps": r["msps"], "lobe_bench_scalar_msps": r["scalar_msps"],
         "ratio_python_over_bench": py / r["msps"], "ratio_python_out_over_bench": pq / r["msps"],
+        "python_sample_msps": [s1, s2], "lobe_bench_sample_msps": r["sample_msps"],
+        "ratio_python_sample_over_bench": max(s1, s2) / r["sample_msps"],
+        "two_calls_serial_s": t_serial, "two_calls_concurrent_s": t_conc,
+        "concurrent_speed_over_serial": t_serial / t_conc,
     }, indent=2))
 
 

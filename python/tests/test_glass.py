@@ -89,3 +89,34 @@ def test_rough_glass_runs_on_the_simd_kernels_and_matches_the_f64_path():
     assert (fast.wi[both, 2] * wo[both, 2] < 0).mean() > 0.5  # mostly refracted, from both sides
     close = np.isclose(fast.weight[both], ref.weight[both], rtol=1e-3).all(axis=1)
     assert close.mean() > 0.99
+
+
+@pytest.mark.parametrize(
+    "desc",
+    [
+        {"type": "roughplastic", "distribution": "ggx", "alpha": 0.3, "diffuse_reflectance": [0.8, 0.3, 0.1]},
+        {"type": "roughplastic", "distribution": "beckmann", "alpha": 0.2, "multiscatter": "turquin"},
+        {"type": "cook-torrance", "distribution": "ggx", "alpha": 0.5, "multiscatter": "turquin", "kd": 0.2},
+    ],
+)
+def test_rough_plastic_and_turquin_run_on_the_simd_kernels_and_match_the_f64_path(desc):
+    m = lobe.load_dict(desc)
+    assert all(m.batched(s) for s in m.strategies), m.strategies
+    wo = sphere(4000, seed=5)
+    wo = wo[wo[:, 2] > 0.05]
+    n = len(wo)
+    rng = np.random.default_rng(12)
+    u, uc = rng.random((n, 2)), rng.random(n)
+    for strategy in ("brdf", "vndf"):
+        fast = m.sample(wo, u, uc, strategy=strategy)
+        ref = m.sample(wo, u, uc, strategy=strategy, reference=True)
+        both = fast.valid & ref.valid
+        assert both.mean() > 0.5 and (fast.valid != ref.valid).mean() < 0.01
+        assert np.abs(fast.wi[both] - ref.wi[both]).max() < 1e-4
+        assert np.isclose(fast.pdf[both], ref.pdf[both], rtol=1e-3).mean() > 0.99
+        close = np.isclose(fast.weight[both], ref.weight[both], rtol=1e-3).all(axis=1)
+        assert close.mean() > 0.99
+        f, pdf = m.eval_pdf(wo, ref.wi, strategy=strategy)
+        f_ref, pdf_ref = m.eval_pdf(wo, ref.wi, strategy=strategy, reference=True)
+        assert np.isclose(f, f_ref, rtol=1e-3, atol=1e-6).all(axis=1).mean() > 0.99
+        assert np.isclose(pdf, pdf_ref, rtol=1e-3, atol=1e-6).mean() > 0.99

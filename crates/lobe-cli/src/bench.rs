@@ -42,10 +42,12 @@ const QUOTABLE_SAMPLES: usize = 1 << 22;
                   median of --reps warm repetitions (one more, untimed, runs first).\n\n\
                   The dispatch level is the best the CPU has unless LOBE_SIMD=scalar|avx2|avx512 \
                   forces one. Speed claims come from here or from `cargo bench`, never from timed \
-                  tests; on a shared machine compare the ratios within one run.",
+                  tests; on a shared machine compare the ratios within one run.\n\n\
+                  --all times the whole table of BENCHMARKS.md (about 12 minutes on 2 cores).",
     after_help = "Examples:\n  \
                   lobe bench\n  \
-                  lobe bench --threads 2 --json\n  \
+                  lobe bench --threads 1,2 --json\n  \
+                  lobe bench --all --threads 1\n  \
                   lobe bench --material '{\"type\":\"cook-torrance\",\"distribution\":\"beckmann\",\"alpha\":0.2}' --strategy vndf,brdf\n  \
                   LOBE_SIMD=avx2 lobe bench --material '{\"type\":\"cook-torrance\",\"alpha_u\":0.1,\"alpha_v\":0.4}' --strategy vndf"
 )]

@@ -214,7 +214,8 @@ fn print_markdown(
     head += " best / f64 |";
     rule += "---:|";
     println!("{head}\n{rule}");
-    let mut reasons: Vec<(String, String)> = Vec::new();
+    // (case, reason) -> the strategies it holds for.
+    let mut reasons: Vec<(&str, String, Vec<String>)> = Vec::new();
     for r in rows {
         let mut line = format!(
             "| {} | {} | {} | {} |",
@@ -232,9 +233,14 @@ fn print_markdown(
                 }
                 Cell::NotBatched(reason) => {
                     line += " — |";
-                    let key = format!("{} {}", r.label, r.strategy);
-                    if !reasons.iter().any(|(k, _)| *k == key) {
-                        reasons.push((key, reason.clone()));
+                    let s = r.strategy.to_string();
+                    match reasons
+                        .iter_mut()
+                        .find(|(l, why, _)| *l == r.label && why == reason)
+                    {
+                        Some((_, _, list)) if !list.contains(&s) => list.push(s),
+                        Some(_) => {}
+                        None => reasons.push((r.label, reason.clone(), vec![s])),
                     }
                 }
             }
@@ -255,8 +261,8 @@ fn print_markdown(
     }
     if !reasons.is_empty() {
         println!("\n— = no batch kernel (the scalar path serves it):\n");
-        for (k, reason) in reasons {
-            println!("* {k}: {reason}");
+        for (label, reason, strategies) in reasons {
+            println!("* {label} ({}): {reason}", strategies.join(", "));
         }
     }
 }

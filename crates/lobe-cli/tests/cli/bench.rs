@@ -92,3 +92,86 @@ fn bench_errors_are_one_line() {
         "{e}"
     );
 }
+
+#[test]
+fn bench_all_covers_every_model_and_level() {
+    let o = lobe(
+        &[
+            "bench",
+            "--all",
+            "--samples",
+            "4096",
+            "--reps",
+            "1",
+            "--threads",
+            "1,2",
+            "--json",
+        ],
+        None,
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let levels: Vec<&str> = v["levels"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|l| l.as_str().unwrap())
+        .collect();
+    assert_eq!(levels[0], "scalar", "{levels:?}");
+    assert_eq!(v["threads"], serde_json::json!([1, 2]));
+    let rows = v["results"].as_array().unwrap();
+    // Every model of lobe's list but the measured one (it needs a file).
+    let models: std::collections::BTreeSet<String> = rows
+        .iter()
+        .map(|r| {
+            let m: serde_json::Value =
+                serde_json::from_str(r["material"].as_str().unwrap()).unwrap();
+            m["type"].as_str().unwrap().to_string()
+        })
+        .collect();
+    for name in [
+        "diffuse",
+        "phong",
+        "blinn-phong",
+        "cook-torrance",
+        "roughconductor",
+        "roughdielectric",
+        "roughplastic",
+        "conductor",
+        "dielectric",
+        "thindielectric",
+        "plastic",
+        "twosided",
+    ] {
+        assert!(models.contains(name), "{name} missing from {models:?}");
+    }
+    let find = |case: &str, strategy: &str, threads: u64| {
+        rows.iter()
+            .find(|r| r["case"] == case && r["strategy"] == strategy && r["threads"] == threads)
+            .unwrap_or_else(|| panic!("no row {case} {strategy} {threads}"))
+    };
+    // A batched row has a figure at every level; an unbatched one says why.
+    for t in [1, 2] {
+        let r = find("roughplastic GGX α 0.2", "vndf", t);
+        assert!(r["f64"]["msps"].as_f64().unwrap() > 0.0, "{r}");
+        for l in &levels {
+            let x = r[*l]["msps"].as_f64().unwrap();
+            assert!(x > 0.0 && (r[*l]["ns_per_sample"].as_f64().unwrap() * x - 1e3).abs() < 1e-6);
+        }
+        let r = find("conductor", "brdf", t);
+        assert!(
+            r[levels[0]]["not_batched"]
+                .as_str()
+                .unwrap()
+                .contains("delta"),
+            "{r}"
+        );
+    }
+    // --all is the whole table: not with --material.
+    let o = lobe(
+        &["bench", "--all", "--material", "{\"type\":\"diffuse\"}"],
+        None,
+    );
+    assert!(!o.status.success());
+    assert!(String::from_utf8_lossy(&o.stderr).contains("--all"));
+}

@@ -825,10 +825,7 @@ fn kernel_for(m: &Material, strategy: BsdfStrategy) -> Result<Kernel, BatchError
         });
     }
     if m.two_sided {
-        return unsupported(
-            "not yet batched: glass, mirrors, plastic and two-sided materials (this one is two-sided)"
-                .into(),
-        );
+        return unsupported("not yet batched: two-sided materials".into());
     }
     let c3 = |c: Rgb| [c.x as f32, c.y as f32, c.z as f32];
     let kd = m.diffuse.albedo;
