@@ -120,6 +120,15 @@ impl<'a> Batch<'a> {
                     m.model_name()
                 ));
             }
+            if m.reach().delta {
+                // Mirrors and smooth plastic: light sampling cannot reach a
+                // delta part, so its paths continue by the BSDF sample
+                // alone, which the scalar loop does.
+                return Err(format!(
+                    "object {i} ({}): a delta lobe takes the scalar loop",
+                    m.model_name()
+                ));
+            }
             let est = super::object_shading(strategy, m).estimator;
             // The scalar path's BSDF strategy for the object; light sampling
             // only evaluates `f`, which every strategy's kernel gives.

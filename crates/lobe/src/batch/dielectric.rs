@@ -57,7 +57,7 @@ fn d_ggx<L: Lanes>(l: L, p: &CtParams, m: V3<L>) -> L::F {
 /// Fresnel reflectance at `c ∈ (0, 1]` for the relative index `eta`
 /// (lanes), 1 under total internal reflection, and the refracted cosine.
 #[inline(always)]
-fn fresnel<L: Lanes>(l: L, c: L::F, eta: L::F, inv_eta: L::F) -> (L::F, L::F) {
+pub(super) fn fresnel<L: Lanes>(l: L, c: L::F, eta: L::F, inv_eta: L::F) -> (L::F, L::F) {
     let one = l.splat(1.0);
     let zero = l.splat(0.0);
     let sin2_t = (one - c * c) * (inv_eta * inv_eta);

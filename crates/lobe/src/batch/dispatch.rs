@@ -11,6 +11,7 @@ use super::SimdLevel;
 use super::block::{EvalIn, EvalOut, F_ONLY, PDF_ONLY, SampleIn, SampleOut};
 use super::kernel::dielectric::DielectricParams;
 use super::kernel::phong::{BLINN, LectureParams, PHONG};
+use super::kernel::smooth::{CONDUCTOR, DIELECTRIC, PLASTIC, SmoothParams, THIN};
 use super::kernel::{
     self, BECKMANN, BLINN_PHONG, BOUNDED, BRDF, CAPS, COSINE, CtParams, GGX, Sampled, UNIFORM, VNDF,
 };
@@ -39,6 +40,23 @@ pub(crate) enum Kernel {
     },
     /// A rough dielectric, GGX, visible normals.
     Dielectric(DielectricParams),
+    /// A smooth model (`model`: `smooth::CONDUCTOR`, ...), strategy brdf.
+    Smooth { model: u8, p: SmoothParams },
+}
+
+/// A two-sided material's view of `wo`: `s = −1` where it is below the
+/// surface (`two_sided`; else 1) and `wo` with its `z` times `s`, what the
+/// one-sided kernel sees (`crate::Material` mirrors it the same way); the
+/// kernel's `wi.z` is then multiplied back by `s`. Branch-free: one select
+/// and two products a vector, exact where `s = 1`.
+#[inline(always)]
+fn side_of<L: Lanes>(l: L, two_sided: bool, wo: [L::F; 3]) -> (L::F, [L::F; 3]) {
+    let one = l.splat(1.0);
+    if !two_sided {
+        return (one, wo);
+    }
+    let s = l.select(l.lt(wo[2], l.splat(0.0)), -one, one);
+    (s, [wo[0], wo[1], wo[2] * s])
 }
 
 /// A kernel's parameters, as the block loops run them: one vector of
@@ -77,7 +95,12 @@ impl VecKernel for CtParams {
         u2: L::F,
         uc: L::F,
     ) -> Sampled<L> {
-        kernel::sample::<L, A, B>(l, self, wo, u1, u2, uc)
+        let (s, wo) = side_of(l, self.two_sided, wo);
+        let mut r = kernel::sample::<L, A, B>(l, self, wo, u1, u2, uc);
+        if self.two_sided {
+            r.wi[2] = r.wi[2] * s;
+        }
+        r
     }
     #[inline(always)]
     fn eval_pdf<L: Lanes, const A: u8, const B: u8>(
@@ -86,6 +109,8 @@ impl VecKernel for CtParams {
         wo: [L::F; 3],
         wi: [L::F; 3],
     ) -> ([L::F; 3], L::F) {
+        let (s, wo) = side_of(l, self.two_sided, wo);
+        let wi = [wi[0], wi[1], wi[2] * s];
         kernel::eval_pdf::<L, A, B>(l, self, wo, wi)
     }
 }
@@ -104,7 +129,12 @@ impl VecKernel for LectureParams {
         u2: L::F,
         uc: L::F,
     ) -> Sampled<L> {
-        kernel::phong::sample::<L, A, B>(l, self, wo, u1, u2, uc)
+        let (s, wo) = side_of(l, self.two_sided, wo);
+        let mut r = kernel::phong::sample::<L, A, B>(l, self, wo, u1, u2, uc);
+        if self.two_sided {
+            r.wi[2] = r.wi[2] * s;
+        }
+        r
     }
     #[inline(always)]
     fn eval_pdf<L: Lanes, const A: u8, const B: u8>(
@@ -113,6 +143,8 @@ impl VecKernel for LectureParams {
         wo: [L::F; 3],
         wi: [L::F; 3],
     ) -> ([L::F; 3], L::F) {
+        let (s, wo) = side_of(l, self.two_sided, wo);
+        let wi = [wi[0], wi[1], wi[2] * s];
         kernel::phong::eval_pdf::<L, A, B>(l, self, wo, wi)
     }
 }
@@ -141,6 +173,40 @@ impl VecKernel for DielectricParams {
         wi: [L::F; 3],
     ) -> ([L::F; 3], L::F) {
         kernel::dielectric::eval_pdf(l, self, wo, wi)
+    }
+}
+
+impl VecKernel for SmoothParams {
+    #[inline(always)]
+    fn two_lobes(&self) -> bool {
+        true
+    }
+    #[inline(always)]
+    fn sample<L: Lanes, const A: u8, const B: u8>(
+        &self,
+        l: L,
+        wo: [L::F; 3],
+        u1: L::F,
+        u2: L::F,
+        uc: L::F,
+    ) -> Sampled<L> {
+        let (s, wo) = side_of(l, self.two_sided, wo);
+        let mut r = kernel::smooth::sample::<L, A>(l, self, wo, u1, u2, uc);
+        if self.two_sided {
+            r.wi[2] = r.wi[2] * s;
+        }
+        r
+    }
+    #[inline(always)]
+    fn eval_pdf<L: Lanes, const A: u8, const B: u8>(
+        &self,
+        l: L,
+        wo: [L::F; 3],
+        wi: [L::F; 3],
+    ) -> ([L::F; 3], L::F) {
+        let (s, wo) = side_of(l, self.two_sided, wo);
+        let wi = [wi[0], wi[1], wi[2] * s];
+        kernel::smooth::eval_pdf::<L, A>(l, self, wo, wi)
     }
 }
 
@@ -599,6 +665,13 @@ macro_rules! instances {
             },
             Kernel::Measured(_) => unreachable!("run before the level's dispatch"),
             Kernel::Dielectric(p) => $f::<_, _, GGX, VNDF>($l, p, $($args),*),
+            Kernel::Smooth { model, p } => match *model {
+                CONDUCTOR => $f::<_, _, CONDUCTOR, BRDF>($l, p, $($args),*),
+                DIELECTRIC => $f::<_, _, DIELECTRIC, BRDF>($l, p, $($args),*),
+                THIN => $f::<_, _, THIN, BRDF>($l, p, $($args),*),
+                PLASTIC => $f::<_, _, PLASTIC, BRDF>($l, p, $($args),*),
+                _ => unreachable!("BatchSampler::new builds only these"),
+            },
         }
     };
 }

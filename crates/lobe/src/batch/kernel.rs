@@ -66,6 +66,8 @@ mod caps;
 pub(crate) mod dielectric;
 #[path = "phong.rs"]
 pub(crate) mod phong;
+#[path = "smooth.rs"]
+pub(crate) mod smooth;
 
 const INV_SQRT_PI: f32 = 0.5 * std::f32::consts::FRAC_2_SQRT_PI;
 const TWO_INV_SQRT_PI: f32 = std::f32::consts::FRAC_2_SQRT_PI;
@@ -123,6 +125,9 @@ pub(crate) struct CtParams {
     pub base: Option<PlasticBaseP>,
     /// Turquin's energy compensation of the glossy lobe.
     pub turquin: Option<TurquinP>,
+    /// A two-sided material (`wo` below the surface is mirrored up:
+    /// `dispatch::side_of`).
+    pub two_sided: bool,
 }
 
 /// Nodes of the tables below (rough plastic's transmittance, Mitsuba's
@@ -454,11 +459,21 @@ pub(super) fn plus_diffuse<L: Lanes>(
     above: L::M,
 ) -> V3<L> {
     let zero = l.splat(0.0);
+    // No closures here (`array::map`): one that is not inlined loses the
+    // caller's target features.
     let d = match &p.base {
-        None => p.kd_pi.map(|c| l.splat(c)),
+        None => [
+            l.splat(p.kd_pi[0]),
+            l.splat(p.kd_pi[1]),
+            l.splat(p.kd_pi[2]),
+        ],
         Some(b) => {
             let tt = plastic_t(l, b, wo[2]) * plastic_t(l, b, wi[2]);
-            b.scale.map(|c| l.splat(c) * tt)
+            [
+                l.splat(b.scale[0]) * tt,
+                l.splat(b.scale[1]) * tt,
+                l.splat(b.scale[2]) * tt,
+            ]
         }
     };
     [

@@ -79,11 +79,20 @@
 //! lobe's. Both are tested against the scalar path like the rest (the
 //! grid's `roughplastic` and `turquin` groups, chi-square included).
 //!
+//! The **smooth models** (`conductor`, `dielectric`, `thindielectric`,
+//! `plastic`; `kernel::smooth`): a delta sample's `f` is its value times
+//! the probability of the part drawn over `|cos θi|` and its pdf that
+//! probability, as the scalar path's; glass and the thin sheet from either
+//! side. **Two-sided** materials (`twosided` of any batched opaque model)
+//! mirror a `wo` below the surface up and the sampled `wi` back
+//! (`dispatch::side_of`). Both are tested against the scalar path over the
+//! whole sphere (`tests_smooth.rs`).
+//!
 //! Refused with [`BatchError::Unsupported`], the scalar path serving them:
-//! the smooth models (`conductor`, `dielectric`, `thindielectric`,
-//! `plastic`: delta lobes), two-sided materials, Kulla-Conty compensation
-//! (its added lobe and mixture sampling), and rough glass other than GGX
-//! by visible normals. `lobe bench --all` lists them with the reason.
+//! Kulla-Conty compensation (its added lobe and mixture sampling), rough
+//! glass other than GGX by visible normals, a diffuse term beside a smooth
+//! lobe, two-sided measured tables. `lobe bench --all` lists them with the
+//! reason.
 //!
 //! Beckmann's visible slopes are drawn as the scalar path draws them (Heitz
 //! and d'Eon 2014: the slope CDF inverted by Newton's method inside a
@@ -587,6 +596,7 @@ impl BatchSampler {
             Kernel::Measured(k) => k.chooses_lobe(),
             Kernel::Lecture { p, .. } => p.two_lobes,
             Kernel::Dielectric(_) => true,
+            Kernel::Smooth { model, .. } => *model != kernel::smooth::CONDUCTOR,
         }
     }
 
@@ -816,16 +826,32 @@ fn check_pairs(
 }
 
 /// The kernel and its f32 parameters for a material and strategy, or why
-/// the batch path does not have them.
+/// the batch path does not have them; a two-sided material's kernel mirrors
+/// `wo` up where it is below (`dispatch::side_of`).
 fn kernel_for(m: &Material, strategy: BsdfStrategy) -> Result<Kernel, BatchError> {
+    let mut k = one_sided_kernel_for(m, strategy)?;
+    if m.two_sided {
+        match &mut k {
+            Kernel::CookTorrance { p, .. } => p.two_sided = true,
+            Kernel::Lecture { p, .. } => p.two_sided = true,
+            Kernel::Smooth { p, .. } => p.two_sided = true,
+            Kernel::Measured(_) | Kernel::Dielectric(_) => {
+                return Err(BatchError::Unsupported {
+                    reason: "not yet batched: two-sided measured tables".into(),
+                });
+            }
+        }
+    }
+    Ok(k)
+}
+
+/// [`kernel_for`] of the material seen from above.
+fn one_sided_kernel_for(m: &Material, strategy: BsdfStrategy) -> Result<Kernel, BatchError> {
     let unsupported = |reason: String| Err(BatchError::Unsupported { reason });
     if let Err(e) = m.check(strategy) {
         return Err(BatchError::Inapplicable {
             reason: e.to_string(),
         });
-    }
-    if m.two_sided {
-        return unsupported("not yet batched: two-sided materials".into());
     }
     let c3 = |c: Rgb| [c.x as f32, c.y as f32, c.z as f32];
     let kd = m.diffuse.albedo;
@@ -887,14 +913,10 @@ fn kernel_for(m: &Material, strategy: BsdfStrategy) -> Result<Kernel, BatchError
         }
         Glossy::RoughDielectric(rd) => return dielectric_kernel(rd, strategy),
         Glossy::RoughPlastic(rp) => return rough_plastic_kernel(m, rp, strategy),
-        #[allow(unreachable_patterns)]
-        _ => {
-            return unsupported(format!(
-                "model `{}`: not yet batched: smooth glass, mirrors and plastic (delta lobes), \
-                 two-sided materials",
-                m.model_name()
-            ));
-        }
+        Glossy::Conductor(_)
+        | Glossy::Dielectric(_)
+        | Glossy::ThinDielectric(_)
+        | Glossy::Plastic(_) => return smooth_kernel(m),
     };
     let turquin = match &lobe.multiscatter {
         Multiscatter::None => None,
@@ -963,7 +985,6 @@ fn strat_code(strategy: BsdfStrategy) -> u8 {
 /// A single-scattering Cook-Torrance lobe's kernel parameters: no diffuse
 /// term, no lobe choice, no compensation (callers set what differs).
 fn cook_torrance_params(lobe: &CookTorrance, strategy: BsdfStrategy) -> CtParams {
-    let c3 = |c: Rgb| [c.x as f32, c.y as f32, c.z as f32];
     let CookTorrance {
         ks,
         microfacet,
@@ -972,7 +993,93 @@ fn cook_torrance_params(lobe: &CookTorrance, strategy: BsdfStrategy) -> CtParams
         multiscatter: _,
     } = *lobe;
     let (ax, ay) = microfacet.alpha();
-    let fresnel = match fresnel {
+    let fresnel = fresnel_params(ks, fresnel);
+    let shadow = match shadowing {
+        Shadowing::SmithCorrelated => Shadow::Correlated,
+        Shadowing::SmithSeparable => Shadow::Separable,
+        Shadowing::VCavity => Shadow::VCavity,
+    };
+    CtParams {
+        fresnel,
+        shadow,
+        guess: if microfacet.ndf() == Ndf::Beckmann && strategy == BsdfStrategy::Vndf {
+            kernel::beckmann_guess_table()
+        } else {
+            &[]
+        },
+        ..microfacets_only(ax, ay)
+    }
+}
+
+/// The smooth models (`kernel::smooth`): strategy brdf, their only one
+/// (`m.check` accepted it); a diffuse term beside a delta lobe is refused.
+fn smooth_kernel(m: &Material) -> Result<Kernel, BatchError> {
+    use kernel::smooth;
+    if m.diffuse.albedo != Rgb::ZERO {
+        return Err(BatchError::Unsupported {
+            reason: "not yet batched: a diffuse term beside a smooth (delta) lobe".into(),
+        });
+    }
+    let c3 = |c: Rgb| [c.x as f32, c.y as f32, c.z as f32];
+    let mut p = smooth::SmoothParams {
+        fresnel: FresnelP::Schlick {
+            ks_f0: [0.0; 3],
+            ks_1mf0: [0.0; 3],
+        },
+        eta: 1.0,
+        inv_eta: 1.0,
+        kr: [0.0; 3],
+        kt: [0.0; 3],
+        radiance: false,
+        scale: [0.0; 3],
+        w: 0.0,
+        two_sided: false,
+    };
+    let with_eta = |p: &mut smooth::SmoothParams, eta: f64| {
+        p.eta = eta as f32;
+        p.inv_eta = (1.0 / eta) as f32;
+    };
+    let model = match &m.glossy {
+        Glossy::Conductor(c) => {
+            p.fresnel = fresnel_params(c.specular_reflectance, c.fresnel);
+            smooth::CONDUCTOR
+        }
+        Glossy::Dielectric(d) => {
+            if d.eta == 1.0 {
+                return Err(BatchError::Unsupported {
+                    reason: "smooth dielectric: index-matched (η = 1), it passes light straight on"
+                        .into(),
+                });
+            }
+            with_eta(&mut p, d.eta);
+            p.kr = c3(d.specular_reflectance);
+            p.kt = c3(d.specular_transmittance);
+            p.radiance = d.mode == crate::TransportMode::Radiance;
+            smooth::DIELECTRIC
+        }
+        Glossy::ThinDielectric(d) => {
+            with_eta(&mut p, d.eta);
+            p.kr = c3(d.specular_reflectance);
+            p.kt = c3(d.specular_transmittance);
+            smooth::THIN
+        }
+        Glossy::Plastic(pl) => {
+            with_eta(&mut p, pl.eta);
+            p.kr = c3(pl.specular_reflectance);
+            let base = pl.base();
+            p.scale = c3(base.scale);
+            p.w = base.specular_weight as f32;
+            smooth::PLASTIC
+        }
+        _ => unreachable!("called for the smooth models only"),
+    };
+    Ok(Kernel::Smooth { model, p })
+}
+
+/// `ks` times the Fresnel term, as the kernels read it.
+fn fresnel_params(ks: Rgb, fresnel: Fresnel) -> FresnelP {
+    let c3 = |c: Rgb| [c.x as f32, c.y as f32, c.z as f32];
+    match fresnel {
         Fresnel::None => FresnelP::Schlick {
             ks_f0: c3(ks),
             ks_1mf0: [0.0; 3],
@@ -990,21 +1097,6 @@ fn cook_torrance_params(lobe: &CookTorrance, strategy: BsdfStrategy) -> CtParams
             eta: c3(eta),
             k: c3(k),
         },
-    };
-    let shadow = match shadowing {
-        Shadowing::SmithCorrelated => Shadow::Correlated,
-        Shadowing::SmithSeparable => Shadow::Separable,
-        Shadowing::VCavity => Shadow::VCavity,
-    };
-    CtParams {
-        fresnel,
-        shadow,
-        guess: if microfacet.ndf() == Ndf::Beckmann && strategy == BsdfStrategy::Vndf {
-            kernel::beckmann_guess_table()
-        } else {
-            &[]
-        },
-        ..microfacets_only(ax, ay)
     }
 }
 
@@ -1084,6 +1176,7 @@ fn microfacets_only(ax: f64, ay: f64) -> CtParams {
         two_lobes: false,
         base: None,
         turquin: None,
+        two_sided: false,
     }
 }
 
@@ -1163,6 +1256,7 @@ fn lecture_kernel(
         // Constant for these models (their albedo hint ignores wo).
         p_glossy: m.glossy_probability(glam::DVec3::Z) as f32,
         two_lobes: m.chooses_lobe(strategy),
+        two_sided: false,
     };
     Ok(Kernel::Lecture { model, strat, p })
 }

@@ -1190,6 +1190,10 @@ mod grid;
 #[path = "tests_dielectric.rs"]
 mod dielectric;
 
+/// The smooth models' kernels and two-sided materials over the sphere.
+#[path = "tests_smooth.rs"]
+mod smooth;
+
 /// A zeroed `n`-value slice of `v` starting at a 128-byte boundary plus
 /// `shift` values.
 fn aligned_part(v: &mut Vec<f32>, n: usize, shift: usize) -> &mut [f32] {

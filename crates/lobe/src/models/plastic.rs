@@ -157,6 +157,13 @@ impl Plastic {
 
     /// Probability of sampling the coating for `wo` and its Fresnel term.
     #[inline]
+    /// The base under the coating: the scale of its `f` and the coating's
+    /// weight in the lobe choice.
+    #[must_use]
+    pub fn base(&self) -> &Base {
+        &self.base
+    }
+
     fn coating(&self, wo: DVec3) -> (f64, f64) {
         let f = fresnel_dielectric(wo.z, self.eta).r;
         (self.base.coating_probability(1.0 - f), f)

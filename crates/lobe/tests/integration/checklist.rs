@@ -98,7 +98,7 @@ const ROWS: &[Row] = &[
         chi2_test: "fn smooth_conductor",
         readme_row: "| Smooth conductor ",
         alias_of: None,
-        scalar_only: Some(GLASS_SCALAR_ONLY),
+        scalar_only: None,
         batched: &[],
     },
     Row {
@@ -107,7 +107,7 @@ const ROWS: &[Row] = &[
         chi2_test: "fn delta_parts_directions_probabilities_and_weights",
         readme_row: "| Smooth dielectric ",
         alias_of: None,
-        scalar_only: Some(GLASS_SCALAR_ONLY),
+        scalar_only: None,
         batched: &[],
     },
     Row {
@@ -116,7 +116,7 @@ const ROWS: &[Row] = &[
         chi2_test: "fn delta_parts_directions_probabilities_and_weights",
         readme_row: "| Thin dielectric ",
         alias_of: None,
-        scalar_only: Some(GLASS_SCALAR_ONLY),
+        scalar_only: None,
         batched: &[],
     },
     Row {
@@ -138,7 +138,7 @@ const ROWS: &[Row] = &[
         chi2_test: "fn chi2_plastic_and_two_sided",
         readme_row: "| Smooth plastic ",
         alias_of: None,
-        scalar_only: Some(GLASS_SCALAR_ONLY),
+        scalar_only: None,
         batched: &[],
     },
     Row {
@@ -178,15 +178,10 @@ const ROWS: &[Row] = &[
         chi2_test: "fn chi2_plastic_and_two_sided",
         readme_row: "| Two-sided ",
         alias_of: Some("cook-torrance"),
-        scalar_only: Some(TWO_SIDED_SCALAR_ONLY),
+        scalar_only: None,
         batched: &[],
     },
 ];
-
-/// Why the smooth models of issue 42 and two-sided materials have no batch
-/// kernels yet: the words the batch module's doc says it with.
-const GLASS_SCALAR_ONLY: &str = "the smooth models (`conductor`, `dielectric`, `thindielectric`,";
-const TWO_SIDED_SCALAR_ONLY: &str = "two-sided materials, Kulla-Conty compensation";
 
 /// What of rough glass is not batched, in the batch module doc's words.
 const ROUGH_GLASS_SCALAR_ONLY: &str = "rough dielectric: GGX vndf only";
