@@ -302,11 +302,24 @@ fn ks_fresnel<L: Lanes>(l: L, f: &FresnelP, c: L::F) -> V3<L> {
                 l.mul_add(l.splat(ks_1mf0[2]), m5, l.splat(ks_f0[2])),
             ]
         }
+        // A grey index (every channel's the same, as a plastic's coating
+        // or a `none` conductor has it): one Fresnel term for the three,
+        // the same bits.
+        FresnelP::Dielectric { ks, eta } if eta[0] == eta[1] && eta[1] == eta[2] => {
+            let r = fr_dielectric(l, c, eta[0]);
+            [l.splat(ks[0]) * r, l.splat(ks[1]) * r, l.splat(ks[2]) * r]
+        }
         FresnelP::Dielectric { ks, eta } => [
             l.splat(ks[0]) * fr_dielectric(l, c, eta[0]),
             l.splat(ks[1]) * fr_dielectric(l, c, eta[1]),
             l.splat(ks[2]) * fr_dielectric(l, c, eta[2]),
         ],
+        FresnelP::Conductor { ks, eta, k }
+            if eta[0] == eta[1] && eta[1] == eta[2] && k[0] == k[1] && k[1] == k[2] =>
+        {
+            let r = fr_conductor(l, c, eta[0], k[0]);
+            [l.splat(ks[0]) * r, l.splat(ks[1]) * r, l.splat(ks[2]) * r]
+        }
         FresnelP::Conductor { ks, eta, k } => [
             l.splat(ks[0]) * fr_conductor(l, c, eta[0], k[0]),
             l.splat(ks[1]) * fr_conductor(l, c, eta[1], k[1]),
