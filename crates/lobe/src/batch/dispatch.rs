@@ -44,21 +44,6 @@ pub(crate) enum Kernel {
     Smooth { model: u8, p: SmoothParams },
 }
 
-/// A two-sided material's view of `wo`: `s = −1` where it is below the
-/// surface (`two_sided`; else 1) and `wo` with its `z` times `s`, what the
-/// one-sided kernel sees (`crate::Material` mirrors it the same way); the
-/// kernel's `wi.z` is then multiplied back by `s`. Branch-free: one select
-/// and two products a vector, exact where `s = 1`.
-#[inline(always)]
-fn side_of<L: Lanes>(l: L, two_sided: bool, wo: [L::F; 3]) -> (L::F, [L::F; 3]) {
-    let one = l.splat(1.0);
-    if !two_sided {
-        return (one, wo);
-    }
-    let s = l.select(l.lt(wo[2], l.splat(0.0)), -one, one);
-    (s, [wo[0], wo[1], wo[2] * s])
-}
-
 /// A kernel's parameters, as the block loops run them: one vector of
 /// `sample` and of `eval_pdf` for the instance `<A, B>` (the kernel's const
 /// parameters: distribution or model, and strategy).
@@ -95,12 +80,7 @@ impl VecKernel for CtParams {
         u2: L::F,
         uc: L::F,
     ) -> Sampled<L> {
-        let (s, wo) = side_of(l, self.two_sided, wo);
-        let mut r = kernel::sample::<L, A, B>(l, self, wo, u1, u2, uc);
-        if self.two_sided {
-            r.wi[2] = r.wi[2] * s;
-        }
-        r
+        kernel::sample::<L, A, B>(l, self, wo, u1, u2, uc)
     }
     #[inline(always)]
     fn eval_pdf<L: Lanes, const A: u8, const B: u8>(
@@ -109,8 +89,6 @@ impl VecKernel for CtParams {
         wo: [L::F; 3],
         wi: [L::F; 3],
     ) -> ([L::F; 3], L::F) {
-        let (s, wo) = side_of(l, self.two_sided, wo);
-        let wi = [wi[0], wi[1], wi[2] * s];
         kernel::eval_pdf::<L, A, B>(l, self, wo, wi)
     }
 }
@@ -129,12 +107,7 @@ impl VecKernel for LectureParams {
         u2: L::F,
         uc: L::F,
     ) -> Sampled<L> {
-        let (s, wo) = side_of(l, self.two_sided, wo);
-        let mut r = kernel::phong::sample::<L, A, B>(l, self, wo, u1, u2, uc);
-        if self.two_sided {
-            r.wi[2] = r.wi[2] * s;
-        }
-        r
+        kernel::phong::sample::<L, A, B>(l, self, wo, u1, u2, uc)
     }
     #[inline(always)]
     fn eval_pdf<L: Lanes, const A: u8, const B: u8>(
@@ -143,8 +116,6 @@ impl VecKernel for LectureParams {
         wo: [L::F; 3],
         wi: [L::F; 3],
     ) -> ([L::F; 3], L::F) {
-        let (s, wo) = side_of(l, self.two_sided, wo);
-        let wi = [wi[0], wi[1], wi[2] * s];
         kernel::phong::eval_pdf::<L, A, B>(l, self, wo, wi)
     }
 }
@@ -190,12 +161,7 @@ impl VecKernel for SmoothParams {
         u2: L::F,
         uc: L::F,
     ) -> Sampled<L> {
-        let (s, wo) = side_of(l, self.two_sided, wo);
-        let mut r = kernel::smooth::sample::<L, A>(l, self, wo, u1, u2, uc);
-        if self.two_sided {
-            r.wi[2] = r.wi[2] * s;
-        }
-        r
+        kernel::smooth::sample::<L, A>(l, self, wo, u1, u2, uc)
     }
     #[inline(always)]
     fn eval_pdf<L: Lanes, const A: u8, const B: u8>(
@@ -204,8 +170,6 @@ impl VecKernel for SmoothParams {
         wo: [L::F; 3],
         wi: [L::F; 3],
     ) -> ([L::F; 3], L::F) {
-        let (s, wo) = side_of(l, self.two_sided, wo);
-        let wi = [wi[0], wi[1], wi[2] * s];
         kernel::smooth::eval_pdf::<L, A>(l, self, wo, wi)
     }
 }

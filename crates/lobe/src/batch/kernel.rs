@@ -125,9 +125,6 @@ pub(crate) struct CtParams {
     pub base: Option<PlasticBaseP>,
     /// Turquin's energy compensation of the glossy lobe.
     pub turquin: Option<TurquinP>,
-    /// A two-sided material (`wo` below the surface is mirrored up:
-    /// `dispatch::side_of`).
-    pub two_sided: bool,
 }
 
 /// Nodes of the tables below (rough plastic's transmittance, Mitsuba's
@@ -302,24 +299,11 @@ fn ks_fresnel<L: Lanes>(l: L, f: &FresnelP, c: L::F) -> V3<L> {
                 l.mul_add(l.splat(ks_1mf0[2]), m5, l.splat(ks_f0[2])),
             ]
         }
-        // A grey index (every channel's the same, as a plastic's coating
-        // or a `none` conductor has it): one Fresnel term for the three,
-        // the same bits.
-        FresnelP::Dielectric { ks, eta } if eta[0] == eta[1] && eta[1] == eta[2] => {
-            let r = fr_dielectric(l, c, eta[0]);
-            [l.splat(ks[0]) * r, l.splat(ks[1]) * r, l.splat(ks[2]) * r]
-        }
         FresnelP::Dielectric { ks, eta } => [
             l.splat(ks[0]) * fr_dielectric(l, c, eta[0]),
             l.splat(ks[1]) * fr_dielectric(l, c, eta[1]),
             l.splat(ks[2]) * fr_dielectric(l, c, eta[2]),
         ],
-        FresnelP::Conductor { ks, eta, k }
-            if eta[0] == eta[1] && eta[1] == eta[2] && k[0] == k[1] && k[1] == k[2] =>
-        {
-            let r = fr_conductor(l, c, eta[0], k[0]);
-            [l.splat(ks[0]) * r, l.splat(ks[1]) * r, l.splat(ks[2]) * r]
-        }
         FresnelP::Conductor { ks, eta, k } => [
             l.splat(ks[0]) * fr_conductor(l, c, eta[0], k[0]),
             l.splat(ks[1]) * fr_conductor(l, c, eta[1], k[1]),
@@ -472,21 +456,16 @@ pub(super) fn plus_diffuse<L: Lanes>(
     above: L::M,
 ) -> V3<L> {
     let zero = l.splat(0.0);
-    // No closures here (`array::map`): one that is not inlined loses the
-    // caller's target features.
+    // `array::map` with closures, on purpose: this is the two-lobe path,
+    // inlined (cold) into every single-lobe instance too, and written out
+    // in full it cost GGX brdf's sampler 35% at AVX-512 (Zen 4, `lobe
+    // bench`: 370 -> 237 M/s for its `sample`): the whole instance's code
+    // layout and registers, not the single-lobe work, changed.
     let d = match &p.base {
-        None => [
-            l.splat(p.kd_pi[0]),
-            l.splat(p.kd_pi[1]),
-            l.splat(p.kd_pi[2]),
-        ],
+        None => p.kd_pi.map(|c| l.splat(c)),
         Some(b) => {
             let tt = plastic_t(l, b, wo[2]) * plastic_t(l, b, wi[2]);
-            [
-                l.splat(b.scale[0]) * tt,
-                l.splat(b.scale[1]) * tt,
-                l.splat(b.scale[2]) * tt,
-            ]
+            b.scale.map(|c| l.splat(c) * tt)
         }
     };
     [

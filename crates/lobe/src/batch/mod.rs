@@ -85,13 +85,14 @@
 //! probability, as the scalar path's; glass and the thin sheet from either
 //! side. **Two-sided** materials (`twosided` of any batched opaque model)
 //! mirror a `wo` below the surface up and the sampled `wi` back
-//! (`dispatch::side_of`). Both are tested against the scalar path over the
+//! (`BatchSampler`, around the one-sided kernel). Both are tested against the scalar path over the
 //! whole sphere (`tests_smooth.rs`).
 //!
 //! Refused with [`BatchError::Unsupported`], the scalar path serving them:
 //! Kulla-Conty compensation (its added lobe and mixture sampling), rough
-//! glass other than GGX by visible normals, a diffuse term beside a smooth
-//! lobe, two-sided measured tables. `lobe bench --all` lists them with the
+//! glass other than GGX by visible normals, rough glass with Turquin's
+//! compensation, a diffuse term beside a smooth lobe, two-sided measured
+//! tables. `lobe bench --all` lists them with the
 //! reason.
 //!
 //! Beckmann's visible slopes are drawn as the scalar path draws them (Heitz
@@ -560,7 +561,17 @@ pub struct BatchSampler {
     kernel: Kernel,
     strategy: BsdfStrategy,
     backend: Backend,
+    /// A two-sided material: `wo` below the surface is mirrored up (`z`
+    /// by its absolute value, as `Material` does) for the one-sided kernel
+    /// and the sampled `wi` mirrored back, chunk by chunk around the
+    /// kernel calls (the kernels themselves carry no two-sided code: in
+    /// them it cost GGX brdf 25% at AVX-512 even where it was off).
+    two_sided: bool,
 }
+
+/// Values per chunk of a two-sided material's mirrored inputs (a stack
+/// array).
+const TWO_SIDED_CHUNK: usize = 1024;
 
 impl BatchSampler {
     /// For `material` and `strategy` at [`SimdLevel::from_env`] (the best
@@ -584,6 +595,7 @@ impl BatchSampler {
             kernel,
             strategy,
             backend,
+            two_sided: material.two_sided,
         })
     }
 
@@ -688,9 +700,46 @@ impl BatchSampler {
         ];
         let w = dispatch::SampleWrites {
             f: want_f,
-            stream: store == Store::Streamed,
+            stream: store == Store::Streamed && !self.two_sided,
         };
-        dispatch::sample(self.backend, &self.kernel, inp, (&mut o, out.valid), w);
+        if !self.two_sided {
+            dispatch::sample(self.backend, &self.kernel, inp, (&mut o, out.valid), w);
+            return Ok(());
+        }
+        // Two-sided: chunks with |wo.z|, then wi.z mirrored back where wo
+        // was below.
+        let mut z = [0.0f32; TWO_SIDED_CHUNK];
+        let mut start = 0;
+        while start < n {
+            let r = start..(start + TWO_SIDED_CHUNK).min(n);
+            let len = r.len();
+            for (d, s) in z.iter_mut().zip(&inp[2][r.clone()]) {
+                *d = s.abs();
+            }
+            let part = [
+                &inp[0][r.clone()],
+                &inp[1][r.clone()],
+                &z[..len],
+                &inp[3][r.clone()],
+                &inp[4][r.clone()],
+                &inp[5][r.clone()],
+            ];
+            let mut o_part = o.each_mut().map(|s| {
+                if s.is_empty() {
+                    &mut s[..]
+                } else {
+                    &mut s[r.clone()]
+                }
+            });
+            let valid = &mut out.valid[r.clone()];
+            dispatch::sample(self.backend, &self.kernel, part, (&mut o_part, valid), w);
+            for (wz, oz) in o_part[2].iter_mut().zip(&inp[2][r.clone()]) {
+                if *oz < 0.0 {
+                    *wz = -*wz;
+                }
+            }
+            start = r.end;
+        }
         Ok(())
     }
 
@@ -742,14 +791,56 @@ impl BatchSampler {
             _ => &lens[..],
         };
         check_pairs(wo, wi, written)?;
-        dispatch::eval_pdf(
-            self.backend,
-            &self.kernel,
-            mode,
-            [wo.x, wo.y, wo.z, wi.x, wi.y, wi.z],
-            &mut o,
-            store == Store::Streamed,
-        );
+        if !self.two_sided {
+            dispatch::eval_pdf(
+                self.backend,
+                &self.kernel,
+                mode,
+                [wo.x, wo.y, wo.z, wi.x, wi.y, wi.z],
+                &mut o,
+                store == Store::Streamed,
+            );
+            return Ok(());
+        }
+        // Two-sided: both directions mirrored where wo is below.
+        let n = wo.x.len();
+        let (mut zo, mut zi) = ([0.0f32; TWO_SIDED_CHUNK], [0.0f32; TWO_SIDED_CHUNK]);
+        let mut start = 0;
+        while start < n {
+            let r = start..(start + TWO_SIDED_CHUNK).min(n);
+            let len = r.len();
+            for ((a, b), (&oz, &iz)) in zo
+                .iter_mut()
+                .zip(zi.iter_mut())
+                .zip(wo.z[r.clone()].iter().zip(&wi.z[r.clone()]))
+            {
+                *a = oz.abs();
+                *b = if oz < 0.0 { -iz } else { iz };
+            }
+            let mut o_part = o.each_mut().map(|s| {
+                if s.is_empty() {
+                    &mut s[..]
+                } else {
+                    &mut s[r.clone()]
+                }
+            });
+            dispatch::eval_pdf(
+                self.backend,
+                &self.kernel,
+                mode,
+                [
+                    &wo.x[r.clone()],
+                    &wo.y[r.clone()],
+                    &zo[..len],
+                    &wi.x[r.clone()],
+                    &wi.y[r.clone()],
+                    &zi[..len],
+                ],
+                &mut o_part,
+                false,
+            );
+            start = r.end;
+        }
         Ok(())
     }
 
@@ -826,21 +917,15 @@ fn check_pairs(
 }
 
 /// The kernel and its f32 parameters for a material and strategy, or why
-/// the batch path does not have them; a two-sided material's kernel mirrors
-/// `wo` up where it is below (`dispatch::side_of`).
+/// the batch path does not have them. A two-sided material gets its
+/// one-sided kernel: [`BatchSampler`] mirrors a `wo` below the surface up
+/// around it (`BatchSampler::two_sided`).
 fn kernel_for(m: &Material, strategy: BsdfStrategy) -> Result<Kernel, BatchError> {
-    let mut k = one_sided_kernel_for(m, strategy)?;
-    if m.two_sided {
-        match &mut k {
-            Kernel::CookTorrance { p, .. } => p.two_sided = true,
-            Kernel::Lecture { p, .. } => p.two_sided = true,
-            Kernel::Smooth { p, .. } => p.two_sided = true,
-            Kernel::Measured(_) | Kernel::Dielectric(_) => {
-                return Err(BatchError::Unsupported {
-                    reason: "not yet batched: two-sided measured tables".into(),
-                });
-            }
-        }
+    let k = one_sided_kernel_for(m, strategy)?;
+    if m.two_sided && matches!(k, Kernel::Measured(_) | Kernel::Dielectric(_)) {
+        return Err(BatchError::Unsupported {
+            reason: "not yet batched: two-sided measured tables".into(),
+        });
     }
     Ok(k)
 }
@@ -1033,7 +1118,6 @@ fn smooth_kernel(m: &Material) -> Result<Kernel, BatchError> {
         radiance: false,
         scale: [0.0; 3],
         w: 0.0,
-        two_sided: false,
     };
     let with_eta = |p: &mut smooth::SmoothParams, eta: f64| {
         p.eta = eta as f32;
@@ -1176,7 +1260,6 @@ fn microfacets_only(ax: f64, ay: f64) -> CtParams {
         two_lobes: false,
         base: None,
         turquin: None,
-        two_sided: false,
     }
 }
 
@@ -1256,7 +1339,6 @@ fn lecture_kernel(
         // Constant for these models (their albedo hint ignores wo).
         p_glossy: m.glossy_probability(glam::DVec3::Z) as f32,
         two_lobes: m.chooses_lobe(strategy),
-        two_sided: false,
     };
     Ok(Kernel::Lecture { model, strat, p })
 }

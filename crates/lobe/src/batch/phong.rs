@@ -60,8 +60,6 @@ pub(crate) struct LectureParams {
     pub p_glossy: f32,
     /// Whether `uc` chooses the lobe (`kd > 0`, strategy brdf).
     pub two_lobes: bool,
-    /// A two-sided material (`dispatch::side_of`).
-    pub two_sided: bool,
 }
 
 /// Knuth's TwoSum: `a + b = s + e` exactly.

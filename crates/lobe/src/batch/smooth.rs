@@ -44,8 +44,6 @@ pub(crate) struct SmoothParams {
     /// `w` in the lobe choice (`models::plastic::Base`).
     pub scale: [f32; 3],
     pub w: f32,
-    /// A two-sided conductor or plastic (`dispatch::side_of`).
-    pub two_sided: bool,
 }
 
 /// `a · x` per channel. (Functions, not closures, in the kernels: a closure
