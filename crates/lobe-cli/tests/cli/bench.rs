@@ -159,11 +159,13 @@ fn bench_all_covers_every_model_and_level() {
             assert!(x > 0.0 && (r[*l]["ns_per_sample"].as_f64().unwrap() * x - 1e3).abs() < 1e-6);
         }
         let r = find("conductor", "brdf", t);
+        assert!(r[levels[0]]["msps"].as_f64().unwrap() > 0.0, "{r}");
+        let r = find("cook-torrance GGX α 0.2, Kulla-Conty", "vndf", t);
         assert!(
             r[levels[0]]["not_batched"]
                 .as_str()
                 .unwrap()
-                .contains("delta"),
+                .contains("Kulla-Conty"),
             "{r}"
         );
     }
