@@ -67,6 +67,17 @@ def default_mitsuba_python():
 SHARE = {"lobe": [], "mitsuba": []}
 
 
+def run_context():
+    """(lobe's short commit, the load average now), for a table's header."""
+    commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT,
+                            capture_output=True, text=True).stdout.strip() or "?"
+    try:
+        load = " ".join(open("/proc/loadavg").read().split()[:3])
+    except OSError:
+        load = "?"
+    return commit, load
+
+
 def run_json(cmd, env=None, side=None, threads=1):
     """Runs `cmd`; returns (parsed JSON, None) or (None, first error line).
     Records the share of `threads` cores the process got (CPU time over
@@ -218,12 +229,7 @@ def main():
             json.dump(raw, f, indent=2)
 
     lo, mt = meta["lobe"] or {}, meta["mitsuba"] or {}
-    commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT,
-                            capture_output=True, text=True).stdout.strip() or "?"
-    try:
-        load = " ".join(open("/proc/loadavg").read().split()[:3])
-    except OSError:
-        load = "?"
+    commit, load = run_context()
     med = lambda v: statistics.median(v) if v else None  # noqa: E731
     fmt = lambda x: "—" if x is None else f"{x:.1f}"  # noqa: E731
     ratio = lambda a, b: "—" if a is None or b is None else f"{a / b:.2f}×"  # noqa: E731
@@ -335,12 +341,7 @@ def run_all(args, threads, env):
                 by_material.setdefault((r["material"], r["strategy"], o["threads"]), []).append(best)
     mt = mi_runs[0][0] if mi_runs and mi_runs[0] else {}
     lo = lobe_runs[0]
-    commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT,
-                            capture_output=True, text=True).stdout.strip() or "?"
-    try:
-        load = " ".join(open("/proc/loadavg").read().split()[:3])
-    except OSError:
-        load = "?"
+    commit, load = run_context()
     heads = {"scalar": "f32 portable", "avx2": "AVX2", "avx512": "AVX-512"}
     print(f"CPU: {lo['cpu']}; lobe levels {', '.join(levels)}; Mitsuba {mt.get('mitsuba', '?')} "
           f"{mt.get('variant', '?')} (Dr.Jit {mt.get('drjit', '?')}, {mt.get('simd', '?')}).  ")

@@ -573,6 +573,21 @@ pub struct BatchSampler {
 /// array).
 const TWO_SIDED_CHUNK: usize = 1024;
 
+/// Each output's values in `r` (an empty output, one not written, stays
+/// empty).
+fn chunk_of<'a, const N: usize>(
+    o: &'a mut [&mut [f32]; N],
+    r: std::ops::Range<usize>,
+) -> [&'a mut [f32]; N] {
+    o.each_mut().map(|s| {
+        if s.is_empty() {
+            &mut s[..]
+        } else {
+            &mut s[r.clone()]
+        }
+    })
+}
+
 impl BatchSampler {
     /// For `material` and `strategy` at [`SimdLevel::from_env`] (the best
     /// level unless `LOBE_SIMD` says otherwise). Errors: what the batch path
@@ -724,13 +739,7 @@ impl BatchSampler {
                 &inp[4][r.clone()],
                 &inp[5][r.clone()],
             ];
-            let mut o_part = o.each_mut().map(|s| {
-                if s.is_empty() {
-                    &mut s[..]
-                } else {
-                    &mut s[r.clone()]
-                }
-            });
+            let mut o_part = chunk_of(&mut o, r.clone());
             let valid = &mut out.valid[r.clone()];
             dispatch::sample(self.backend, &self.kernel, part, (&mut o_part, valid), w);
             for (wz, oz) in o_part[2].iter_mut().zip(&inp[2][r.clone()]) {
@@ -817,13 +826,7 @@ impl BatchSampler {
                 *a = oz.abs();
                 *b = if oz < 0.0 { -iz } else { iz };
             }
-            let mut o_part = o.each_mut().map(|s| {
-                if s.is_empty() {
-                    &mut s[..]
-                } else {
-                    &mut s[r.clone()]
-                }
-            });
+            let mut o_part = chunk_of(&mut o, r.clone());
             dispatch::eval_pdf(
                 self.backend,
                 &self.kernel,
@@ -921,17 +924,6 @@ fn check_pairs(
 /// one-sided kernel: [`BatchSampler`] mirrors a `wo` below the surface up
 /// around it (`BatchSampler::two_sided`).
 fn kernel_for(m: &Material, strategy: BsdfStrategy) -> Result<Kernel, BatchError> {
-    let k = one_sided_kernel_for(m, strategy)?;
-    if m.two_sided && matches!(k, Kernel::Measured(_) | Kernel::Dielectric(_)) {
-        return Err(BatchError::Unsupported {
-            reason: "not yet batched: two-sided measured tables".into(),
-        });
-    }
-    Ok(k)
-}
-
-/// [`kernel_for`] of the material seen from above.
-fn one_sided_kernel_for(m: &Material, strategy: BsdfStrategy) -> Result<Kernel, BatchError> {
     let unsupported = |reason: String| Err(BatchError::Unsupported { reason });
     if let Err(e) = m.check(strategy) {
         return Err(BatchError::Inapplicable {
@@ -963,6 +955,9 @@ fn one_sided_kernel_for(m: &Material, strategy: BsdfStrategy) -> Result<Kernel, 
                     ..microfacets_only(1.0, 1.0)
                 },
             });
+        }
+        Glossy::Measured(_) if m.two_sided => {
+            return unsupported("not yet batched: two-sided measured tables".into());
         }
         Glossy::Measured(lobe) => {
             return match measured::MeasuredKernel::new(m, lobe, strategy) {

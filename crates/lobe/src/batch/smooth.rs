@@ -17,7 +17,7 @@
 //! reflection where `uc < R`.
 
 use super::dielectric::fresnel;
-use super::{FresnelP, INV_PI, Sampled, V3, cosine_hemisphere, finish, ks_fresnel};
+use super::{FresnelP, INV_PI, Sampled, V3, cosine_hemisphere, finish, ks_fresnel, select3};
 use crate::batch::lanes::Lanes;
 
 /// The kernels' model codes (their first const parameter).
@@ -59,7 +59,7 @@ fn mul3<L: Lanes>(_l: L, v: V3<L>, x: L::F) -> V3<L> {
     [v[0] * x, v[1] * x, v[2] * x]
 }
 
-/// `m ? a : b` per channel.
+/// `m ? a : b` per channel (`super::select3` where `b` is zero).
 #[inline(always)]
 fn select3m<L: Lanes>(l: L, m: L::M, a: V3<L>, b: V3<L>) -> V3<L> {
     [
@@ -195,5 +195,5 @@ pub(crate) fn eval_pdf<L: Lanes, const MODEL: u8>(
     let f = plastic_base(l, p, one - fo, wi);
     let pdf = pb * wi[2] * l.splat(INV_PI);
     let ok = above & l.is_finite(pdf);
-    (select3m(l, ok, f, [zero; 3]), l.select(ok, pdf, zero))
+    (select3(l, ok, f, zero), l.select(ok, pdf, zero))
 }
