@@ -27,7 +27,7 @@ use super::{
 
 /// The visible normal of the caps (`STRAT = CAPS`) or of the bounded VNDF.
 #[inline(always)]
-fn cap_normal<L: Lanes, const STRAT: u8>(
+pub(super) fn cap_normal<L: Lanes, const STRAT: u8>(
     l: L,
     p: &CtParams,
     wo: V3<L>,

@@ -38,8 +38,12 @@ pub(crate) enum Kernel {
         strat: u8,
         p: LectureParams,
     },
-    /// A rough dielectric, GGX, visible normals.
-    Dielectric(DielectricParams),
+    /// A rough dielectric with distribution `ndf` and strategy `strat`.
+    Dielectric {
+        ndf: u8,
+        strat: u8,
+        p: DielectricParams,
+    },
     /// A smooth model (`model`: `smooth::CONDUCTOR`, ...), strategy brdf.
     Smooth { model: u8, p: SmoothParams },
 }
@@ -134,7 +138,7 @@ impl VecKernel for DielectricParams {
         u2: L::F,
         uc: L::F,
     ) -> Sampled<L> {
-        kernel::dielectric::sample(l, self, wo, u1, u2, uc)
+        kernel::dielectric::sample::<L, A, B>(l, self, wo, u1, u2, uc)
     }
     #[inline(always)]
     fn eval_pdf<L: Lanes, const A: u8, const B: u8>(
@@ -143,7 +147,7 @@ impl VecKernel for DielectricParams {
         wo: [L::F; 3],
         wi: [L::F; 3],
     ) -> ([L::F; 3], L::F) {
-        kernel::dielectric::eval_pdf(l, self, wo, wi)
+        kernel::dielectric::eval_pdf::<L, A, B>(l, self, wo, wi)
     }
 }
 
@@ -628,7 +632,18 @@ macro_rules! instances {
                 _ => unreachable!("BatchSampler::new builds only these"),
             },
             Kernel::Measured(_) => unreachable!("run before the level's dispatch"),
-            Kernel::Dielectric(p) => $f::<_, _, GGX, VNDF>($l, p, $($args),*),
+            Kernel::Dielectric { ndf, strat, p } => match (*ndf, *strat) {
+                (GGX, VNDF) => $f::<_, _, GGX, VNDF>($l, p, $($args),*),
+                (GGX, BRDF) => $f::<_, _, GGX, BRDF>($l, p, $($args),*),
+                (GGX, CAPS) => $f::<_, _, GGX, CAPS>($l, p, $($args),*),
+                (GGX, UNIFORM) => $f::<_, _, GGX, UNIFORM>($l, p, $($args),*),
+                (GGX, COSINE) => $f::<_, _, GGX, COSINE>($l, p, $($args),*),
+                (BECKMANN, VNDF) => $f::<_, _, BECKMANN, VNDF>($l, p, $($args),*),
+                (BECKMANN, BRDF) => $f::<_, _, BECKMANN, BRDF>($l, p, $($args),*),
+                (BECKMANN, UNIFORM) => $f::<_, _, BECKMANN, UNIFORM>($l, p, $($args),*),
+                (BECKMANN, COSINE) => $f::<_, _, BECKMANN, COSINE>($l, p, $($args),*),
+                _ => unreachable!("BatchSampler::new builds only these"),
+            },
             Kernel::Smooth { model, p } => match *model {
                 CONDUCTOR => $f::<_, _, CONDUCTOR, BRDF>($l, p, $($args),*),
                 DIELECTRIC => $f::<_, _, DIELECTRIC, BRDF>($l, p, $($args),*),

@@ -58,12 +58,13 @@
 //! is refused. (A lecture-form `ks` whose `ks · K` is beyond f32's range is
 //! refused with that reason.)
 //!
-//! Rough dielectrics (rough glass) with GGX, isotropic or anisotropic, by
-//! visible normals: reflection and refraction through the generalized half
-//! vector, seen from either side (`kernel::dielectric`; tested against the
-//! scalar path over the whole sphere in `tests_dielectric.rs`). The rest of
-//! rough dielectric: GGX vndf only (Beckmann, the other strategies and an
-//! index-matched interface take the scalar path).
+//! Rough dielectrics (rough glass) with GGX or Beckmann, isotropic or
+//! anisotropic, by every strategy the scalar path gives them (visible
+//! normals, `D cos θm`, GGX's spherical caps, uniform and cosine over the
+//! sphere): reflection and refraction through the generalized half vector,
+//! seen from either side (`kernel::dielectric`; tested against the scalar
+//! path over the whole sphere in `tests_dielectric.rs`). An index-matched
+//! interface (a delta) takes the scalar path.
 //!
 //! **Rough plastic** (`roughplastic`, GGX or Beckmann, every strategy it
 //! has) runs in the Cook-Torrance kernel: its coating is a Cook-Torrance
@@ -90,10 +91,9 @@
 //!
 //! Refused with [`BatchError::Unsupported`], the scalar path serving them:
 //! Kulla-Conty compensation (its added lobe and mixture sampling), rough
-//! glass other than GGX by visible normals, rough glass with Turquin's
-//! compensation, a diffuse term beside a smooth lobe, two-sided measured
-//! tables. `lobe bench --all` lists them with the
-//! reason.
+//! glass with Turquin's compensation, index-matched rough glass, a diffuse
+//! term beside a smooth lobe, two-sided measured tables. `lobe bench
+//! --all` lists them with the reason.
 //!
 //! Beckmann's visible slopes are drawn as the scalar path draws them (Heitz
 //! and d'Eon 2014: the slope CDF inverted by Newton's method inside a
@@ -622,7 +622,9 @@ impl BatchSampler {
             Kernel::CookTorrance { p, .. } => p.two_lobes,
             Kernel::Measured(k) => k.chooses_lobe(),
             Kernel::Lecture { p, .. } => p.two_lobes,
-            Kernel::Dielectric(_) => true,
+            Kernel::Dielectric { strat, .. } => {
+                *strat != kernel::UNIFORM && *strat != kernel::COSINE
+            }
             Kernel::Smooth { model, .. } => *model != kernel::smooth::CONDUCTOR,
         }
     }
@@ -1258,37 +1260,47 @@ fn microfacets_only(ax: f64, ay: f64) -> CtParams {
     }
 }
 
-/// The rough dielectric's kernel: GGX with visible normals; Beckmann, the
-/// other strategies and the index-matched interface (a delta) are scalar
-/// only ("rough dielectric: GGX vndf only" in the module doc).
+/// The rough dielectric's kernel (`kernel::dielectric`): GGX or Beckmann,
+/// every strategy the scalar path gives it (`m.check` accepted it:
+/// visible normals, `D cos θm`, GGX's spherical caps, uniform and cosine
+/// over the sphere); the index-matched interface (a delta) is scalar only.
 fn dielectric_kernel(
     rd: &crate::models::RoughDielectric,
     strategy: BsdfStrategy,
 ) -> Result<Kernel, BatchError> {
-    let unsupported = |reason: String| Err(BatchError::Unsupported { reason });
     if rd.eta == 1.0 {
-        return unsupported(
-            "rough dielectric: GGX vndf only; index-matched (η = 1) it is a delta".into(),
-        );
+        return Err(BatchError::Unsupported {
+            reason: "rough dielectric: index-matched (η = 1), it is a delta".into(),
+        });
     }
-    if rd.microfacet.ndf() != Ndf::Ggx {
-        return unsupported("rough dielectric: GGX vndf only (this one is Beckmann)".into());
-    }
-    if strategy != BsdfStrategy::Vndf {
-        return unsupported(format!(
-            "rough dielectric: GGX vndf only (not `{strategy}`)"
-        ));
+    let ndf = rd.microfacet.ndf();
+    if ndf == Ndf::BlinnPhong {
+        return Err(BatchError::Unsupported {
+            reason: "rough dielectric: GGX or Beckmann (not the Blinn-Phong NDF)".into(),
+        });
     }
     let (ax, ay) = rd.microfacet.alpha();
     let c3 = |c: Rgb| [c.x as f32, c.y as f32, c.z as f32];
-    Ok(Kernel::Dielectric(kernel::dielectric::DielectricParams {
-        ct: microfacets_only(ax, ay),
-        eta: rd.eta as f32,
-        inv_eta: (1.0 / rd.eta) as f32,
-        kr: c3(rd.specular_reflectance),
-        kt: c3(rd.specular_transmittance),
-        importance: rd.mode == crate::TransportMode::Importance,
-    }))
+    let ct = CtParams {
+        guess: if ndf == Ndf::Beckmann && strategy == BsdfStrategy::Vndf {
+            kernel::beckmann_guess_table()
+        } else {
+            &[]
+        },
+        ..microfacets_only(ax, ay)
+    };
+    Ok(Kernel::Dielectric {
+        ndf: ndf_code(ndf),
+        strat: strat_code(strategy),
+        p: kernel::dielectric::DielectricParams {
+            ct,
+            eta: rd.eta as f32,
+            inv_eta: (1.0 / rd.eta) as f32,
+            kr: c3(rd.specular_reflectance),
+            kt: c3(rd.specular_transmittance),
+            importance: rd.mode == crate::TransportMode::Importance,
+        },
+    })
 }
 
 /// The kernel of a Phong (`model = PHONG`) or Blinn-Phong material with

@@ -1,30 +1,45 @@
-//! The rough dielectric kernel (GGX, visible normals) against the scalar
+//! The rough dielectric kernel (GGX and Beckmann, every strategy) against the scalar
 //! f64 path, at every level this CPU has, seen from outside and from
 //! inside: the same samples (the same outcome, `wi` within 1e-5, `f`,
 //! `pdf` and `weight` within 1e-4 relative), the same `eval_pdf` over the
 //! whole sphere, and the same bits at every level.
 //!
-//! The tolerances grow by what f32 inputs cannot avoid: `f` and the pdf
-//! divide by `|wo.z|` and `|wi.z|`, and refraction takes `√(1 − sin²θt)`,
-//! so the inputs' rounding (about 1e-7) is magnified near the horizon and
-//! near total internal reflection ([`conditioning`]). Where `uc` is within
+//! The tolerances grow by what f32 cannot avoid, measured on the f64 path
+//! by moving its inputs by their rounding ([`conditioning`]): near the
+//! horizon, next to total internal reflection, where the half vector
+//! cancels, far in Beckmann's tail. Where `uc` is within
 //! 1e-5 of the Fresnel reflectance, or a direction within 1e-4 of the
 //! horizon, the two paths may choose differently: counted, at most one
 //! sample in 10³.
 
 use super::{d3, levels, random_wo, rel_err, uniform};
 use crate::batch::{BatchSampler, EvalPdfBuffers, SampleBuffers, SampleInputs};
-use crate::{BsdfStrategy, Material};
-use glam::DVec2;
+use crate::{BsdfSampler, BsdfStrategy, Material};
+use glam::{DVec2, DVec3};
 use rand::{Rng, RngExt, SeedableRng};
 use rand_pcg::Pcg64;
 
-const MATERIALS: [&str; 4] = [
+const MATERIALS: [&str; 6] = [
     r#"{"type":"roughdielectric","distribution":"ggx","alpha":0.3}"#,
+    r#"{"type":"roughdielectric","distribution":"beckmann","alpha":0.3}"#,
+    r#"{"type":"roughdielectric","distribution":"beckmann","alpha_u":0.05,"alpha_v":0.4,"int_ior":1.0,"ext_ior":1.5,"specular_transmittance":[0.9,0.5,0.2]}"#,
     r#"{"type":"roughdielectric","distribution":"ggx","alpha_u":0.1,"alpha_v":0.5,"int_ior":1.0,"ext_ior":1.33}"#,
     r#"{"type":"roughdielectric","distribution":"ggx","alpha":0.02,"int_ior":"diamond","specular_transmittance":[0.9,0.5,0.2],"mode":"importance"}"#,
     r#"{"type":"roughdielectric","distribution":"ggx","alpha":0.8,"specular_reflectance":0.7}"#,
 ];
+
+/// Every (material, strategy) pair: each material of [`MATERIALS`] with
+/// every strategy the scalar path gives it.
+fn cases() -> Vec<(String, Material, BsdfStrategy)> {
+    let mut v = Vec::new();
+    for json in MATERIALS {
+        let m = Material::load(json).unwrap();
+        for s in m.strategies() {
+            v.push((format!("{json} {s}"), m.clone(), s));
+        }
+    }
+    v
+}
 
 /// A view over the sphere: `random_wo`'s (grazing ones included) on
 /// either side.
@@ -38,10 +53,9 @@ fn wo_sphere(rng: &mut impl Rng) -> [f32; 3] {
 }
 
 /// At the microfacet normal taking `wo` to `wi`, seen from `wo`'s side:
-/// `|wo·m|`, the length of the unnormalized half vector, the Fresnel
-/// reflectance, and `1 − sin²θt` (negative under total internal
+/// the Fresnel reflectance and `1 − sin²θt` (negative under total internal
 /// reflection).
-fn at_normal(m: &Material, wo: glam::DVec3, wi: glam::DVec3) -> (f64, f64, f64, f64) {
+fn at_normal(m: &Material, wo: glam::DVec3, wi: glam::DVec3) -> (f64, f64) {
     let crate::Glossy::RoughDielectric(rd) = &m.glossy else {
         unreachable!("rough dielectrics only")
     };
@@ -53,27 +67,53 @@ fn at_normal(m: &Material, wo: glam::DVec3, wi: glam::DVec3) -> (f64, f64, f64, 
     };
     let c = wo.dot(h.normalize()).abs();
     let fr = crate::fresnel::fresnel_dielectric(c, eta).r;
-    (c, h.length(), fr, 1.0 - (1.0 - c * c) / (eta * eta))
+    (fr, 1.0 - (1.0 - c * c) / (eta * eta))
 }
 
-/// The relative error an f32 evaluation cannot avoid at `(wo, wi)`, from
-/// rounding of about 1e-7 in its steps: `f` and the pdf divide by `|wo.z|`
-/// and `|wi.z|`; `wo·m` cancels where the half vector is short and `wo·m`
-/// small (a direction nearly back along `wo`), and `F` follows it; and
-/// refraction takes `cos θt = √(1 − sin²θt)` near total internal
-/// reflection.
-fn conditioning(m: &Material, wo: glam::DVec3, wi: glam::DVec3) -> f64 {
-    let (c, hl, _, cos2_t) = at_normal(m, wo, wi);
-    let refract = wo.z * wi.z < 0.0;
-    2e-7 / wo.z.abs()
-        + 2e-7 / wi.z.abs()
-        + 2e-7 / (hl * c).max(1e-12)
-        + if refract {
-            6e-7 / cos2_t.abs().max(1e-12)
+/// The relative error an f32 evaluation cannot avoid at `(wo, wi)`,
+/// measured on the f64 path rather than modelled: four times the largest
+/// relative change of its `f` and pdf (and the sample weight `f |wi.z| /
+/// pdf` if `weight`) when both directions move by `delta`
+/// in each coordinate (four draws, renormalized). The kernel's inputs and
+/// steps round by about 1e-7 (`delta` 3e-7 stands for them); where that
+/// moves the result far, f32 cannot say: near the horizon (`f` and the pdf
+/// divide by `|wo.z|`, `|wi.z|`), next to total internal reflection
+/// (`cos θt = √(1 − sin²θt)` in `F` and in refraction), where the half
+/// vector cancels (`wo·m`, `m.z` of `D cos θm`'s density), and in
+/// Beckmann's `exp(−tan²θm/α²)` far in its tail.
+fn conditioning(sp: &BsdfSampler<'_>, wo: DVec3, wi: DVec3, delta: f64, weight: bool) -> f64 {
+    let (f0, p0) = sp.eval_pdf(wo, wi);
+    let w = |f: f64, p: f64, wi: DVec3| {
+        if weight && p > 0.0 {
+            f * wi.z.abs() / p
         } else {
             0.0
         }
+    };
+    let mut rng = Pcg64::seed_from_u64(wo.x.to_bits() ^ wi.y.to_bits());
+    let mut jitter = |w: DVec3| {
+        let d = DVec3::new(rng.random(), rng.random(), rng.random()) * 2.0 - DVec3::ONE;
+        (w + d * delta).normalize()
+    };
+    let mut worst = 0.0f64;
+    for _ in 0..4 {
+        let wi_j = jitter(wi);
+        let (f, p) = sp.eval_pdf(jitter(wo), wi_j);
+        worst = [
+            rel_err(w(f.x, p, wi_j), w(f0.x, p0, wi)),
+            rel_err(f.x, f0.x),
+            rel_err(f.y, f0.y),
+            rel_err(f.z, f0.z),
+            rel_err(p, p0),
+        ]
+        .into_iter()
+        .fold(worst, f64::max);
+    }
+    4.0 * worst
 }
+
+/// The inputs' rounding for [`conditioning`].
+const ROUNDING: f64 = 3e-7;
 
 /// Where [`conditioning`] allows more than this, the pair is counted as
 /// ill-conditioned instead of compared: at the horizon (within 1e-2), or
@@ -87,7 +127,7 @@ fn near_an_edge(m: &Material, wo: glam::DVec3, uc: f64, wi: Option<glam::DVec3>)
         return true;
     }
     let Some(wi) = wi else { return false };
-    let (_, _, fr, cos2_t) = at_normal(m, wo, wi);
+    let (fr, cos2_t) = at_normal(m, wo, wi);
     (uc - fr).abs() < 1e-5 || cos2_t.abs() < 1e-5
 }
 
@@ -96,9 +136,8 @@ fn dielectric_samples_match_the_scalar_path() {
     let mut rng = Pcg64::seed_from_u64(0xd1e1);
     let n = 20_000;
     let mut report = Vec::new();
-    for json in MATERIALS {
-        let m = Material::load(json).unwrap();
-        let sp = m.sampler(BsdfStrategy::Vndf).unwrap();
+    for (json, m, strategy) in cases() {
+        let sp = m.sampler(strategy).unwrap();
         let mut inp = SampleInputs::default();
         for _ in 0..n {
             inp.push(
@@ -110,8 +149,11 @@ fn dielectric_samples_match_the_scalar_path() {
         }
         let mut first: Option<SampleBuffers> = None;
         for level in levels("dielectric_samples_match_the_scalar_path") {
-            let b = BatchSampler::with_level(&m, BsdfStrategy::Vndf, level).unwrap();
-            assert!(b.chooses_lobe());
+            let b = BatchSampler::with_level(&m, strategy, level).unwrap();
+            assert_eq!(
+                b.chooses_lobe(),
+                !matches!(strategy, BsdfStrategy::Uniform | BsdfStrategy::Cosine)
+            );
             let mut out = SampleBuffers::new(n);
             b.sample(inp.input(true), out.output()).unwrap();
             let (mut edges, mut bad, mut valid, mut below) = (0usize, Vec::new(), 0usize, 0usize);
@@ -155,9 +197,8 @@ fn dielectric_samples_match_the_scalar_path() {
                         ]
                         .into_iter()
                         .fold(0.0, f64::max);
-                        // Plus twice what the two directions' difference
-                        // explains through 1/|wi.z|.
-                        let allowance = conditioning(&m, wo, x.wi) + 2.0 * dwi / x.wi.z.abs();
+                        // Moving by the two directions' difference too.
+                        let allowance = conditioning(&sp, wo, x.wi, ROUNDING.max(dwi), true);
                         if allowance > ILL {
                             if wo.z.abs() < 1e-2 || x.wi.z.abs() < 1e-2 {
                                 grazing += 1;
@@ -228,9 +269,8 @@ fn dielectric_samples_match_the_scalar_path() {
 fn dielectric_eval_pdf_matches_the_scalar_path_over_the_sphere() {
     let mut rng = Pcg64::seed_from_u64(0xd1e2);
     let n = 20_000;
-    for json in MATERIALS {
-        let m = Material::load(json).unwrap();
-        let sp = m.sampler(BsdfStrategy::Vndf).unwrap();
+    for (json, m, strategy) in cases() {
+        let sp = m.sampler(strategy).unwrap();
         let mut pairs = crate::batch::DirPairs::default();
         for j in 0..n {
             let o = wo_sphere(&mut rng);
@@ -245,7 +285,7 @@ fn dielectric_eval_pdf_matches_the_scalar_path_over_the_sphere() {
             pairs.push(o, i);
         }
         for level in levels("dielectric_eval_pdf_matches_the_scalar_path_over_the_sphere") {
-            let b = BatchSampler::with_level(&m, BsdfStrategy::Vndf, level).unwrap();
+            let b = BatchSampler::with_level(&m, strategy, level).unwrap();
             let mut out = EvalPdfBuffers::new(n);
             b.eval_pdf(pairs.wo(), pairs.wi(), out.output()).unwrap();
             let (mut worst, mut edges, mut nonzero) = (0.0f64, 0usize, 0usize);
@@ -270,11 +310,7 @@ fn dielectric_eval_pdf_matches_the_scalar_path_over_the_sphere() {
                 ]
                 .into_iter()
                 .fold(0.0, f64::max);
-                let allowance = if pdf > 0.0 {
-                    conditioning(&m, o, i)
-                } else {
-                    0.0
-                };
+                let allowance = conditioning(&sp, o, i, ROUNDING, false);
                 if allowance > ILL {
                     // At the horizon (a fifth of `random_wo`'s views graze
                     // it) or at total internal reflection's edge: f32
@@ -290,7 +326,9 @@ fn dielectric_eval_pdf_matches_the_scalar_path_over_the_sphere() {
                     if o.z.abs() < 1e-4 || i.z.abs() < 1e-4 {
                         edges += 1;
                     } else {
-                        bad.push(format!("wo {o} wi {i}: f {got:?} vs {f} {pdf}"));
+                        bad.push(format!(
+                            "wo {o} wi {i} (allowance {allowance:.1e}): f {got:?} vs {f} {pdf}"
+                        ));
                     }
                 } else if e > worst {
                     worst = e;

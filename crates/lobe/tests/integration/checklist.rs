@@ -129,8 +129,8 @@ const ROWS: &[Row] = &[
         chi2_test: "fn chi2_rough_dielectric",
         readme_row: "| Rough dielectric ",
         alias_of: None,
-        scalar_only: Some(ROUGH_GLASS_SCALAR_ONLY),
-        batched: &[BsdfStrategy::Vndf],
+        scalar_only: None,
+        batched: &[],
     },
     Row {
         model: "plastic",
@@ -182,9 +182,6 @@ const ROWS: &[Row] = &[
         batched: &[],
     },
 ];
-
-/// What of rough glass is not batched, in the batch module doc's words.
-const ROUGH_GLASS_SCALAR_ONLY: &str = "rough dielectric: GGX vndf only";
 
 fn read(rel: &str) -> String {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(rel);
