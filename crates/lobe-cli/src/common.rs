@@ -294,37 +294,7 @@ pub fn warn_energy_gain(m: &lobe::Material, what: &str) {
     }
 }
 
-/// What `mis`, the default strategy, is: the one description of every help
-/// text that names it ([`strategy_help`], `lobe render --help`).
-pub const MIS_DESCRIPTION: &str = "adaptive MIS, the default: each sample draws one BSDF direction (vndf where the material has it, else brdf) and one light direction, and gives both to BSDF sampling, to the balance heuristic or to light sampling, whichever a pilot of its own samples finds of least variance (in a render: per pixel, from the pilots of the 7 × 7 pixels around it; deeper bounces use the balance heuristic)";
-
-/// What a strategy of [`Strategy::names`](lobe::estimator::Strategy::names)
-/// is, in a few words; `None` for a name this list does not know (a test
-/// checks that every accepted name has one).
-#[must_use]
-pub fn strategy_description(name: &str) -> Option<&'static str> {
-    Some(match name {
-        "uniform" => "uniform over the hemisphere (the baseline)",
-        "cosine" => "cosine-weighted hemisphere",
-        "brdf" => {
-            "the lecture's importance sampling (Phong's lobe, Blinn-Phong's half vector, Cook-Torrance's D(h) cos θh)"
-        }
-        "vndf" => "visible normals (Heitz 2018; GGX and Beckmann)",
-        "spherical-caps" => "visible normals by spherical caps (Dupuy and Benyoub 2023; GGX)",
-        "bounded-vndf" => "bounded VNDF (Eto and Tokuyoshi 2023; GGX)",
-        "light" => "light sampling alone (the environment map's or the light's own distribution)",
-        "mis" => MIS_DESCRIPTION,
-        "mis-balance" => {
-            "multi-sample MIS with the balance heuristic: one BSDF and one light sample, both weighted"
-        }
-        "mis-power" => "multi-sample MIS with the power heuristic",
-        "mis-one" => {
-            "one-sample MIS with the balance heuristic: one draw, BSDF or light at even odds"
-        }
-        "mis-power-one" => "one-sample MIS with the power heuristic",
-        _ => return None,
-    })
-}
+pub use lobe::strategy::description as strategy_description;
 
 /// Every strategy name with its description ([`strategy_description`]):
 /// the one text of `--strategy` in `estimate`, `converge`, `render` and
@@ -631,6 +601,6 @@ mod tests {
         for n in lobe::estimator::Strategy::names().split(", ") {
             assert!(strategy_description(n).is_some(), "{n}");
         }
-        assert!(strategy_help().contains(MIS_DESCRIPTION));
+        assert!(strategy_help().contains(lobe::strategy::MIS_DESCRIPTION));
     }
 }

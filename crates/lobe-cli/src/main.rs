@@ -17,6 +17,7 @@ mod estimate;
 mod eval;
 mod eval_batch;
 mod eval_line;
+mod explore;
 mod figures;
 mod fit;
 mod furnace;
@@ -62,6 +63,7 @@ enum Command {
     Tabulate(tabulate::TabulateArgs),
     TabulateEnergy(tabulate_energy::TabulateEnergyArgs),
     Fit(fit::FitArgs),
+    Explore(explore::ExploreArgs),
     Furnace(furnace::FurnaceArgs),
     Sweep(sweep::SweepArgs),
 }
@@ -84,6 +86,7 @@ fn main() -> ExitCode {
         Command::Tabulate(args) => tabulate::run(&args),
         Command::TabulateEnergy(args) => tabulate_energy::run(&args),
         Command::Fit(args) => fit::run(&args),
+        Command::Explore(args) => explore::run(&args),
         Command::Furnace(args) => furnace::run(&args),
         Command::Sweep(args) => sweep::run(&args),
     });

@@ -248,6 +248,27 @@ pub fn showcase(width: u32, height: u32) -> Result<Scene, CameraError> {
         ))
 }
 
+/// One sphere of `material` (radius 1 at the origin) seen from +z at
+/// distance 4 in a square `size × size` view (vertical field of view 32°:
+/// the sphere fills most of it), under `env`: a material's preview, as
+/// `lobe explore` shows it. Errors: `size` outside 1 to 16384.
+pub fn material_preview(
+    material: Material,
+    env: impl Into<Arc<EnvMap>>,
+    size: u32,
+) -> Result<Scene, CameraError> {
+    let camera = Camera::new(
+        DVec3::new(0.0, 0.0, 4.0),
+        DVec3::ZERO,
+        DVec3::Y,
+        32.0,
+        size,
+        size,
+    )?;
+    Ok(Scene::new(camera, env)
+        .with(Object::sphere(DVec3::ZERO, 1.0, material).expect("a unit sphere is valid")))
+}
+
 // ---------------------------------------------------------------------------
 // The file format.
 

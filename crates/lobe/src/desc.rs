@@ -284,6 +284,27 @@ impl MaterialDesc {
         }
     }
 
+    /// The description as one line of JSON: the keys it has, in a fixed
+    /// order ([`MaterialDesc::from_json`] reads it back).
+    #[must_use]
+    pub fn to_json(&self) -> String {
+        serde_json::to_string(self).unwrap_or_default()
+    }
+
+    /// The description as a TOML table ([`MaterialDesc::from_toml`] reads
+    /// it back).
+    pub fn to_toml(&self) -> Result<String, Error> {
+        toml::to_string(self)
+            .map_err(|e| Error::Parse(format!("material: cannot be written as TOML: {e}")))
+    }
+
+    /// The description as a Python dict literal, for `lobe.load_dict`
+    /// (and Mitsuba 3's `mi.load_dict` where the model is Mitsuba's).
+    #[must_use]
+    pub fn to_python(&self) -> String {
+        python_literal(&self.to_json())
+    }
+
     /// The same description, its relative paths taken from `dir` (the
     /// directory of the file that names it).
     #[must_use]
@@ -506,6 +527,53 @@ impl FresnelDesc {
     }
 }
 
+/// JSON text as a Python literal, keys in their order: `true`, `false` and
+/// `null` become `True`, `False` and `None` outside strings, and a space
+/// follows each `:` and `,` as Python writes dicts.
+fn python_literal(json: &str) -> String {
+    let mut out = String::with_capacity(json.len() + json.len() / 4);
+    let mut chars = json.chars().peekable();
+    while let Some(c) = chars.next() {
+        match c {
+            '"' => {
+                out.push('"');
+                while let Some(d) = chars.next() {
+                    out.push(d);
+                    if d == '\\' {
+                        if let Some(e) = chars.next() {
+                            out.push(e);
+                        }
+                    } else if d == '"' {
+                        break;
+                    }
+                }
+            }
+            ':' | ',' => {
+                out.push(c);
+                out.push(' ');
+            }
+            't' | 'f' | 'n' => {
+                let mut word = String::from(c);
+                while let Some(&d) = chars.peek() {
+                    if !d.is_ascii_alphabetic() {
+                        break;
+                    }
+                    word.push(d);
+                    chars.next();
+                }
+                out.push_str(match word.as_str() {
+                    "true" => "True",
+                    "false" => "False",
+                    "null" => "None",
+                    w => w,
+                });
+            }
+            c => out.push(c),
+        }
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -599,6 +667,23 @@ mod tests {
         );
         assert!(err(r#"{"type":"cook-torrance","alpha_u":0.1}"#).contains("alpha_v"));
         assert!(err(r#"{"type":"lambert","albedo":1.5}"#).contains("albedo"));
+    }
+
+    #[test]
+    fn descriptions_are_written_back_as_json_toml_and_python() {
+        let text = r#"{"type":"twosided","bsdf":{"type":"roughplastic","alpha":0.3,"diffuse_reflectance":[0.2,0.4,0.6],"int_ior":"polypropylene","nonlinear":true}}"#;
+        let d = MaterialDesc::from_json(text).unwrap();
+        assert_eq!(d.to_json(), text);
+        assert_eq!(MaterialDesc::from_toml(&d.to_toml().unwrap()).unwrap(), d);
+        assert_eq!(
+            d.to_python(),
+            r#"{"type": "twosided", "bsdf": {"type": "roughplastic", "alpha": 0.3, "diffuse_reflectance": [0.2, 0.4, 0.6], "int_ior": "polypropylene", "nonlinear": True}}"#
+        );
+        // Quotes and escapes inside strings stay as they are.
+        assert_eq!(
+            python_literal(r#"{"a":"t,\"x:null"}"#),
+            r#"{"a": "t,\"x:null"}"#
+        );
     }
 
     #[test]

@@ -37,6 +37,9 @@ fn skipped(line: &str) -> Option<&'static str> {
     match words.get(1).copied() {
         Some("demo") if !line.contains("--quick") => Some("the full demo takes about a minute"),
         Some("report") if !line.contains("--quick") => Some("the full report takes minutes"),
+        Some("explore") => Some(
+            "a server that runs until stopped (tests/cli/explore.rs and crates/lobe-explore's tests start it)",
+        ),
         Some("sweep") => Some(
             "needs the Python package with its dask extra (python/tests/test_sweeps.py runs it)",
         ),

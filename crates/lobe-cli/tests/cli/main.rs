@@ -11,6 +11,7 @@ mod demo;
 mod estimate;
 mod eval;
 mod eval_batch;
+mod explore;
 mod help_examples;
 mod measured;
 mod plot;

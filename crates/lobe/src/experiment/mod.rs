@@ -26,11 +26,13 @@
 //! the inputs and merged in a fixed order, so the numbers are the same with
 //! or without the feature and for any thread count.
 
+pub mod albedo;
 pub mod converge;
 pub mod estimate;
 #[cfg(feature = "desc")]
 pub mod furnace;
 pub mod histogram;
+pub mod lobe_grid;
 pub mod polar;
 pub mod table;
 pub mod variance;

@@ -317,6 +317,33 @@ impl RoughPlastic {
 /// the larger index, 128 from the other, where total internal reflection
 /// cuts the integrand).
 fn coating_tables(mf: &Microfacet, eta: f64) -> (Vec<f64>, f64) {
+    // Recently built coatings, by their microfacets and index: a front end
+    // that builds the same material for each of its views (`lobe explore`)
+    // computes the 1.1 million integrand values once. At most 16 kept.
+    type Cache = std::sync::Mutex<Vec<(String, (Vec<f64>, f64))>>;
+    static CACHE: std::sync::OnceLock<Cache> = std::sync::OnceLock::new();
+    let key = format!("{mf:?} {eta:?}");
+    let cache = CACHE.get_or_init(Default::default);
+    if let Some(hit) = cache
+        .lock()
+        .ok()
+        .and_then(|c| c.iter().find(|e| e.0 == key).map(|e| e.1.clone()))
+    {
+        return hit;
+    }
+    let tables = compute_coating_tables(mf, eta);
+    if let Ok(mut c) = cache.lock() {
+        if c.len() >= 16 {
+            c.remove(0);
+        }
+        c.push((key, tables.clone()));
+    }
+    tables
+}
+
+/// [`coating_tables`] computed (the cosines in parallel, summed in order:
+/// the same numbers for any thread count).
+fn compute_coating_tables(mf: &Microfacet, eta: f64) -> (Vec<f64>, f64) {
     let mu = |j: usize| (j as f64 / (TABLE_SIZE - 1) as f64).max(1e-6);
     // The two rules, computed once for the 128 integrals.
     let rules = [32, 128].map(crate::stats::quadrature::gauss_legendre);
@@ -352,10 +379,10 @@ fn coating_tables(mf: &Microfacet, eta: f64) -> (Vec<f64>, f64) {
         })
     };
     let dir = |m: f64| DVec3::new((1.0 - m * m).max(0.0).sqrt(), 0.0, m);
-    let table = (0..TABLE_SIZE).map(|j| transmittance(dir(mu(j)), eta)).collect();
+    let table = crate::parallel::map_indices(TABLE_SIZE, |j| transmittance(dir(mu(j)), eta));
     let r_int = 2.0
-        * (0..TABLE_SIZE)
-            .map(|j| reflectance(dir(mu(j)), 1.0 / eta) * mu(j))
+        * crate::parallel::map_indices(TABLE_SIZE, |j| reflectance(dir(mu(j)), 1.0 / eta) * mu(j))
+            .into_iter()
             .sum::<f64>()
         / TABLE_SIZE as f64;
     (table, r_int)
