@@ -303,3 +303,59 @@ fn the_page_works_in_chromium() {
     let errors = page.errors();
     assert!(errors.is_empty(), "console errors: {errors:#?}");
 }
+
+#[test]
+fn a_measured_table_beside_its_fit() {
+    // A data directory with one RGL table of a known material.
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("explore-data");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(dir.join("tables")).unwrap();
+    let paint = lobe::Material::load(
+        r#"{"type":"cook-torrance","distribution":"ggx","alpha":0.25,"kd":0.1,"ks":0.6}"#,
+    )
+    .unwrap();
+    let bytes = lobe::tabulate::to_bytes(
+        &paint,
+        lobe::tabulate::Format::Rgl(lobe::tabulate::RglResolution { n_theta: 6, n: 24 }),
+    );
+    std::fs::write(dir.join("tables/paint.bsdf"), bytes).unwrap();
+    let url = lobe_explore::Server::bind(&lobe_explore::Config {
+        data: Some(dir),
+        ..lobe_explore::Config::default()
+    })
+    .unwrap()
+    .spawn();
+    let profile = Path::new(env!("CARGO_TARGET_TMPDIR")).join("explore-chromium-data");
+    let (_browser, mut page) = open(&url, &profile);
+    page.wait_for("!!(window.lobeExplore && window.lobeExplore.ready)", 120);
+    page.wait_for(
+        "[...document.querySelectorAll('#data-file option')].some(o => o.value === 'tables/paint.bsdf')",
+        30,
+    );
+    // Load the table as a material (it becomes the active one), then fit it.
+    page.eval(
+        "(() => { const s = document.getElementById('data-file'); s.value = 'tables/paint.bsdf'; \
+         s.dispatchEvent(new Event('change', {bubbles: true})); \
+         document.getElementById('load-data').click(); return true; })()",
+    );
+    page.wait_for("document.querySelectorAll('.material').length === 3", 30);
+    page.wait_for("!document.getElementById('fit').disabled", 60);
+    page.eval("(() => { document.getElementById('fit').click(); return true; })()");
+    page.wait_for("document.querySelectorAll('.material').length === 4", 120);
+    // The polar plot overlays the table and its fit (and the two others).
+    page.wait_for(
+        "document.getElementById('polar').data.filter(t => /^[0-9]+\\. /.test(t.name || '')).length === 4",
+        60,
+    );
+    let names = page.eval("JSON.stringify(document.getElementById('polar').data.map(t => t.name))");
+    assert!(names.as_str().unwrap().contains("4. fit of paint.bsdf"), "{names}");
+    let status = page.eval("document.getElementById('fit-status').textContent");
+    assert!(status.as_str().unwrap().contains("error"), "{status}");
+    // Let the lit sphere refine a few passes before the picture.
+    std::thread::sleep(Duration::from_secs(3));
+    page.screenshot("explore-measured");
+    let page_errors = page.eval("JSON.stringify(window.lobeExplore.errors)");
+    assert_eq!(page_errors, json!("[]"), "errors shown on the page");
+    let errors = page.errors();
+    assert!(errors.is_empty(), "console errors: {errors:#?}");
+}
