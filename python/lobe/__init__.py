@@ -66,6 +66,11 @@ __all__ = [
     "fit",
     "sweep",
     "render",
+    "polar",
+    "lobe_grid",
+    "albedo_curve",
+    "warp_test",
+    "weight_map",
     "set_threads",
     "get_threads",
     "simd_level",
@@ -311,5 +316,7 @@ def render(
 
 
 from . import chi2  # noqa: E402
+from . import views  # noqa: E402
+from .views import albedo_curve, lobe_grid, polar, warp_test, weight_map  # noqa: E402
 from . import sweeps  # noqa: E402  (imports Dask only when a sweep runs)
 from .sweeps import sweep  # noqa: E402

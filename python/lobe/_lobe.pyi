@@ -13,11 +13,12 @@ import numpy.typing as npt
 _ArrayLike = npt.ArrayLike
 _F32 = npt.NDArray[np.float32]
 _Floats = npt.NDArray[np.floating[Any]]
+_F64 = npt.NDArray[np.float64]
 
 __all__ = [
-    "BLOCK", "Material", "SampleResult", "_chi2_test", "_chi2_uniforms", "_estimate_json", "_fit_json", "_furnace_json", "_json_to_toml",
-    "_load_json", "_render", "cache_info", "clear_cache", "get_threads", "set_cache_limit", "set_threads", "sidak",
-    "simd_level", "__version__",
+    "BLOCK", "Material", "SampleResult", "_albedo_curve", "_chi2_test", "_chi2_uniforms", "_estimate_json", "_fit_json", "_furnace_json",
+    "_json_to_toml", "_load_json", "_lobe_grid", "_polar", "_render", "_warp_test", "_weight_map", "cache_info", "clear_cache",
+    "get_threads", "set_cache_limit", "set_threads", "sidak", "simd_level", "__version__",
 ]
 
 BLOCK: int
@@ -95,6 +96,10 @@ class Material:
     @property
     def description(self) -> str:
         """lobe's description of the material: JSON text with the keys of ``--material``."""
+    def to_toml(self) -> str:
+        """The description as TOML text (``MaterialDesc::to_toml``)."""
+    def to_python(self) -> str:
+        """The description as a Python dict literal, for ``lobe.load_dict`` (``MaterialDesc::to_python``)."""
 
 def _load_json(text: str) -> Material: ...
 def set_threads(n: Optional[int] = None) -> None:
@@ -130,3 +135,14 @@ def _chi2_test(
     n_z: int, n_phi: int, min_expected: float, dirs: npt.NDArray[np.float64], valid: npt.NDArray[np.bool_],
     probs: npt.NDArray[np.float64], errors: npt.NDArray[np.float64],
 ) -> dict[str, Any]: ...
+def _polar(
+    material: Material, theta_o: float, phi_o: float, steps: int,
+) -> Tuple[_F64, _F64, dict[str, _F64], bool]: ...
+def _lobe_grid(
+    material: Material, theta_o: float, phi_o: float, n_theta: int, n_phi: int,
+) -> Tuple[_F64, _F64, _F64, bool]: ...
+def _albedo_curve(material: Material, thetas_deg: Sequence[float], phi_deg: float, n: int) -> _F64: ...
+def _warp_test(
+    material: Material, strategy: str, theta_o: float, phi_o: float, samples: int, res: int, seed: Optional[int],
+) -> dict[str, Any]: ...
+def _weight_map(material: Material, strategy: str, theta_o: float, phi_o: float, res: int) -> _F64: ...

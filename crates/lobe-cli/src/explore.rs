@@ -35,6 +35,10 @@ pub struct ExploreArgs {
     /// The address to listen on (127.0.0.1: this machine only).
     #[arg(long, default_value = "127.0.0.1")]
     host: std::net::IpAddr,
+    /// No line on standard error for each request (method, path, status,
+    /// milliseconds).
+    #[arg(long)]
+    quiet: bool,
 }
 
 pub fn run(args: &ExploreArgs) -> Result<()> {
@@ -52,6 +56,7 @@ pub fn run(args: &ExploreArgs) -> Result<()> {
         port: args.port,
         data: args.data.clone(),
         materials,
+        log: !args.quiet,
     })
     .map_err(|e| anyhow!(e))?;
     let mut out = std::io::stdout().lock();

@@ -9,7 +9,7 @@ use crate::error::ApiError;
 use glam::DVec3;
 use lobe::experiment::estimate::{EstimateTableSettings, estimate_table};
 use lobe::experiment::histogram::{WeightPixel, weight_pixels};
-use lobe::experiment::warp_test::{chi2_config, warp_test};
+use lobe::experiment::warp_test::{interactive_config, warp_test};
 use lobe::experiment::{albedo, lobe_grid, polar};
 use lobe::models::{MODELS, Param, Range, Value as PValue};
 use lobe::{BsdfStrategy, Material, MaterialDesc, Rgb};
@@ -36,6 +36,8 @@ pub mod limits {
     pub const MAX_SIZE: u32 = 512;
     pub const MAX_SPP: u64 = 256;
     pub const MAX_PASS: u64 = 4095;
+    /// Camera samples of one pass, `size² × spp` (a 256² pass of 64).
+    pub const MAX_PASS_SAMPLES: u64 = 1 << 22;
     /// A request body (a material description and settings).
     pub const MAX_BODY: usize = 64 * 1024;
 }
@@ -117,29 +119,11 @@ fn resolve_paths(state: &State, v: &mut Value) -> Result<(), ApiError> {
     Ok(())
 }
 
-/// The view direction at `theta_o`, `phi_o` degrees: θo in `[0, 90)`, or
-/// up to 180 (from below) for a material that transmits or is two-sided.
+/// The view direction at `theta_o`, `phi_o` degrees
+/// ([`Material::view_direction`]).
 pub fn view(m: &Material, theta_o: f64, phi_o: f64) -> Result<DVec3, ApiError> {
-    let below_ok = m.reach().transmits || m.two_sided;
-    let top = if below_ok { 180.0 } else { 90.0 };
-    if !(theta_o.is_finite() && phi_o.is_finite()) {
-        return Err(ApiError::bad("`theta_o` and `phi_o` must be numbers"));
-    }
-    if !(0.0..=top).contains(&theta_o) || theta_o == 90.0 || (!below_ok && theta_o >= 90.0) {
-        return Err(ApiError::bad(format!(
-            "`theta_o` {theta_o} must be in [0, 90){}",
-            if below_ok {
-                " or (90, 180] for this material"
-            } else {
-                ""
-            }
-        )));
-    }
-    let wo = lobe::frame::wo_from_theta(theta_o, phi_o);
-    if wo.z == 0.0 {
-        return Err(ApiError::bad("the view direction is on the horizon"));
-    }
-    Ok(wo)
+    m.view_direction(theta_o, phi_o)
+        .map_err(|e| ApiError::bad(e.named("`theta_o`", "`phi_o`")))
 }
 
 fn rgb(c: Rgb) -> [f64; 3] {
@@ -297,15 +281,7 @@ pub fn warp(state: &State, body: &[u8]) -> Result<Value, ApiError> {
     let sp = m
         .sampler(strategy)
         .map_err(|e| ApiError::bad(format!("`strategy`: {e}")))?;
-    // The chi-square's bins as `lobe report --quick` has them: a test
-    // that answers while the slider moves.
-    let config = lobe::stats::chi2::Chi2Settings {
-        n_z: 16,
-        n_phi: 16,
-        samples,
-        ..chi2_config(m)
-    };
-    let w = warp_test(&sp, wo, config, res, &());
+    let w = warp_test(&sp, wo, interactive_config(m, samples), res, &());
     let weights: Vec<Option<f64>> = weight_pixels(&sp, wo, heat_res)
         .into_iter()
         .map(|p| match p {
@@ -414,6 +390,13 @@ pub fn sphere(state: &State, body: &[u8]) -> Result<Value, ApiError> {
     let size = bounded("size", r.size, 96, 8, limits::MAX_SIZE)?;
     let spp = bounded("spp", r.spp, 4, 1, limits::MAX_SPP)?;
     let pass = bounded("pass", Some(r.pass), 0, 0, limits::MAX_PASS)?;
+    let work = u64::from(size) * u64::from(size) * spp;
+    if work > limits::MAX_PASS_SAMPLES {
+        return Err(ApiError::bad(format!(
+            "`size`² × `spp` = {work} samples in one pass: at most {} (fewer samples a pass, more passes)",
+            limits::MAX_PASS_SAMPLES
+        )));
+    }
     let b = build(state, &r.material)?;
     let env = state.envmap(&r.env)?;
     let scene = lobe_render::scene::material_preview(b.material, env, size)

@@ -44,6 +44,9 @@ pub struct Config {
     /// The materials the page opens with (descriptions as JSON objects);
     /// empty: the page's own two.
     pub materials: Vec<Value>,
+    /// A line on standard error for each API request: method, path,
+    /// status, milliseconds (and the error's message).
+    pub log: bool,
 }
 
 impl Default for Config {
@@ -53,6 +56,7 @@ impl Default for Config {
             port: 0,
             data: None,
             materials: Vec::new(),
+            log: false,
         }
     }
 }
@@ -64,6 +68,7 @@ const MAX_PENDING: usize = 256;
 /// What the handlers share.
 pub struct State {
     pub data: DataDir,
+    log: bool,
     materials: Vec<Value>,
     /// Environment maps by name, loaded once.
     envmaps: Mutex<HashMap<String, Arc<EnvMap>>>,
@@ -106,6 +111,7 @@ impl Server {
         let cpus = std::thread::available_parallelism().map_or(1, |n| n.get());
         let state = Arc::new(State {
             data,
+            log: config.log,
             materials: config.materials.clone(),
             envmaps: Mutex::new(HashMap::new()),
             gate: Arc::new(Semaphore::new(cpus)),
@@ -211,7 +217,21 @@ async fn handle(AxState(state): AxState<Arc<State>>, req: Request) -> Response {
             .into_response();
         }
     };
-    match run_view(state, view, body).await {
+    let t = std::time::Instant::now();
+    let log = state.log;
+    let r = run_view(state, view, body).await;
+    if log {
+        let ms = t.elapsed().as_secs_f64() * 1e3;
+        match &r {
+            Ok(_) => eprintln!("lobe explore: POST {path} 200 {ms:.0} ms"),
+            Err(e) => eprintln!(
+                "lobe explore: POST {path} {} {ms:.0} ms: {}",
+                e.status.as_u16(),
+                e.message
+            ),
+        }
+    }
+    match r {
         Ok(v) => axum::Json(v).into_response(),
         Err(e) => e.into_response(),
     }

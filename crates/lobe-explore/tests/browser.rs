@@ -348,7 +348,10 @@ fn a_measured_table_beside_its_fit() {
         60,
     );
     let names = page.eval("JSON.stringify(document.getElementById('polar').data.map(t => t.name))");
-    assert!(names.as_str().unwrap().contains("4. fit of paint.bsdf"), "{names}");
+    assert!(
+        names.as_str().unwrap().contains("4. fit of paint.bsdf"),
+        "{names}"
+    );
     let status = page.eval("document.getElementById('fit-status').textContent");
     assert!(status.as_str().unwrap().contains("error"), "{status}");
     // Let the lit sphere refine a few passes before the picture.

@@ -3,9 +3,9 @@
 //!
 //! The pure-Rust parts are modules of their own, tested by `cargo test`
 //! without Python: the array [`engine`] (batch SIMD kernels with a scalar
-//! fallback, rayon blocks), the
-//! [`estimate`] call and the [`chi2`] glue. The PyO3 glue (`py`) is built
-//! only with the `python` feature, which maturin turns on
+//! fallback, rayon blocks), the [`estimate`] call, the explorer's
+//! [`views`] and the [`chi2`] glue. The PyO3 glue (`py`) is built only
+//! with the `python` feature, which maturin turns on
 //! (`pyproject.toml`), so a plain `cargo build` or `cargo test` neither
 //! needs nor links a Python interpreter.
 
@@ -15,3 +15,4 @@ pub mod estimate;
 pub mod pool;
 #[cfg(feature = "python")]
 mod py;
+pub mod views;

@@ -646,8 +646,45 @@ impl PyMaterial {
         &self.desc
     }
 
+    /// The description as TOML text (a material file for `--material
+    /// @FILE.toml`, or a scene's `material` table): `MaterialDesc::to_toml`
+    /// of `description`, its keys in lobe's order (a Mitsuba colour dict
+    /// `{"type": "rgb", "value": [...]}` written as `[r, g, b]`).
+    /// Conventions: local frame (+z the normal), wo toward the viewer, wi
+    /// toward the light, f without the cosine, weight = f·cos θi / pdf.
+    ///
+    /// >>> import lobe
+    /// >>> print(lobe.load_dict({"type": "roughconductor", "alpha": 0.2}).to_toml().strip())
+    /// type = "roughconductor"
+    /// alpha = 0.2
+    fn to_toml(&self) -> PyResult<String> {
+        self.desc_of()?.to_toml().map_err(value_error)
+    }
+
+    /// The description as a Python dict literal, for `lobe.load_dict`
+    /// (and Mitsuba 3's `mi.load_dict` where the model is Mitsuba's):
+    /// `MaterialDesc::to_python` of `description` (`ast.literal_eval`
+    /// reads it back).
+    /// Conventions: local frame (+z the normal), wo toward the viewer, wi
+    /// toward the light, f without the cosine, weight = f·cos θi / pdf.
+    ///
+    /// >>> import lobe
+    /// >>> lobe.load_dict({"type": "roughconductor", "alpha": 0.2}).to_python()
+    /// '{"type": "roughconductor", "alpha": 0.2}'
+    fn to_python(&self) -> PyResult<String> {
+        Ok(self.desc_of()?.to_python())
+    }
+
     fn __repr__(&self) -> String {
         format!("lobe.Material({})", self.desc)
+    }
+}
+
+impl PyMaterial {
+    /// `description` as lobe's `MaterialDesc`.
+    fn desc_of(&self) -> PyResult<lobe::MaterialDesc> {
+        lobe::MaterialDesc::from_json(&self.desc)
+            .map_err(|e| value_error(without_position(&e.to_string())))
     }
 }
 
@@ -858,6 +895,151 @@ fn _furnace_json(
         .map_err(|e| value_error(e.to_string()))
 }
 
+/// `v` as an `(n,)` float64 array.
+fn array1(py: Python<'_>, v: Vec<f64>) -> Bound<'_, PyAny> {
+    Array1::from_vec(v).into_pyarray(py).into_any()
+}
+
+/// `v` as a C-ordered float64 array of `shape`.
+fn array_nd<'py>(py: Python<'py>, v: Vec<f64>, shape: &[usize]) -> Bound<'py, PyAny> {
+    ndarray::ArrayD::from_shape_vec(ndarray::IxDyn(shape), v)
+        .expect("the shape of the values")
+        .into_pyarray(py)
+        .into_any()
+}
+
+/// `_polar`'s `(theta, fcos, pdfs, full_circle)`.
+type PolarOut<'py> = (
+    Bound<'py, PyAny>,
+    Bound<'py, PyAny>,
+    Bound<'py, PyDict>,
+    bool,
+);
+
+/// `_lobe_grid`'s `(theta, phi, values, sphere)`.
+type GridOut<'py> = (
+    Bound<'py, PyAny>,
+    Bound<'py, PyAny>,
+    Bound<'py, PyAny>,
+    bool,
+);
+
+/// The explorer's polar view (`lobe.polar`): `(theta, fcos, pdfs,
+/// full_circle)`, `pdfs` a dict of strategy name to array.
+#[pyfunction]
+#[pyo3(signature = (material, theta_o, phi_o, steps))]
+fn _polar<'py>(
+    py: Python<'py>,
+    material: &PyMaterial,
+    theta_o: f64,
+    phi_o: f64,
+    steps: usize,
+) -> PyResult<PolarOut<'py>> {
+    let m = &material.m;
+    let p = py
+        .detach(|| in_pool(|| crate::views::polar(m, theta_o, phi_o, steps)))
+        .map_err(value_error)?;
+    let pdfs = PyDict::new(py);
+    for (name, v) in p.pdfs {
+        pdfs.set_item(name, array1(py, v))?;
+    }
+    Ok((array1(py, p.theta), array1(py, p.fcos), pdfs, p.full_circle))
+}
+
+/// The explorer's 3D lobe (`lobe.lobe_grid`): `(theta, phi, values,
+/// sphere)`, `values` of shape `(len(theta), len(phi))`.
+#[pyfunction]
+#[pyo3(signature = (material, theta_o, phi_o, n_theta, n_phi))]
+fn _lobe_grid<'py>(
+    py: Python<'py>,
+    material: &PyMaterial,
+    theta_o: f64,
+    phi_o: f64,
+    n_theta: usize,
+    n_phi: usize,
+) -> PyResult<GridOut<'py>> {
+    let m = &material.m;
+    let g = py
+        .detach(|| in_pool(|| crate::views::lobe_grid(m, theta_o, phi_o, n_theta, n_phi)))
+        .map_err(value_error)?;
+    let shape = [g.theta.len(), g.phi.len()];
+    Ok((
+        array1(py, g.theta),
+        array1(py, g.phi),
+        array_nd(py, g.values, &shape),
+        g.sphere,
+    ))
+}
+
+/// The explorer's albedo curve (`lobe.albedo_curve`): `(len, 3)` RGB.
+#[pyfunction]
+#[pyo3(signature = (material, thetas_deg, phi_deg, n))]
+fn _albedo_curve<'py>(
+    py: Python<'py>,
+    material: &PyMaterial,
+    thetas_deg: Vec<f64>,
+    phi_deg: f64,
+    n: usize,
+) -> PyResult<Bound<'py, PyAny>> {
+    let m = &material.m;
+    let a = py
+        .detach(|| in_pool(|| crate::views::albedo_curve(m, &thetas_deg, phi_deg, n)))
+        .map_err(value_error)?;
+    let rows = a.len();
+    Ok(array_nd(py, a.into_iter().flatten().collect(), &[rows, 3]))
+}
+
+/// The explorer's warp test (`lobe.warp_test`): a dict of `observed`,
+/// `expected` (`(grids, res, res)`), `sphere`, `statistic`, `dof`,
+/// `p_value` and `message`.
+#[pyfunction]
+#[pyo3(signature = (material, strategy, theta_o, phi_o, samples, res, seed))]
+#[allow(clippy::too_many_arguments)]
+fn _warp_test<'py>(
+    py: Python<'py>,
+    material: &PyMaterial,
+    strategy: &str,
+    theta_o: f64,
+    phi_o: f64,
+    samples: usize,
+    res: usize,
+    seed: Option<u64>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let m = &material.m;
+    let w = py
+        .detach(|| in_pool(|| crate::views::warp(m, strategy, theta_o, phi_o, samples, res, seed)))
+        .map_err(value_error)?;
+    let shape = [if w.sphere { 2 } else { 1 }, w.res, w.res];
+    let out = PyDict::new(py);
+    out.set_item("observed", array_nd(py, w.observed, &shape))?;
+    out.set_item("expected", array_nd(py, w.expected, &shape))?;
+    out.set_item("sphere", w.sphere)?;
+    out.set_item("statistic", w.statistic)?;
+    out.set_item("dof", w.dof)?;
+    out.set_item("p_value", w.p_value)?;
+    out.set_item("message", w.message)?;
+    Ok(out)
+}
+
+/// The explorer's weight heat map (`lobe.weight_map`): `(grids, res,
+/// res)`, NaN outside the disk or where the strategy never samples.
+#[pyfunction]
+#[pyo3(signature = (material, strategy, theta_o, phi_o, res))]
+fn _weight_map<'py>(
+    py: Python<'py>,
+    material: &PyMaterial,
+    strategy: &str,
+    theta_o: f64,
+    phi_o: f64,
+    res: usize,
+) -> PyResult<Bound<'py, PyAny>> {
+    let m = &material.m;
+    let (v, sphere) = py
+        .detach(|| in_pool(|| crate::views::weight_map(m, strategy, theta_o, phi_o, res)))
+        .map_err(value_error)?;
+    Ok(array_nd(py, v, &[if sphere { 2 } else { 1 }, res, res]))
+}
+
 /// Render a scene (TOML text as if read from `path`) to an (H, W, 3)
 /// float32 linear image.
 /// Run `work` with the GIL released, on a thread of its own, while this
@@ -1052,6 +1234,11 @@ fn _lobe(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(_furnace_json, m)?)?;
     m.add_function(wrap_pyfunction!(_fit_json, m)?)?;
     m.add_function(wrap_pyfunction!(_render, m)?)?;
+    m.add_function(wrap_pyfunction!(_polar, m)?)?;
+    m.add_function(wrap_pyfunction!(_lobe_grid, m)?)?;
+    m.add_function(wrap_pyfunction!(_albedo_curve, m)?)?;
+    m.add_function(wrap_pyfunction!(_warp_test, m)?)?;
+    m.add_function(wrap_pyfunction!(_weight_map, m)?)?;
     m.add_function(wrap_pyfunction!(_json_to_toml, m)?)?;
     m.add_function(wrap_pyfunction!(_chi2_uniforms, m)?)?;
     m.add_function(wrap_pyfunction!(_chi2_test, m)?)?;

@@ -103,7 +103,7 @@ pub use frame::Frame;
 pub use fresnel::Fresnel;
 pub use glam;
 pub use light::Light;
-pub use material::{BsdfSampler, Glossy, Material};
+pub use material::{BsdfSampler, Glossy, Material, ViewError};
 pub use math::Rgb;
 pub use microfacet::{Microfacet, Ndf, Shadowing};
 pub use sample::{BsdfSample, Component, Delta, Deltas, LobeSample, Reach, Scattering};

@@ -157,6 +157,35 @@ impl Material {
             .collect()
     }
 
+    /// The view direction `wo` at `theta_deg` from the normal and azimuth
+    /// `phi_deg`: θ in `[0, 90)`, or in `(90, 180]` (from below) for a
+    /// material that transmits or is two-sided; φ any finite number. The
+    /// error says which angle and why (front ends name their field with
+    /// [`ViewError::named`]).
+    pub fn view_direction(&self, theta_deg: f64, phi_deg: f64) -> Result<DVec3, ViewError> {
+        if !phi_deg.is_finite() {
+            return Err(ViewError::Phi(format!(
+                "{phi_deg}: the azimuth must be a finite number of degrees"
+            )));
+        }
+        let below = self.reach().transmits || self.two_sided;
+        let ok = theta_deg.is_finite()
+            && ((0.0..90.0).contains(&theta_deg)
+                || (below && theta_deg > 90.0 && theta_deg <= 180.0));
+        if !ok {
+            return Err(ViewError::Theta(if below {
+                format!(
+                    "{theta_deg}: the view angle must be in [0, 90) or (90, 180] degrees (from below) for this material"
+                )
+            } else {
+                format!(
+                    "{theta_deg}: the view angle must be in [0, 90) degrees (this material neither transmits nor is two-sided)"
+                )
+            }));
+        }
+        Ok(crate::frame::wo_from_theta(theta_deg, phi_deg))
+    }
+
     /// The BSDF strategy to pair with light sampling in MIS: visible normals
     /// where the material has them, else the lecture's `brdf`.
     #[must_use]
@@ -584,4 +613,22 @@ fn finish(
         component,
         scattering,
     })
+}
+
+/// Which angle [`Material::view_direction`] refused, with the value and why.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum ViewError {
+    Theta(String),
+    Phi(String),
+}
+
+impl ViewError {
+    /// The message with the angle named as the front end spells it.
+    #[must_use]
+    pub fn named(&self, theta: &str, phi: &str) -> String {
+        match self {
+            ViewError::Theta(m) => format!("{theta} {m}"),
+            ViewError::Phi(m) => format!("{phi} {m}"),
+        }
+    }
 }

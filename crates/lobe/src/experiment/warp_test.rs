@@ -28,6 +28,22 @@ pub fn chi2_config(m: &Material) -> Chi2Settings {
     }
 }
 
+/// The chi-square bins (in `z` and in `φ`) of [`interactive_config`].
+pub const INTERACTIVE_BINS: usize = 16;
+
+/// [`chi2_config`] with `samples` draws and [`INTERACTIVE_BINS`]² bins, as
+/// `lobe report --quick` has them: a test that answers while a slider
+/// moves (`lobe explore`, Python's `lobe.warp_test`).
+#[must_use]
+pub fn interactive_config(m: &Material, samples: usize) -> Chi2Settings {
+    Chi2Settings {
+        n_z: INTERACTIVE_BINS,
+        n_phi: INTERACTIVE_BINS,
+        samples,
+        ..chi2_config(m)
+    }
+}
+
 /// What [`warp_test`] found.
 #[derive(Debug, Clone, PartialEq)]
 pub struct WarpTest {
