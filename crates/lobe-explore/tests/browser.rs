@@ -302,6 +302,33 @@ fn the_page_works_in_chromium() {
     assert_eq!(page_errors, json!("[]"), "errors shown on the page");
     let errors = page.errors();
     assert!(errors.is_empty(), "console errors: {errors:#?}");
+
+    // A material the server refuses (a glass cannot be two-sided): the
+    // server's message is shown on the page, and the page goes on.
+    page.eval(
+        "(() => { const c = document.querySelector('.material[data-index=\"0\"] .twosided'); \
+         c.checked = true; c.dispatchEvent(new Event('change', {bubbles: true})); return true; })()",
+    );
+    page.wait_for(
+        "!document.getElementById('error').hidden && document.getElementById('error').textContent.length > 0",
+        60,
+    );
+    let shown = page.eval("document.getElementById('error').textContent");
+    eprintln!("shown on the page: {shown}");
+    assert!(shown.as_str().unwrap().contains("material"), "{shown}");
+    let before = version(&mut page, "polar");
+    page.eval(
+        "(() => { const c = document.querySelector('.material[data-index=\"0\"] .twosided'); \
+         c.checked = false; c.dispatchEvent(new Event('change', {bubbles: true})); return true; })()",
+    );
+    let t = Instant::now();
+    while version(&mut page, "polar") <= before {
+        assert!(
+            t.elapsed() < Duration::from_secs(60),
+            "the page did not recover"
+        );
+        std::thread::sleep(Duration::from_millis(100));
+    }
 }
 
 #[test]
