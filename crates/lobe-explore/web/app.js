@@ -341,7 +341,10 @@ const descriptionKey = (desc) => JSON.stringify(desc);
 
 /** The legend name of material `m` at `index` (kept short for the legends). */
 function legendName(m, index) {
-  let text = `${m.label || m.type}${m.twosided ? ', two-sided' : ''}`;
+  // A measured material is named by its file.
+  const file = m.label ? null : fileOf(m);
+  const name = m.label || (file ? `${m.type} ${file.split('/').pop()}` : m.type);
+  let text = `${name}${m.twosided ? ', two-sided' : ''}`;
   if (text.length > 26) text = `${text.slice(0, 25)}…`;
   return `${index + 1}. ${text}`;
 }
