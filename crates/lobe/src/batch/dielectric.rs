@@ -82,11 +82,18 @@ fn d_ggx<L: Lanes>(l: L, p: &CtParams, m: V3<L>) -> L::F {
 /// (lanes), 1 under total internal reflection, and the refracted cosine.
 #[inline(always)]
 pub(super) fn fresnel<L: Lanes>(l: L, c: L::F, eta: L::F, inv_eta: L::F) -> (L::F, L::F) {
+    let (ct, tir) = refracted_cos(l, c, inv_eta);
+    (l.select(tir, l.splat(1.0), fresnel_cos(l, c, ct, eta)), ct)
+}
+
+/// The refracted cosine at `c` by Snell's law (0 under total internal
+/// reflection), and where total internal reflection is.
+#[inline(always)]
+fn refracted_cos<L: Lanes>(l: L, c: L::F, inv_eta: L::F) -> (L::F, L::M) {
     let one = l.splat(1.0);
     let sin2_t = (one - c * c) * (inv_eta * inv_eta);
     let tir = l.gt(sin2_t, one) | l.eq(sin2_t, one);
-    let ct = l.sqrt(l.max(one - sin2_t, l.splat(0.0)));
-    (l.select(tir, one, fresnel_cos(l, c, ct, eta)), ct)
+    (l.sqrt(l.max(one - sin2_t, l.splat(0.0))), tir)
 }
 
 /// Fresnel reflectance at `c` whose refracted cosine `ct` is known.
@@ -315,8 +322,9 @@ pub(crate) fn eval_pdf<L: Lanes, const NDF: u8, const STRAT: u8>(
     // A refraction's cos θt is |wi·m| itself: from c_o by Snell's law it
     // cancels next to total internal reflection, where c_o hardly moves
     // with the directions (the f64 path's F there is well-conditioned).
-    let (fr, _) = fresnel(l, c_o1, eta_s, inv_eta_s);
-    let fr = l.select(reflect, fr, fresnel_cos(l, c_o1, l.abs(c_i), eta_s));
+    let (ct_snell, tir) = refracted_cos(l, c_o1, inv_eta_s);
+    let ct = l.select(reflect, ct_snell, l.abs(c_i));
+    let fr = l.select(tir & reflect, one, fresnel_cos(l, c_o1, ct, eta_s));
     let (f, pdf) = f_pdf::<L, NDF, STRAT>(l, p, up, wi_up, m, c_o, c_i, fr, eta_s);
     let f_ok = ok & l.is_finite(f[0]) & l.is_finite(f[1]) & l.is_finite(f[2]);
     if STRAT == UNIFORM || STRAT == COSINE {
