@@ -4,8 +4,8 @@
 //! ([`limits`]); the work runs on the blocking pool behind
 //! [`crate::State`]'s gate.
 
-use crate::State;
 use crate::error::ApiError;
+use crate::state::State;
 use glam::DVec3;
 use lobe::experiment::estimate::{EstimateTableSettings, estimate_table};
 use lobe::experiment::histogram::{WeightPixel, weight_pixels};
@@ -15,7 +15,6 @@ use lobe::models::{MODELS, Param, Range, Value as PValue};
 use lobe::{BsdfStrategy, Material, MaterialDesc, Rgb};
 use serde::Deserialize;
 use serde_json::{Value, json};
-use std::sync::Arc;
 
 /// The bounds of a request's work: beyond them it is refused with the
 /// bound named, so that no request can hold the server for long.
@@ -547,22 +546,4 @@ pub fn models(state: &State) -> Value {
         .map(|s| json!({"name": s.name(), "description": lobe::strategy::description(s.name())}))
         .collect();
     json!({"models": models, "strategies": strategies, "data_files": files})
-}
-
-/// The state's environment maps: the built-in sky, or a file of the data
-/// directory (loaded once).
-pub(crate) fn load_envmap(
-    state: &State,
-    name: &str,
-) -> Result<Arc<lobe::envmap::EnvMap>, ApiError> {
-    if name == "sky" {
-        let (e, a, scale, rot) = (35.0, 40.0, 1.0, 0.0);
-        let (map, _) = lobe_render::envmap_io::sky(e, a, scale, rot)
-            .map_err(|e| ApiError::internal(e.to_string()))?;
-        return Ok(Arc::new(map));
-    }
-    let path = state.data.resolve(name).map_err(ApiError::bad)?;
-    let (map, _) = lobe_render::envmap_io::load_envmap(&path, 1.0, 0.0)
-        .map_err(|e| ApiError::bad(format!("`{name}`: {e}")))?;
-    Ok(Arc::new(map))
 }

@@ -15,21 +15,20 @@ pub mod api;
 mod assets;
 pub mod error;
 pub mod sandbox;
+pub mod state;
 
 use axum::Router;
 use axum::extract::{Request, State as AxState};
 use axum::http::{Method, StatusCode};
 use axum::response::{IntoResponse, Response};
 use error::ApiError;
-use lobe::envmap::EnvMap;
 use sandbox::DataDir;
 use serde_json::Value;
-use std::collections::HashMap;
+use state::State;
 use std::net::{IpAddr, Ipv4Addr, SocketAddr};
 use std::path::PathBuf;
+use std::sync::Arc;
 use std::sync::atomic::{AtomicUsize, Ordering};
-use std::sync::{Arc, Mutex};
-use tokio::sync::Semaphore;
 
 /// How the server starts.
 #[derive(Debug, Clone)]
@@ -65,36 +64,6 @@ impl Default for Config {
 /// 503 at once (a burst never queues unbounded work).
 const MAX_PENDING: usize = 256;
 
-/// What the handlers share.
-pub struct State {
-    pub data: DataDir,
-    log: bool,
-    materials: Vec<Value>,
-    /// Environment maps by name, loaded once.
-    envmaps: Mutex<HashMap<String, Arc<EnvMap>>>,
-    /// Computations at once: one per CPU (each is parallel itself).
-    gate: Arc<Semaphore>,
-    pending: AtomicUsize,
-}
-
-impl State {
-    /// The environment map `name` names ("sky" or a data file), cached.
-    pub fn envmap(&self, name: &str) -> Result<Arc<EnvMap>, ApiError> {
-        if let Some(m) = self.envmaps.lock().ok().and_then(|m| m.get(name).cloned()) {
-            return Ok(m);
-        }
-        let m = api::load_envmap(self, name)?;
-        if let Ok(mut cache) = self.envmaps.lock() {
-            // At most a few maps are kept (each can be large).
-            if cache.len() >= 4 {
-                cache.clear();
-            }
-            cache.insert(name.to_string(), m.clone());
-        }
-        Ok(m)
-    }
-}
-
 /// A bound server: its listener and state.
 pub struct Server {
     runtime: tokio::runtime::Runtime,
@@ -109,14 +78,7 @@ impl Server {
     pub fn bind(config: &Config) -> Result<Server, String> {
         let data = DataDir::new(config.data.as_deref())?;
         let cpus = std::thread::available_parallelism().map_or(1, |n| n.get());
-        let state = Arc::new(State {
-            data,
-            log: config.log,
-            materials: config.materials.clone(),
-            envmaps: Mutex::new(HashMap::new()),
-            gate: Arc::new(Semaphore::new(cpus)),
-            pending: AtomicUsize::new(0),
-        });
+        let state = Arc::new(State::new(data, config.log, config.materials.clone(), cpus));
         for (i, m) in config.materials.iter().enumerate() {
             api::build(&state, m).map_err(|e| format!("--material #{}: {}", i + 1, e.message))?;
         }
