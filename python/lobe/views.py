@@ -203,7 +203,7 @@ def warp_test(
     projected hemisphere beside the counts its pdf expects, and the
     chi-square test of the draws against the pdf over the sphere (16 × 16
     bins, the material's settings otherwise): the explorer's warp test
-    (``lobe::experiment::warp_test::warp_test`` with ``chi2_config``).
+    (``lobe::experiment::warp_test::warp_test`` with ``interactive_config``).
     ``seed``: None for the chi-square harness's default (the explorer's).
     A strategy that does not apply raises ``ValueError`` naming it.
 
